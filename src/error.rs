@@ -1,0 +1,122 @@
+//! The one error type of the core. Every variant names the argument it is
+//! about and, where there is one, the offending index and value, so that the
+//! binding layer can pass the `Display` text to Python unchanged.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in mcsample's core.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A table weight that is NaN, infinite or negative.
+    #[error("{arg}[{index}] = {value}: {arg} must be finite and >= 0")]
+    InvalidWeight {
+        /// Name of the argument.
+        arg: &'static str,
+        /// Flat index of the first offending entry.
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// A table whose weights are all zero (or that is empty).
+    #[error("{arg} is empty or all zero: nothing to sample")]
+    AllZero {
+        /// Name of the argument.
+        arg: &'static str,
+    },
+    /// An array of the wrong shape.
+    #[error("{arg} must have shape {expected}, got {got}")]
+    Shape {
+        /// Name of the argument.
+        arg: &'static str,
+        /// The shapes accepted, e.g. `(N, 2) or (2,)`.
+        expected: String,
+        /// The shape given, e.g. `(5, 3)`.
+        got: String,
+    },
+    /// A scalar parameter outside its valid range.
+    #[error("{arg} = {value}: {requirement}")]
+    Parameter {
+        /// Name of the argument.
+        arg: &'static str,
+        /// The offending value.
+        value: f64,
+        /// What the value must satisfy, e.g. `must be >= 0`.
+        requirement: &'static str,
+    },
+    /// An entry of a batch outside its valid range (e.g. `u` outside `[0, 1]`).
+    #[error("{arg}{index} = {value}: {requirement}")]
+    Element {
+        /// Name of the argument.
+        arg: &'static str,
+        /// Index of the first offending entry, formatted as `[i]` or `[i, j]`.
+        index: String,
+        /// The offending value.
+        value: f64,
+        /// What every entry must satisfy.
+        requirement: &'static str,
+    },
+    /// An integer argument that is negative or too large.
+    #[error("{arg} = {value}: {requirement}")]
+    Integer {
+        /// Name of the argument.
+        arg: &'static str,
+        /// The offending value, as text (it may not fit any Rust integer).
+        value: String,
+        /// What the value must satisfy.
+        requirement: String,
+    },
+    /// A file that cannot be read or written, or whose content is invalid.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+/// Result type of the core.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Formats a shape as numpy prints it: `(5, 3)`, `(2,)`, `()`.
+pub fn shape_str(shape: &[usize]) -> String {
+    match shape {
+        [one] => format!("({one},)"),
+        _ => {
+            let parts: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+            format!("({})", parts.join(", "))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn messages_name_argument_index_and_value() {
+        let e = Error::InvalidWeight {
+            arg: "weights",
+            index: 17,
+            value: -0.5,
+        };
+        assert_eq!(
+            e.to_string(),
+            "weights[17] = -0.5: weights must be finite and >= 0"
+        );
+        let e = Error::Element {
+            arg: "u",
+            index: "[3, 1]".into(),
+            value: f64::NAN,
+            requirement: "must lie in [0, 1]",
+        };
+        assert_eq!(e.to_string(), "u[3, 1] = NaN: must lie in [0, 1]");
+    }
+
+    #[test]
+    fn shapes_print_like_numpy() {
+        assert_eq!(shape_str(&[5, 3]), "(5, 3)");
+        assert_eq!(shape_str(&[2]), "(2,)");
+        assert_eq!(shape_str(&[]), "()");
+    }
+}

@@ -1,0 +1,302 @@
+//! Image files: OpenEXR (read RGB / RGBA with half or float channels, write
+//! float or half), Radiance `.hdr` (RGBE, read) and PNG (write, tone-mapped
+//! with an exposure and the sRGB transfer curve).
+//!
+//! Pixels are linear RGB(A) `f32`, row-major `(height, width, channels)`,
+//! row 0 at the top. Every failure is an [`Error::Io`] naming the path.
+
+use crate::error::{Error, Result};
+use std::path::Path;
+
+/// A linear image: `height × width × channels` floats, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Raster {
+    /// Number of columns.
+    pub width: usize,
+    /// Number of rows.
+    pub height: usize,
+    /// 3 (RGB) or 4 (RGBA).
+    pub channels: usize,
+    /// Row-major samples, `channels` per pixel.
+    pub data: Vec<f32>,
+}
+
+fn io_error(path: &Path, message: impl std::fmt::Display) -> Error {
+    Error::Io {
+        path: path.to_path_buf(),
+        message: message.to_string(),
+    }
+}
+
+impl Raster {
+    fn check(&self, path: &Path) -> Result<()> {
+        let expected = self.width * self.height * self.channels;
+        if !(3..=4).contains(&self.channels) || self.data.len() != expected {
+            return Err(io_error(
+                path,
+                format!(
+                    "image must be height x width x 3 or 4, got {} samples for {}x{}x{}",
+                    self.data.len(),
+                    self.height,
+                    self.width,
+                    self.channels
+                ),
+            ));
+        }
+        if self.width == 0 || self.height == 0 {
+            return Err(io_error(path, "image is empty"));
+        }
+        Ok(())
+    }
+
+    fn pixel(&self, x: usize, y: usize) -> &[f32] {
+        let start = (y * self.width + x) * self.channels;
+        &self.data[start..start + self.channels]
+    }
+}
+
+/// Reads the first RGB layer of an OpenEXR file (half, float or uint
+/// channels, converted to `f32`); the result has 4 channels when the file
+/// has an `A` channel, else 3.
+///
+/// # Errors
+/// [`Error::Io`] if the file cannot be opened, is not OpenEXR, is truncated,
+/// or has no R, G and B channels.
+pub fn read_exr(path: &Path) -> Result<Raster> {
+    use exr::prelude::*;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .specific_channels()
+        .required("R")
+        .required("G")
+        .required("B")
+        .optional("A", 1.0f32)
+        .collect_pixels(
+            |size: Vec2<usize>, (_, _, _, alpha)| {
+                let channels = if alpha.is_some() { 4 } else { 3 };
+                Raster {
+                    width: size.width(),
+                    height: size.height(),
+                    channels,
+                    data: vec![0.0; size.area() * channels],
+                }
+            },
+            |raster: &mut Raster, pos: Vec2<usize>, (r, g, b, a): (f32, f32, f32, f32)| {
+                let start = (pos.y() * raster.width + pos.x()) * raster.channels;
+                let px = [r, g, b, a];
+                raster.data[start..start + raster.channels]
+                    .copy_from_slice(&px[..raster.channels]);
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(|e| io_error(path, format!("cannot read OpenEXR: {e}")))?;
+    Ok(image.layer_data.channel_data.pixels)
+}
+
+/// Writes an RGB or RGBA OpenEXR file with `f32` channels, or `f16` when
+/// `half` is true (values beyond ±65504 become ±inf).
+///
+/// # Errors
+/// [`Error::Io`] if the raster's size is inconsistent or the file cannot be
+/// written.
+pub fn write_exr(path: &Path, image: &Raster, half: bool) -> Result<()> {
+    use exr::prelude::*;
+    image.check(path)?;
+    let size = (image.width, image.height);
+    let h = |v: f32| f16::from_f32(v);
+    let result = match (image.channels, half) {
+        (3, false) => Image::from_channels(
+            size,
+            SpecificChannels::rgb(|p: Vec2<usize>| {
+                let c = image.pixel(p.x(), p.y());
+                (c[0], c[1], c[2])
+            }),
+        )
+        .write()
+        .to_file(path),
+        (3, true) => Image::from_channels(
+            size,
+            SpecificChannels::rgb(|p: Vec2<usize>| {
+                let c = image.pixel(p.x(), p.y());
+                (h(c[0]), h(c[1]), h(c[2]))
+            }),
+        )
+        .write()
+        .to_file(path),
+        (_, false) => Image::from_channels(
+            size,
+            SpecificChannels::rgba(|p: Vec2<usize>| {
+                let c = image.pixel(p.x(), p.y());
+                (c[0], c[1], c[2], c[3])
+            }),
+        )
+        .write()
+        .to_file(path),
+        (_, true) => Image::from_channels(
+            size,
+            SpecificChannels::rgba(|p: Vec2<usize>| {
+                let c = image.pixel(p.x(), p.y());
+                (h(c[0]), h(c[1]), h(c[2]), h(c[3]))
+            }),
+        )
+        .write()
+        .to_file(path),
+    };
+    result.map_err(|e| io_error(path, format!("cannot write OpenEXR: {e}")))
+}
+
+/// Reads a Radiance RGBE (`.hdr`) file as 3-channel linear RGB.
+///
+/// # Errors
+/// [`Error::Io`] if the file cannot be opened, is not Radiance HDR or is
+/// truncated.
+pub fn read_hdr(path: &Path) -> Result<Raster> {
+    let reader = image::ImageReader::open(path).map_err(|e| io_error(path, e))?;
+    let mut reader = reader;
+    reader.set_format(image::ImageFormat::Hdr);
+    let decoded = reader
+        .decode()
+        .map_err(|e| io_error(path, format!("cannot read Radiance HDR: {e}")))?;
+    let rgb = decoded.into_rgb32f();
+    Ok(Raster {
+        width: rgb.width() as usize,
+        height: rgb.height() as usize,
+        channels: 3,
+        data: rgb.into_raw(),
+    })
+}
+
+/// The sRGB transfer curve (IEC 61966-2-1) of a linear value in `[0, 1]`.
+pub fn srgb_encode(linear: f32) -> f32 {
+    if linear <= 0.003_130_8 {
+        12.92 * linear
+    } else {
+        1.055 * linear.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// A linear value scaled by `2^exposure`, clamped to `[0, 1]`, sRGB-encoded
+/// when `srgb` is true, and quantised to 8 bits. Infinities clamp; NaN is
+/// rejected by [`write_png`] before this is called.
+pub fn tonemap(linear: f32, exposure: f32, srgb: bool) -> u8 {
+    let v = (linear * exposure.exp2()).clamp(0.0, 1.0);
+    let v = if srgb { srgb_encode(v) } else { v };
+    (v * 255.0 + 0.5) as u8
+}
+
+/// Writes an 8-bit PNG of an RGB(A) raster, tone-mapped by [`tonemap`]
+/// (alpha is written linearly, unscaled).
+///
+/// # Errors
+/// [`Error::Element`] naming the first NaN sample; [`Error::Io`] if the file
+/// cannot be written.
+pub fn write_png(path: &Path, image: &Raster, exposure: f32, srgb: bool) -> Result<()> {
+    image.check(path)?;
+    if let Some(i) = image.data.iter().position(|v| v.is_nan()) {
+        let c = image.channels;
+        let (pixel, ch) = (i / c, i % c);
+        return Err(Error::Element {
+            arg: "image",
+            index: format!("[{}, {}, {}]", pixel / image.width, pixel % image.width, ch),
+            value: f64::NAN,
+            requirement: "a PNG cannot show NaN",
+        });
+    }
+    let bytes: Vec<u8> = image
+        .data
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            if image.channels == 4 && i % 4 == 3 {
+                tonemap(v, 0.0, false)
+            } else {
+                tonemap(v, exposure, srgb)
+            }
+        })
+        .collect();
+    let color = if image.channels == 4 {
+        image::ExtendedColorType::Rgba8
+    } else {
+        image::ExtendedColorType::Rgb8
+    };
+    image::save_buffer_with_format(
+        path,
+        &bytes,
+        image.width as u32,
+        image.height as u32,
+        color,
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| io_error(path, format!("cannot write PNG: {e}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gradient(channels: usize) -> Raster {
+        let (width, height) = (7, 5);
+        let data = (0..width * height * channels)
+            .map(|i| i as f32 * 0.37 - 3.0)
+            .collect();
+        Raster {
+            width,
+            height,
+            channels,
+            data,
+        }
+    }
+
+    #[test]
+    fn exr_round_trips_rgb_and_rgba_float_and_half() {
+        let dir = tempfile::tempdir().unwrap();
+        for channels in [3, 4] {
+            for half in [false, true] {
+                let path = dir.path().join(format!("t{channels}{half}.exr"));
+                let image = gradient(channels);
+                write_exr(&path, &image, half).unwrap();
+                let back = read_exr(&path).unwrap();
+                assert_eq!((back.width, back.height, back.channels), (7, 5, channels));
+                let tol = if half { 1e-2 } else { 0.0 };
+                for (a, b) in image.data.iter().zip(&back.data) {
+                    assert!((a - b).abs() <= tol * a.abs().max(1.0), "{a} vs {b}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn truncated_and_missing_files_name_the_path() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.exr");
+        write_exr(&path, &gradient(3), false).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
+        let err = read_exr(&path).unwrap_err().to_string();
+        assert!(err.contains("t.exr"), "{err}");
+        let err = read_hdr(&dir.path().join("nope.hdr")).unwrap_err().to_string();
+        assert!(err.contains("nope.hdr"), "{err}");
+    }
+
+    #[test]
+    fn tonemap_curve() {
+        assert_eq!(tonemap(0.0, 0.0, true), 0);
+        assert_eq!(tonemap(1.0, 0.0, true), 255);
+        assert_eq!(tonemap(f32::INFINITY, 0.0, true), 255);
+        assert_eq!(tonemap(0.25, 1.0, false), 128);
+        assert!((srgb_encode(0.214_041) - 0.5).abs() < 1e-5); // sRGB mid grey
+    }
+
+    #[test]
+    fn png_rejects_nan_and_writes_rgb() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut image = gradient(3);
+        write_png(&dir.path().join("ok.png"), &image, 0.0, true).unwrap();
+        image.data[3 * 7 + 4] = f32::NAN;
+        let err = write_png(&dir.path().join("bad.png"), &image, 0.0, true).unwrap_err();
+        assert_eq!(err.to_string(), "image[1, 1, 1] = NaN: a PNG cannot show NaN");
+    }
+}

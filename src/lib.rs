@@ -1,0 +1,36 @@
+//! # mcsample
+//!
+//! The Monte Carlo sampling toolkit of a physically based renderer: random
+//! numbers, warps, distributions and the statistics that prove them right,
+//! with a Python front (the `python` feature) built by maturin.
+//!
+//! ## Modules
+//! - [`rng`]: PCG32 with jump-ahead, uniform batches.
+//! - [`parallel`]: the batch engine (chunks on a rayon pool, thread count).
+//! - [`warp`]: `square_to_*` warps, their densities and inverses.
+//! - [`io`]: EXR, Radiance HDR and PNG files.
+//! - [`math`]: the [`math::Real`] scalar trait (`f32` / `f64`) and helpers.
+//! - [`error`]: the one error type.
+//!
+//! ## Conventions
+//! - Densities on directions are per steradian; on planar domains per unit
+//!   area; on intervals per unit length.
+//! - Local shading frame: the normal is +z.
+//! - Uniform input `u` lies in `[0, 1]`; `u = 1` maps inside the domain.
+//! - Kernels are infallible and total; inputs are validated at the batch
+//!   boundary. Results are independent of the thread count.
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+
+pub mod error;
+pub mod io;
+pub mod math;
+pub mod parallel;
+pub mod rng;
+pub mod warp;
+
+#[cfg(feature = "python")]
+mod python;
+
+pub use error::{Error, Result};

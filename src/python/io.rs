@@ -1,0 +1,123 @@
+//! `mcsample.io`: image files (see [`crate::io`]). Reads return float32
+//! arrays `(H, W, 3)` (or `(H, W, 4)` for an EXR with alpha); failures raise
+//! `OSError` naming the path, wrong arrays `ValueError`.
+
+use super::parallel::detached;
+use crate::error::{Error, shape_str};
+use crate::io::{self, Raster};
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use std::path::PathBuf;
+
+fn to_numpy<'py>(py: Python<'py>, raster: Raster) -> PyResult<Bound<'py, PyAny>> {
+    let shape = [raster.height, raster.width, raster.channels];
+    Ok(PyArray1::from_vec(py, raster.data).reshape(shape)?.into_any())
+}
+
+fn from_numpy(image: &Bound<'_, PyAny>) -> PyResult<Raster> {
+    let array: PyArrayLikeDyn<'_, f32, AllowTypeChange> = image.extract()?;
+    match *array.shape() {
+        [height, width, channels @ (3 | 4)] if height > 0 && width > 0 => Ok(Raster {
+            width,
+            height,
+            channels,
+            data: array.as_array().iter().copied().collect(),
+        }),
+        _ => Err(Error::Shape {
+            arg: "image",
+            expected: "(H, W, 3) or (H, W, 4) with H, W > 0".into(),
+            got: shape_str(array.shape()),
+        }
+        .into()),
+    }
+}
+
+/// Reads an OpenEXR file (first layer with R, G, B; half, float or uint
+/// channels).
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+///
+/// Returns
+/// -------
+/// ndarray, shape (H, W, 3), or (H, W, 4) if the file has alpha; float32
+/// linear RGB(A), row 0 at the top.
+#[pyfunction]
+pub fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    let raster = detached(py, || io::read_exr(&path))?;
+    to_numpy(py, raster)
+}
+
+/// Writes an OpenEXR file.
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+/// image : array_like, shape (H, W, 3) or (H, W, 4), linear RGB(A)
+/// half : bool
+///     Write 16-bit half floats instead of 32-bit floats.
+#[pyfunction]
+#[pyo3(signature = (path, image, half = false))]
+pub fn write_exr(py: Python<'_>, path: PathBuf, image: &Bound<'_, PyAny>, half: bool) -> PyResult<()> {
+    let raster = from_numpy(image)?;
+    detached(py, || io::write_exr(&path, &raster, half))
+}
+
+/// Reads a Radiance RGBE (.hdr) file.
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+///
+/// Returns
+/// -------
+/// ndarray, shape (H, W, 3), float32 linear RGB, row 0 at the top.
+#[pyfunction]
+pub fn read_hdr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    let raster = detached(py, || io::read_hdr(&path))?;
+    to_numpy(py, raster)
+}
+
+/// Writes an 8-bit PNG of a linear image: scaled by 2**exposure, clamped to
+/// [0, 1] and sRGB-encoded (alpha is written as is).
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+/// image : array_like, shape (H, W, 3) or (H, W, 4), linear RGB(A); NaN is
+///     rejected, infinities clamp to white
+/// exposure : float
+///     In stops (default 0).
+/// srgb : bool
+///     Apply the sRGB transfer curve (default True); False writes the
+///     clamped linear values.
+#[pyfunction]
+#[pyo3(signature = (path, image, exposure = 0.0, srgb = true))]
+pub fn write_png(
+    py: Python<'_>,
+    path: PathBuf,
+    image: &Bound<'_, PyAny>,
+    exposure: f64,
+    srgb: bool,
+) -> PyResult<()> {
+    if !exposure.is_finite() {
+        return Err(Error::Parameter {
+            arg: "exposure",
+            value: exposure,
+            requirement: "must be finite",
+        }
+        .into());
+    }
+    let raster = from_numpy(image)?;
+    detached(py, || io::write_png(&path, &raster, exposure as f32, srgb))
+}
+
+/// Registers the io functions in module `m`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(read_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(write_exr, m)?)?;
+    m.add_function(wrap_pyfunction!(read_hdr, m)?)?;
+    m.add_function(wrap_pyfunction!(write_png, m)?)?;
+    Ok(())
+}

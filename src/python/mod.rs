@@ -1,0 +1,44 @@
+//! The binding layer (`mcsample._core`): argument checks, numpy in and out,
+//! GIL release and error mapping, one file per Python submodule. No
+//! sampling logic lives here.
+
+mod arrays;
+mod error;
+mod io;
+mod parallel;
+mod rng;
+mod warp;
+
+use pyo3::prelude::*;
+
+fn submodule<'py>(
+    parent: &Bound<'py, PyModule>,
+    name: &str,
+    register: fn(&Bound<'py, PyModule>) -> PyResult<()>,
+) -> PyResult<()> {
+    let py = parent.py();
+    let m = PyModule::new(py, name)?;
+    register(&m)?;
+    parent.add_submodule(&m)?;
+    // Make `import mcsample._core.<name>` and `from mcsample._core.<name>
+    // import f` work: extension submodules are not packages.
+    let qualified = format!("mcsample._core.{name}");
+    m.setattr("__name__", &qualified)?;
+    py.import("sys")?
+        .getattr("modules")?
+        .set_item(qualified, &m)
+}
+
+/// mcsample's compiled core. Use the ``mcsample`` package, which re-exports it.
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_class::<rng::PyRng>()?;
+    m.add_function(wrap_pyfunction!(rng::uniform, m)?)?;
+    m.add_function(wrap_pyfunction!(parallel::set_num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(parallel::get_num_threads, m)?)?;
+    m.add_function(wrap_pyfunction!(parallel::_trigger_panic, m)?)?;
+    submodule(m, "warp", warp::register)?;
+    submodule(m, "io", io::register)?;
+    Ok(())
+}

@@ -1,0 +1,236 @@
+//! `mcsample.Rng` and `mcsample.uniform`.
+
+use super::arrays::{finish, index_arg, zeros};
+use super::parallel::detached;
+use crate::math::Real;
+use crate::rng::{MAX_STREAM, Rng};
+use numpy::{Element, PyArrayDescr, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods};
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+
+/// Largest number of values one call may ask for.
+const MAX_COUNT: u64 = 1 << 40;
+
+/// The shape argument: None (one value), an int, or a sequence of ints.
+fn parse_shape(shape: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<usize>> {
+    let Some(shape) = shape.filter(|s| !s.is_none()) else {
+        return Ok(vec![]);
+    };
+    let dims: Vec<usize> = if let Ok(seq) = shape.cast::<PyTuple>() {
+        seq.iter()
+            .map(|d| index_arg(&d, "shape", 0, MAX_COUNT).map(|v| v as usize))
+            .collect::<PyResult<_>>()?
+    } else if let Ok(list) = shape.cast::<pyo3::types::PyList>() {
+        list.iter()
+            .map(|d| index_arg(&d, "shape", 0, MAX_COUNT).map(|v| v as usize))
+            .collect::<PyResult<_>>()?
+    } else {
+        vec![index_arg(shape, "shape", 0, MAX_COUNT)? as usize]
+    };
+    let total = dims.iter().try_fold(1u64, |acc, &d| acc.checked_mul(d as u64));
+    match total {
+        Some(t) if t <= MAX_COUNT => Ok(dims),
+        _ => Err(crate::error::Error::Integer {
+            arg: "shape",
+            value: crate::error::shape_str(&dims),
+            requirement: format!("must hold at most {MAX_COUNT} values"),
+        }
+        .into()),
+    }
+}
+
+/// Whether `dtype` (None, "float32", np.float32, ...) asks for float32;
+/// only float32 and float64 are offered.
+fn wants_float32(py: Python<'_>, dtype: Option<&Bound<'_, PyAny>>) -> PyResult<bool> {
+    let Some(dtype) = dtype.filter(|d| !d.is_none()) else {
+        return Ok(false);
+    };
+    let descr = PyArrayDescr::new(py, dtype)?;
+    if descr.is_equiv_to(&numpy::dtype::<f32>(py)) {
+        Ok(true)
+    } else if descr.is_equiv_to(&numpy::dtype::<f64>(py)) {
+        Ok(false)
+    } else {
+        Err(PyTypeError::new_err(format!(
+            "dtype must be float32 or float64, got {dtype}"
+        )))
+    }
+}
+
+/// The next `shape` floats of `rng` as a fresh array (a numpy scalar for
+/// shape `()`), filled on all cores with the GIL released.
+fn random_array<'py, F: Element + Real>(
+    py: Python<'py>,
+    rng: &mut Rng,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyAny>> {
+    let out: Bound<'py, PyArrayDyn<F>> = zeros(py, shape);
+    {
+        let mut guard = out.readwrite();
+        let flat = guard.as_slice_mut()?;
+        detached(py, || rng.fill(flat))?;
+    }
+    finish(out)
+}
+
+/// PCG32 random number generator (O'Neill's ``pcg32_random_r``, seeded as
+/// ``pcg32_srandom_r(seed, stream)``), the generator of Mitsuba 3 / Dr.Jit.
+///
+/// Parameters
+/// ----------
+/// seed : int
+///     Initial state, 0 to 2**64 - 1.
+/// stream : int
+///     Stream id, 0 to 2**63 - 1; different streams are independent sequences.
+///
+/// Floats are made from one 32-bit output each, exactly as Dr.Jit's
+/// ``PCG32.next_float64`` / ``next_float32`` make them, so the same seed and
+/// stream give the same numbers as ``drjit.scalar.PCG32(1, seed, stream)``.
+#[pyclass(module = "mcsample._core", name = "Rng")]
+#[derive(Clone)]
+pub struct PyRng {
+    rng: Rng,
+    seed: u64,
+    stream: u64,
+}
+
+#[pymethods]
+impl PyRng {
+    #[new]
+    #[pyo3(signature = (seed = None, stream = None))]
+    fn new(seed: Option<&Bound<'_, PyAny>>, stream: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        let seed = seed.map_or(Ok(0), |s| index_arg(s, "seed", 0, u64::MAX))?;
+        let stream = stream.map_or(Ok(0), |s| index_arg(s, "stream", 0, MAX_STREAM))?;
+        Ok(PyRng {
+            rng: Rng::new(seed, stream),
+            seed,
+            stream,
+        })
+    }
+
+    /// Uniform floats in [0, 1).
+    ///
+    /// Parameters
+    /// ----------
+    /// shape : None, int or tuple of int
+    ///     None gives one value (a numpy scalar); otherwise an array of that
+    ///     shape, filled in C order from the stream.
+    /// dtype : float64 (default) or float32
+    ///
+    /// Returns
+    /// -------
+    /// ndarray of `shape`, float64 multiples of 2**-32 (float32: of 2**-23).
+    #[pyo3(signature = (shape = None, dtype = None))]
+    fn random<'py>(
+        &mut self,
+        py: Python<'py>,
+        shape: Option<&Bound<'py, PyAny>>,
+        dtype: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let shape = parse_shape(shape)?;
+        if wants_float32(py, dtype)? {
+            random_array::<f32>(py, &mut self.rng, &shape)
+        } else {
+            random_array::<f64>(py, &mut self.rng, &shape)
+        }
+    }
+
+    /// Raw 32-bit outputs.
+    ///
+    /// Parameters
+    /// ----------
+    /// shape : None, int or tuple of int
+    ///
+    /// Returns
+    /// -------
+    /// ndarray of `shape`, uint32 (a numpy scalar for None).
+    #[pyo3(signature = (shape = None))]
+    fn next_uint32<'py>(
+        &mut self,
+        py: Python<'py>,
+        shape: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let shape = parse_shape(shape)?;
+        let out: Bound<'py, PyArrayDyn<u32>> = zeros(py, &shape);
+        {
+            let mut guard = out.readwrite();
+            let flat = guard.as_slice_mut()?;
+            let rng = &mut self.rng;
+            detached(py, || rng.fill_u32(flat))?;
+        }
+        finish(out)
+    }
+
+    /// Skips ``n`` outputs (0 <= n < 2**64) in O(log n) steps.
+    fn advance(&mut self, n: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.rng.advance(index_arg(n, "n", 0, u64::MAX)?);
+        Ok(())
+    }
+
+    /// The seed given to the constructor.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// The stream given to the constructor.
+    #[getter]
+    fn stream(&self) -> u64 {
+        self.stream
+    }
+
+    /// An independent copy at the same position.
+    fn copy(&self) -> Self {
+        self.clone()
+    }
+
+    fn __copy__(&self) -> Self {
+        self.clone()
+    }
+
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Self {
+        self.clone()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Rng(seed={}, stream={})", self.seed, self.stream)
+    }
+}
+
+/// ``n × dim`` uniform floats in [0, 1): the first ``n·dim`` numbers of
+/// ``Rng(seed)``, computed on all cores (bit-identical for any thread count).
+///
+/// Parameters
+/// ----------
+/// n : int
+///     Number of samples.
+/// dim : int
+///     Numbers per sample (default 2).
+/// seed : int
+/// dtype : float64 (default) or float32
+///
+/// Returns
+/// -------
+/// ndarray, shape (n, dim)
+#[pyfunction]
+#[pyo3(signature = (n, dim = None, seed = None, dtype = None))]
+pub fn uniform<'py>(
+    py: Python<'py>,
+    n: &Bound<'py, PyAny>,
+    dim: Option<&Bound<'py, PyAny>>,
+    seed: Option<&Bound<'py, PyAny>>,
+    dtype: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let n = index_arg(n, "n", 0, MAX_COUNT)? as usize;
+    let dim = dim.map_or(Ok(2), |d| index_arg(d, "dim", 0, 1 << 20))? as usize;
+    let seed = seed.map_or(Ok(0), |s| index_arg(s, "seed", 0, u64::MAX))?;
+    let shape = [n, dim];
+    parse_shape(Some(&PyTuple::new(py, shape)?.into_any()))?;
+    let mut rng = Rng::new(seed, 0);
+    if wants_float32(py, dtype)? {
+        random_array::<f32>(py, &mut rng, &shape)
+    } else {
+        random_array::<f64>(py, &mut rng, &shape)
+    }
+}

@@ -1,0 +1,515 @@
+//! `mcsample.warp`: batched bindings of [`crate::warp`]. Every function
+//! takes an array-like of points (`(N, K)` or `(K,)`), keeps float32 input in
+//! float32, checks `u ∈ [0, 1]` (or finiteness of points) in the kernel's
+//! own pass, and runs on all cores with the GIL released.
+
+use super::arrays::{Check, Points, map, with_precision};
+use crate::error::Error;
+use crate::math::Real;
+use crate::warp;
+use pyo3::prelude::*;
+
+/// Defines one `#[pyfunction]` mapping `$x` (points of `$k` values, checked
+/// with `Check::$check`) through the kernel `$kernel` (built with the
+/// precision alias `$F` in scope; `?` may be used to validate parameters).
+macro_rules! batch_fn {
+    (
+        $(#[$meta:meta])*
+        fn $name:ident($x:ident: [$k:literal; $check:ident] $(, $p:ident: $pty:ty)*)
+        = |$F:ident| $kernel:expr
+    ) => {
+        #[pyfunction]
+        $(#[$meta])*
+        pub fn $name<'py>(
+            py: Python<'py>,
+            $x: &Bound<'py, PyAny>
+            $(, $p: $pty)*
+        ) -> PyResult<Bound<'py, PyAny>> {
+            with_precision!($x, $F => {
+                let points = Points::<$F, $k>::extract($x, stringify!($x))?;
+                map(py, &points, Check::$check, $kernel)
+            })
+        }
+    };
+}
+
+/// `exponent`, checked: finite and >= 0.
+fn exponent_arg<F: Real>(exponent: f64) -> PyResult<F> {
+    if exponent.is_finite() && exponent >= 0.0 {
+        Ok(F::c(exponent))
+    } else {
+        Err(Error::Parameter {
+            arg: "exponent",
+            value: exponent,
+            requirement: "must be finite and >= 0",
+        }
+        .into())
+    }
+}
+
+/// `cos_cutoff`, checked: in [-1, 1).
+fn cos_cutoff_arg<F: Real>(cos_cutoff: f64) -> PyResult<F> {
+    if (-1.0..1.0).contains(&cos_cutoff) {
+        Ok(F::c(cos_cutoff))
+    } else {
+        Err(Error::Parameter {
+            arg: "cos_cutoff",
+            value: cos_cutoff,
+            requirement: "must lie in [-1, 1)",
+        }
+        .into())
+    }
+}
+
+/// `method` of the cosine-hemisphere warps: true for "polar", false for
+/// "concentric".
+fn polar_arg(method: &str) -> PyResult<bool> {
+    match method {
+        "concentric" => Ok(false),
+        "polar" => Ok(true),
+        _ => Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "method = {method:?}: must be \"concentric\" or \"polar\""
+        ))),
+    }
+}
+
+batch_fn! {
+    /// Uniform points on the unit disk by the polar map r = sqrt(u[:, 1]),
+    /// phi = 2 pi u[:, 0] (Mitsuba's order).
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,); density 1/pi per unit area.
+    fn square_to_uniform_disk(u: [2; Unit]) = |F| warp::square_to_uniform_disk::<F>
+}
+batch_fn! {
+    /// Density of ``square_to_uniform_disk``: 1/pi on the unit disk, else 0.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 2) or (2,)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for one point), per unit area.
+    fn square_to_uniform_disk_pdf(x: [2; Finite]) = |F| |p| [warp::square_to_uniform_disk_pdf::<F>(p)]
+}
+batch_fn! {
+    /// Inverse of ``square_to_uniform_disk``: (phi / 2 pi, r^2).
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 2) or (2,), points of the unit disk
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
+    fn uniform_disk_to_square(x: [2; Finite]) = |F| warp::uniform_disk_to_square::<F>
+}
+batch_fn! {
+    /// Uniform points on the unit disk by Shirley and Chiu's concentric map.
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,); density 1/pi per unit area.
+    fn square_to_uniform_disk_concentric(u: [2; Unit]) = |F| warp::square_to_uniform_disk_concentric::<F>
+}
+batch_fn! {
+    /// Density of ``square_to_uniform_disk_concentric``: 1/pi on the unit
+    /// disk, else 0.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 2) or (2,)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for one point), per unit area.
+    fn square_to_uniform_disk_concentric_pdf(x: [2; Finite]) = |F| |p| [warp::square_to_uniform_disk_concentric_pdf::<F>(p)]
+}
+batch_fn! {
+    /// Inverse of ``square_to_uniform_disk_concentric``.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 2) or (2,), points of the unit disk
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2; the origin gives (0.5, 0.5).
+    fn uniform_disk_to_square_concentric(x: [2; Finite]) = |F| warp::uniform_disk_to_square_concentric::<F>
+}
+batch_fn! {
+    /// Uniform directions on the unit sphere: z = 1 - 2 u[:, 1],
+    /// phi = 2 pi u[:, 0].
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 3) or (3,), unit vectors; density 1/(4 pi) per sr.
+    fn square_to_uniform_sphere(u: [2; Unit]) = |F| warp::square_to_uniform_sphere::<F>
+}
+batch_fn! {
+    /// Density of ``square_to_uniform_sphere``: 1/(4 pi) per steradian.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 3) or (3,), unit vectors
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for one direction).
+    fn square_to_uniform_sphere_pdf(x: [3; Finite]) = |F| |d| [warp::square_to_uniform_sphere_pdf::<F>(d)]
+}
+batch_fn! {
+    /// Inverse of ``square_to_uniform_sphere``: (phi / 2 pi, (1 - z) / 2).
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 3) or (3,), unit vectors
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
+    fn uniform_sphere_to_square(x: [3; Finite]) = |F| warp::uniform_sphere_to_square::<F>
+}
+batch_fn! {
+    /// Uniform directions on the +z hemisphere (a concentric disk point
+    /// lifted by an area-preserving map).
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 3) or (3,), unit vectors with z >= 0; density
+    /// 1/(2 pi) per sr.
+    fn square_to_uniform_hemisphere(u: [2; Unit]) = |F| warp::square_to_uniform_hemisphere::<F>
+}
+batch_fn! {
+    /// Density of ``square_to_uniform_hemisphere``: 1/(2 pi) per steradian
+    /// for z >= 0, else 0.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 3) or (3,), unit vectors
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for one direction).
+    fn square_to_uniform_hemisphere_pdf(x: [3; Finite]) = |F| |d| [warp::square_to_uniform_hemisphere_pdf::<F>(d)]
+}
+batch_fn! {
+    /// Inverse of ``square_to_uniform_hemisphere``.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 3) or (3,), unit vectors with z >= 0
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
+    fn uniform_hemisphere_to_square(x: [3; Finite]) = |F| warp::uniform_hemisphere_to_square::<F>
+}
+batch_fn! {
+    /// Cosine-weighted directions on the +z hemisphere (Malley's method).
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    /// method : "concentric" (default; lifts a concentric disk point, as
+    ///     ``mi.warp`` does) or "polar" (x = cos(2 pi u0) sqrt(1 - u1),
+    ///     y = sin(2 pi u0) sqrt(1 - u1), z = sqrt(u1))
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 3) or (3,), unit vectors; density cos(theta)/pi
+    /// per sr.
+    #[pyo3(signature = (u, method = "concentric"))]
+    fn square_to_cosine_hemisphere(u: [2; Unit], method: &str) = |F| {
+        let polar = polar_arg(method)?;
+        move |u: [F; 2]| {
+            if polar {
+                warp::square_to_cosine_hemisphere_polar(u)
+            } else {
+                warp::square_to_cosine_hemisphere(u)
+            }
+        }
+    }
+}
+batch_fn! {
+    /// Density of ``square_to_cosine_hemisphere`` (either method):
+    /// max(cos theta, 0) / pi per steradian.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 3) or (3,), unit vectors
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for one direction).
+    fn square_to_cosine_hemisphere_pdf(x: [3; Finite]) = |F| |d| [warp::square_to_cosine_hemisphere_pdf::<F>(d)]
+}
+batch_fn! {
+    /// Inverse of ``square_to_cosine_hemisphere`` for the same ``method``.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 3) or (3,), unit vectors with z >= 0
+    /// method : "concentric" (default) or "polar"
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
+    #[pyo3(signature = (x, method = "concentric"))]
+    fn cosine_hemisphere_to_square(x: [3; Finite], method: &str) = |F| {
+        let polar = polar_arg(method)?;
+        move |d: [F; 3]| {
+            if polar {
+                warp::cosine_hemisphere_to_square_polar(d)
+            } else {
+                warp::cosine_hemisphere_to_square(d)
+            }
+        }
+    }
+}
+batch_fn! {
+    /// Directions of the cos^n lobe around +z (the Phong lobe):
+    /// cos theta = u1^(1/(n+1)), phi = 2 pi u0.
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    /// exponent : float >= 0
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 3) or (3,), unit vectors; density
+    /// (n + 1)/(2 pi) cos^n theta per sr.
+    fn square_to_cosine_power_hemisphere(u: [2; Unit], exponent: f64) = |F| {
+        let n = exponent_arg::<F>(exponent)?;
+        move |u| warp::square_to_cosine_power_hemisphere(u, n)
+    }
+}
+batch_fn! {
+    /// Density of ``square_to_cosine_power_hemisphere``:
+    /// (n + 1)/(2 pi) cos^n theta per steradian for cos theta > 0, else 0.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 3) or (3,), unit vectors
+    /// exponent : float >= 0
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for one direction).
+    fn square_to_cosine_power_hemisphere_pdf(x: [3; Finite], exponent: f64) = |F| {
+        let n = exponent_arg::<F>(exponent)?;
+        move |d| [warp::square_to_cosine_power_hemisphere_pdf(d, n)]
+    }
+}
+batch_fn! {
+    /// Inverse of ``square_to_cosine_power_hemisphere``:
+    /// (phi / 2 pi, cos^(n+1) theta).
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 3) or (3,), unit vectors with z >= 0
+    /// exponent : float >= 0
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
+    fn cosine_power_hemisphere_to_square(x: [3; Finite], exponent: f64) = |F| {
+        let n = exponent_arg::<F>(exponent)?;
+        move |d| warp::cosine_power_hemisphere_to_square(d, n)
+    }
+}
+batch_fn! {
+    /// Uniform directions in the cone cos theta >= cos_cutoff around +z.
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    /// cos_cutoff : float in [-1, 1)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 3) or (3,), unit vectors; density
+    /// 1 / (2 pi (1 - cos_cutoff)) per sr.
+    fn square_to_uniform_cone(u: [2; Unit], cos_cutoff: f64) = |F| {
+        let c = cos_cutoff_arg::<F>(cos_cutoff)?;
+        move |u| warp::square_to_uniform_cone(u, c)
+    }
+}
+batch_fn! {
+    /// Density of ``square_to_uniform_cone``: 1 / (2 pi (1 - cos_cutoff))
+    /// per steradian inside the cone, else 0.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 3) or (3,), unit vectors
+    /// cos_cutoff : float in [-1, 1)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for one direction).
+    fn square_to_uniform_cone_pdf(x: [3; Finite], cos_cutoff: f64) = |F| {
+        let c = cos_cutoff_arg::<F>(cos_cutoff)?;
+        move |d| [warp::square_to_uniform_cone_pdf(d, c)]
+    }
+}
+batch_fn! {
+    /// Inverse of ``square_to_uniform_cone``.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 3) or (3,), unit vectors inside the cone
+    /// cos_cutoff : float in [-1, 1)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
+    fn uniform_cone_to_square(x: [3; Finite], cos_cutoff: f64) = |F| {
+        let c = cos_cutoff_arg::<F>(cos_cutoff)?;
+        move |d| warp::uniform_cone_to_square(d, c)
+    }
+}
+batch_fn! {
+    /// Uniform points on the triangle (0, 0), (1, 0), (0, 1):
+    /// t = sqrt(1 - u0), point (1 - t, t u1).
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,) (barycentric coordinates); density 2
+    /// per unit area.
+    fn square_to_uniform_triangle(u: [2; Unit]) = |F| warp::square_to_uniform_triangle::<F>
+}
+batch_fn! {
+    /// Density of ``square_to_uniform_triangle``: 2 inside the triangle,
+    /// else 0.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 2) or (2,)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for one point), per unit area.
+    fn square_to_uniform_triangle_pdf(x: [2; Finite]) = |F| |p| [warp::square_to_uniform_triangle_pdf::<F>(p)]
+}
+batch_fn! {
+    /// Inverse of ``square_to_uniform_triangle``.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : array_like, shape (N, 2) or (2,), points of the triangle
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
+    fn uniform_triangle_to_square(x: [2; Finite]) = |F| warp::uniform_triangle_to_square::<F>
+}
+batch_fn! {
+    /// The power density (n + 1) x^n on [0, 1] by inversion:
+    /// x = u^(1/(n+1)).
+    ///
+    /// Parameters
+    /// ----------
+    /// u : float or array_like, shape (N,), values in [0, 1]
+    /// exponent : float >= 0
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for a scalar u).
+    fn interval_to_power(u: [1; Unit], exponent: f64) = |F| {
+        let n = exponent_arg::<F>(exponent)?;
+        move |u: [F; 1]| [warp::interval_to_power(u[0], n)]
+    }
+}
+batch_fn! {
+    /// Density of ``interval_to_power``: (n + 1) x^n on [0, 1], else 0,
+    /// per unit length.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : float or array_like, shape (N,)
+    /// exponent : float >= 0
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for a scalar x).
+    fn interval_to_power_pdf(x: [1; Finite], exponent: f64) = |F| {
+        let n = exponent_arg::<F>(exponent)?;
+        move |x: [F; 1]| [warp::interval_to_power_pdf(x[0], n)]
+    }
+}
+batch_fn! {
+    /// Inverse of ``interval_to_power``: u = x^(n+1).
+    ///
+    /// Parameters
+    /// ----------
+    /// x : float or array_like, shape (N,), values in [0, 1]
+    /// exponent : float >= 0
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for a scalar x).
+    fn power_to_interval(x: [1; Finite], exponent: f64) = |F| {
+        let n = exponent_arg::<F>(exponent)?;
+        move |x: [F; 1]| [warp::power_to_interval(x[0], n)]
+    }
+}
+
+/// Registers the warp functions in module `m`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    macro_rules! add {
+        ($($f:ident),* $(,)?) => { $(m.add_function(wrap_pyfunction!($f, m)?)?;)* };
+    }
+    add!(
+        square_to_uniform_disk,
+        square_to_uniform_disk_pdf,
+        uniform_disk_to_square,
+        square_to_uniform_disk_concentric,
+        square_to_uniform_disk_concentric_pdf,
+        uniform_disk_to_square_concentric,
+        square_to_uniform_sphere,
+        square_to_uniform_sphere_pdf,
+        uniform_sphere_to_square,
+        square_to_uniform_hemisphere,
+        square_to_uniform_hemisphere_pdf,
+        uniform_hemisphere_to_square,
+        square_to_cosine_hemisphere,
+        square_to_cosine_hemisphere_pdf,
+        cosine_hemisphere_to_square,
+        square_to_cosine_power_hemisphere,
+        square_to_cosine_power_hemisphere_pdf,
+        cosine_power_hemisphere_to_square,
+        square_to_uniform_cone,
+        square_to_uniform_cone_pdf,
+        uniform_cone_to_square,
+        square_to_uniform_triangle,
+        square_to_uniform_triangle_pdf,
+        uniform_triangle_to_square,
+        interval_to_power,
+        interval_to_power_pdf,
+        power_to_interval,
+    );
+    Ok(())
+}

@@ -1,0 +1,166 @@
+//! PCG32 random numbers with jump-ahead.
+//!
+//! [`Rng`] is O'Neill's `pcg32_random_r` (64-bit LCG state, XSH-RR output)
+//! seeded as `pcg32_srandom_r(seed, stream)` does, the generator Mitsuba 3
+//! and Dr.Jit use. Floats in `[0, 1)` are made from one 32-bit output each,
+//! as Dr.Jit's `next_float32` / `next_float64` make them
+//! ([`Real::from_random_bits`]), so a stream of floats equals Dr.Jit's for
+//! the same seed and stream.
+//!
+//! [`Rng::advance`] jumps `n` outputs ahead in `O(log n)` (Brown, "Random
+//! number generation with arbitrary strides", 1994). Batch fills give each
+//! chunk of the batch a copy advanced to the chunk's first index, so a batch
+//! is bit-identical to drawing its numbers one after another, on any number
+//! of threads.
+
+use crate::error::Result;
+use crate::math::Real;
+use crate::parallel;
+use rand_core::Rng as _;
+
+/// The largest stream id: PCG32 uses `2·stream + 1` as its increment, so
+/// the top bit of a 64-bit stream id would be lost.
+pub const MAX_STREAM: u64 = (1 << 63) - 1;
+
+/// A PCG32 generator (state and stream).
+#[derive(Clone, Debug)]
+pub struct Rng {
+    pcg: rand_pcg::Pcg32,
+}
+
+impl Rng {
+    /// Seeds as `pcg32_srandom_r(seed, stream)`. `stream` is taken modulo
+    /// 2^63 (see [`MAX_STREAM`]); callers reject larger values.
+    pub fn new(seed: u64, stream: u64) -> Self {
+        Rng {
+            pcg: rand_pcg::Pcg32::new(seed, stream),
+        }
+    }
+
+    /// The next 32-bit output.
+    #[inline(always)]
+    pub fn next_u32(&mut self) -> u32 {
+        self.pcg.next_u32()
+    }
+
+    /// The next float in `[0, 1)`, from one 32-bit output.
+    #[inline(always)]
+    pub fn next_float<F: Real>(&mut self) -> F {
+        F::from_random_bits(self.next_u32())
+    }
+
+    /// Skips `delta` outputs in `O(log delta)`.
+    pub fn advance(&mut self, delta: u64) {
+        self.pcg.advance(delta);
+    }
+
+    /// This generator advanced by `delta` outputs (self is unchanged).
+    pub fn jumped(&self, delta: u64) -> Self {
+        let mut r = self.clone();
+        r.advance(delta);
+        r
+    }
+
+    /// Fills `out` with the next `out.len()` floats of this stream, on all
+    /// cores, and advances past them.
+    ///
+    /// # Errors
+    /// Only if the thread count cannot be determined.
+    pub fn fill<F: Real>(&mut self, out: &mut [F]) -> Result<()> {
+        let n = out.len();
+        let base = &*self;
+        parallel::for_each_chunk(n, out, |range, chunk| {
+            let mut rng = base.jumped(range.start as u64);
+            chunk.iter_mut().for_each(|x| *x = rng.next_float());
+            true
+        })?;
+        self.advance(n as u64);
+        Ok(())
+    }
+
+    /// Fills `out` with the next `out.len()` 32-bit outputs and advances past
+    /// them.
+    ///
+    /// # Errors
+    /// Only if the thread count cannot be determined.
+    pub fn fill_u32(&mut self, out: &mut [u32]) -> Result<()> {
+        let n = out.len();
+        let base = &*self;
+        parallel::for_each_chunk(n, out, |range, chunk| {
+            let mut rng = base.jumped(range.start as u64);
+            chunk.iter_mut().for_each(|x| *x = rng.next_u32());
+            true
+        })?;
+        self.advance(n as u64);
+        Ok(())
+    }
+}
+
+/// `n × dim` uniform floats in `[0, 1)`, row-major: the first `n·dim` floats
+/// of `Rng::new(seed, 0)`.
+///
+/// # Errors
+/// Only if the thread count cannot be determined.
+pub fn uniform<F: Real>(n: usize, dim: usize, seed: u64) -> Result<Vec<F>> {
+    let mut out = vec![F::zero(); n * dim];
+    Rng::new(seed, 0).fill(&mut out)?;
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The first outputs of `pcg32_srandom_r(42, 54)`, as printed by the
+    /// reference implementation's demo program (pcg-c-basic).
+    const REFERENCE_42_54: [u32; 6] = [
+        0xa15c02b7, 0x7b47f409, 0xba1d3330, 0x83d2f293, 0xbfa4784b, 0xcbed606e,
+    ];
+
+    #[test]
+    fn matches_the_reference_implementation() {
+        let mut rng = Rng::new(42, 54);
+        let got: Vec<u32> = (0..6).map(|_| rng.next_u32()).collect();
+        assert_eq!(got, REFERENCE_42_54);
+    }
+
+    #[test]
+    fn matches_drjit_default_seed_floats() {
+        // Dr.Jit's PCG32() with its default state and stream; its test suite
+        // pins next_float32 / next_float64 of the first output.
+        let (state, stream) = (0x853c49e6748fea9b, 0xda3e39cb94b95bdb);
+        assert_eq!(Rng::new(state, stream).next_float::<f32>(), 0.108_378_648_757_934_57);
+        assert_eq!(Rng::new(state, stream).next_float::<f64>(), 0.108_378_705_102_950_33);
+    }
+
+    #[test]
+    fn advance_equals_stepping() {
+        let mut a = Rng::new(7, 3);
+        let mut b = a.clone();
+        for _ in 0..1000 {
+            a.next_u32();
+        }
+        b.advance(1000);
+        assert_eq!(a.next_u32(), b.next_u32());
+    }
+
+    #[test]
+    fn batch_fill_is_the_sequential_stream_for_any_thread_count() {
+        let n = 3 * parallel::CHUNK + 11;
+        let mut seq = Rng::new(5, 0);
+        let expected: Vec<f64> = (0..n).map(|_| seq.next_float()).collect();
+        let mut rng = Rng::new(5, 0);
+        let mut got = vec![0.0; n];
+        rng.fill(&mut got).unwrap();
+        assert_eq!(got, expected);
+        assert_eq!(rng.next_u32(), seq.next_u32(), "fill advances past the batch");
+        assert_eq!(uniform::<f64>(n / 2, 2, 5).unwrap()[..], expected[..n / 2 * 2]);
+    }
+
+    #[test]
+    fn floats_lie_in_the_half_open_interval() {
+        assert_eq!(f32::from_random_bits(0), 0.0);
+        assert!(f32::from_random_bits(u32::MAX) < 1.0);
+        assert!(f64::from_random_bits(u32::MAX) < 1.0);
+    }
+}
