@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 # A libLLVM >= 16 lets Mitsuba 3 run its llvm_ad_rgb variant (Dr.Jit finds
 # it by itself); without one the suite falls back to scalar_rgb.
-if ! ls /usr/lib/*/libLLVM*.so* >/dev/null 2>&1 && command -v apt-get >/dev/null; then
+if ! dpkg -s libllvm19 >/dev/null 2>&1 && command -v apt-get >/dev/null; then
   SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
   $SUDO apt-get update -qq
   $SUDO apt-get install -y -qq libllvm19 >/dev/null

@@ -136,9 +136,12 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
                 .into());
             }
         };
-        let owned = match array.as_slice() {
-            Ok(_) => None,
-            Err(_) => Some(array.as_array().iter().copied().collect()),
+        // Only C order can be read in place (a Fortran-ordered array is
+        // contiguous too, in the wrong order): copy anything else once.
+        let owned = if array.is_c_contiguous() {
+            None
+        } else {
+            Some(array.as_array().iter().copied().collect())
         };
         Ok(Points {
             array,

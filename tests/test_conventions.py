@@ -1,0 +1,153 @@
+"""The binding conventions every kernel shares: array-likes in, precision
+kept, unbatched single points, messages that name the argument and index,
+thread control, and no Rust panic reaching Python."""
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import mcsample as mcs
+from mcsample import warp
+
+
+def test_array_likes_are_accepted():
+    u = [[0.1, 0.2], [0.3, 0.4]]
+    ref = warp.square_to_uniform_disk(np.array(u))
+    assert np.array_equal(warp.square_to_uniform_disk(u), ref)
+    assert np.array_equal(warp.square_to_uniform_disk(tuple(map(tuple, u))), ref)
+    ints = warp.square_to_uniform_disk([[0, 1], [1, 0]])
+    assert ints.dtype == np.float64 and ints.shape == (2, 2)
+
+
+def test_float32_in_float32_out_computed_in_float32():
+    u = mcs.uniform(1000, 2, seed=3)
+    out32 = warp.square_to_cosine_hemisphere(u.astype(np.float32))
+    out64 = warp.square_to_cosine_hemisphere(u)
+    assert out32.dtype == np.float32 and out64.dtype == np.float64
+    assert np.allclose(out32, out64, atol=1e-3)
+    assert warp.square_to_cosine_hemisphere_pdf(out32).dtype == np.float32
+    assert warp.square_to_uniform_disk(u.astype(np.float16)).dtype == np.float64
+
+
+def test_non_contiguous_input():
+    big = mcs.uniform(100, 4, seed=2)
+    view = big[::3, 1:3]
+    assert not view.flags.c_contiguous
+    assert np.array_equal(warp.square_to_uniform_sphere(view),
+                          warp.square_to_uniform_sphere(np.ascontiguousarray(view)))
+    fortran = np.asfortranarray(big[:, :2])
+    assert np.array_equal(warp.square_to_uniform_sphere(fortran),
+                          warp.square_to_uniform_sphere(big[:, :2].copy()))
+
+
+def test_single_points_come_back_unbatched():
+    d = warp.square_to_uniform_sphere([0.25, 0.5])
+    assert d.shape == (3,)
+    assert np.ndim(warp.square_to_uniform_sphere_pdf(d)) == 0
+    assert np.ndim(warp.interval_to_power(0.5, 2.0)) == 0
+    assert warp.interval_to_power([0.5, 0.25], 2.0).shape == (2,)
+    assert warp.square_to_uniform_sphere(np.zeros((0, 2))).shape == (0, 3)
+
+
+def test_u_equal_one_is_valid_and_stays_inside():
+    d = warp.square_to_uniform_sphere([[1.0, 1.0], [1.0, 0.0]])
+    assert np.allclose(np.linalg.norm(d, axis=1), 1.0)
+    p = warp.square_to_uniform_disk_concentric([[1.0, 1.0]])
+    assert np.all(warp.square_to_uniform_disk_concentric_pdf(p) > 0)
+
+
+@pytest.mark.parametrize("u,fragment", [
+    ([[0.1, 0.2], [0.3, 1.5]], "u[1, 1] = 1.5: must lie in [0, 1]"),
+    ([[0.1, float("nan")]], "u[0, 1] = NaN"),
+    ([[-0.0, 0.5], [-1e-9, 0.5]], "u[1, 0] = -0.000000001"),
+    ([0.5, 2.0], "u[1] = 2"),
+    ([[0.1, 0.2, 0.3]], "u must have shape (N, 2) or (2,), got (1, 3)"),
+    (np.zeros((2, 2, 2)), "got (2, 2, 2)"),
+])
+def test_bad_u_names_argument_and_index(u, fragment):
+    with pytest.raises(ValueError) as excinfo:
+        warp.square_to_uniform_disk(u)
+    assert fragment in str(excinfo.value)
+
+
+def test_first_bad_index_found_in_a_large_parallel_batch():
+    u = mcs.uniform(500_000, 2, seed=4)
+    u[123_456, 0] = np.inf
+    u[400_000, 1] = -1
+    with pytest.raises(ValueError, match=r"u\[123456, 0\] = inf"):
+        warp.square_to_uniform_disk(u)
+
+
+def test_wrong_types_raise_type_error():
+    with pytest.raises(TypeError, match="u must be an array of numbers"):
+        warp.square_to_uniform_disk("abc")
+    with pytest.raises(TypeError):
+        warp.square_to_cosine_power_hemisphere([0.5, 0.5], "ten")
+    with pytest.raises(TypeError, match="seed must be an integer"):
+        mcs.Rng(1.5)
+
+
+@pytest.mark.parametrize("call,fragment", [
+    (lambda: mcs.Rng(-1), "seed = -1"),
+    (lambda: mcs.Rng(2**64), "seed = 18446744073709551616"),
+    (lambda: mcs.Rng(0, 2**63), "stream = 9223372036854775808"),
+    (lambda: mcs.uniform(-5), "n = -5"),
+    (lambda: mcs.uniform(10**30), "n = 1000000000000000000000000000000"),
+    (lambda: mcs.set_num_threads(0), "n = 0"),
+    (lambda: mcs.set_num_threads(2**80), "n = "),
+    (lambda: mcs.Rng().advance(-1), "n = -1"),
+    (lambda: mcs.Rng().random((2**30, 2**30)), "shape"),
+])
+def test_bad_integers_are_value_errors_not_overflow(call, fragment):
+    with pytest.raises(ValueError) as excinfo:
+        call()
+    assert not isinstance(excinfo.value, OverflowError)
+    assert fragment in str(excinfo.value)
+
+
+def test_bad_dtype():
+    with pytest.raises(TypeError, match="dtype must be float32 or float64"):
+        mcs.Rng().random(3, dtype=np.int32)
+
+
+def test_a_rust_panic_becomes_runtime_error():
+    # A deliberate panic on a pool thread, through the same path as every
+    # batch kernel: it must be an ordinary Exception, not PanicException.
+    with pytest.raises(RuntimeError, match="internal error in mcsample"):
+        mcs._core._trigger_panic()
+    assert mcs.uniform(3).shape == (3, 2)  # still usable afterwards
+
+
+def _run(code, **env):
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=dict(os.environ, **env), timeout=120)
+
+
+def test_thread_count_from_environment():
+    out = _run("import mcsample as m; print(m.get_num_threads())", MCSAMPLE_NUM_THREADS="1")
+    assert out.stdout.strip() == "1", out.stderr
+    out = _run("import mcsample as m\ntry:\n m.get_num_threads()\nexcept ValueError as e:\n print(e)",
+               MCSAMPLE_NUM_THREADS="lots")
+    assert "MCSAMPLE_NUM_THREADS" in out.stdout and "lots" in out.stdout, out.stderr
+
+
+def test_pool_survives_fork():
+    code = (
+        "import os, mcsample as m\n"
+        "a = m.uniform(200000, 2, seed=1)\n"
+        "pid = os.fork()\n"
+        "if pid == 0:\n"
+        "    b = m.uniform(200000, 2, seed=1)\n"
+        "    os._exit(0 if (a == b).all() else 3)\n"
+        "_, status = os.waitpid(pid, 0)\n"
+        "print(os.waitstatus_to_exitcode(status))\n"
+    )
+    out = _run(code)
+    assert out.stdout.strip() == "0", out.stderr
+
+
+def test_version():
+    assert mcs.__version__.count(".") == 2

@@ -1,0 +1,145 @@
+"""The validation kit: chi2_test must accept right samplers and reject wrong
+ones (each rejection is a test that could fail), and explain why."""
+
+import numpy as np
+import pytest
+
+import mcsample as mcs
+from mcsample import stats, warp
+
+# Accepting tests in this file, for the Šidák correction.
+ACCEPT_COUNT = 7
+
+
+def cos2_pdf(d):
+    """cos^2 lobe: 3/(2 pi) cos^2 theta on the upper hemisphere."""
+    return warp.square_to_cosine_power_hemisphere_pdf(d, 2.0)
+
+
+def disk_r_equals_u(u):
+    """The classic mistake: r = u instead of sqrt(u) crowds the centre."""
+    r, phi = u[:, 1], 2 * np.pi * u[:, 0]
+    return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)
+
+
+def triangle_pdf(p):
+    return warp.square_to_uniform_triangle_pdf(p)
+
+
+@pytest.mark.parametrize("sample,pdf,domain,ires", [
+    (warp.square_to_uniform_sphere, warp.square_to_uniform_sphere_pdf, "sphere", 4),
+    (warp.square_to_cosine_hemisphere, warp.square_to_cosine_hemisphere_pdf, "hemisphere", 4),
+    (warp.square_to_cosine_hemisphere, warp.square_to_cosine_hemisphere_pdf, "sphere", 4),
+    (warp.square_to_uniform_disk, warp.square_to_uniform_disk_pdf, "disk", 4),
+    # The triangle's diagonal edge cuts through cells: the density jumps
+    # inside them, which 4 trapezoid points per axis integrate too coarsely.
+    (warp.square_to_uniform_triangle, triangle_pdf, "square", 24),
+    (lambda u: u, lambda p: np.ones(len(p)), "square", 4),
+    (lambda u: warp.interval_to_power(u[:, 0], 3.0),
+     lambda x: warp.interval_to_power_pdf(x, 3.0), "interval", 4),
+], ids=["sphere", "cosine/hemisphere", "cosine/sphere", "disk", "triangle", "square", "power"])
+def test_accepts_right_samplers(sample, pdf, domain, ires):
+    result = stats.chi2_test(sample, pdf, domain, ires=ires, seed=11, test_count=ACCEPT_COUNT)
+    assert result.passed, result.message
+    assert 0 < result.p_value <= 1 and result.dof > 90
+    assert result.histogram.sum() == 1_000_000
+    assert abs(result.expected.sum() / 1_000_000 - 1) < 1e-3
+
+
+@pytest.mark.parametrize("sample,pdf,domain", [
+    (warp.square_to_uniform_sphere, warp.square_to_cosine_hemisphere_pdf, "sphere"),
+    (warp.square_to_cosine_hemisphere, cos2_pdf, "hemisphere"),
+    (disk_r_equals_u, warp.square_to_uniform_disk_pdf, "disk"),
+    (lambda u: warp.square_to_cosine_power_hemisphere(u, 10.0),
+     lambda d: warp.square_to_cosine_power_hemisphere_pdf(d, 11.0), "hemisphere"),
+    (warp.square_to_uniform_disk_concentric,
+     lambda p: warp.square_to_uniform_disk_pdf(p) * (1 + 0.05 * p[:, 0]), "disk"),
+], ids=["uniform-vs-cosine", "cosine-vs-cos2", "disk-r=u", "power-n-vs-n+1", "5%-tilt"])
+def test_rejects_wrong_samplers(sample, pdf, domain):
+    result = stats.chi2_test(sample, pdf, domain, seed=11)
+    assert not result.passed
+    assert not bool(result)
+    assert "REJECTED" in result.message or "FAILED" in result.message
+
+
+def test_explains_samples_outside_the_domain():
+    result = stats.chi2_test(warp.square_to_uniform_sphere, warp.square_to_uniform_sphere_pdf,
+                             "hemisphere", n=10_000)
+    assert not result.passed
+    assert "outside the domain" in result.message
+
+
+def test_explains_pdf_not_normalised_negative_or_nan():
+    sample, pdf = warp.square_to_uniform_disk, warp.square_to_uniform_disk_pdf
+    r = stats.chi2_test(sample, lambda p: 2 * pdf(p), "disk", n=10_000)
+    assert not r.passed and "integrates to 1.99" in r.message and "not 1" in r.message
+    r = stats.chi2_test(sample, lambda p: pdf(p) - 0.5, "disk", n=10_000)
+    assert not r.passed and "negative" in r.message
+    r = stats.chi2_test(sample, lambda p: np.where(p[:, 0] > 0.9, np.nan, pdf(p)), "disk",
+                        n=10_000)
+    assert not r.passed and "NaN" in r.message
+    r = stats.chi2_test(lambda u: np.full((len(u), 2), np.nan), pdf, "disk", n=10_000)
+    assert not r.passed and "NaN or infinite" in r.message
+
+
+def test_explains_non_unit_directions():
+    r = stats.chi2_test(lambda u: 2 * warp.square_to_uniform_sphere(u),
+                        warp.square_to_uniform_sphere_pdf, "sphere", n=10_000)
+    assert not r.passed and "not unit vectors" in r.message
+
+
+def test_domains_from_tuples():
+    # An interval (a, b) and a rectangle ((x0, x1), (y0, y1)).
+    r = stats.chi2_test(lambda u: 2 + 3 * u[:, 0], lambda x: np.full(len(x), 1 / 3), (2, 5),
+                        sample_dim=1, seed=2)
+    assert r.passed, r.message
+    r = stats.chi2_test(lambda u: u * [2, 1] - [1, 0], lambda p: np.full(len(p), 0.5),
+                        ((-1, 1), (0, 1)), seed=2)
+    assert r.passed, r.message
+    with pytest.raises(ValueError, match="domain"):
+        stats.make_domain("torus")
+
+
+def test_sidak_correction_lowers_the_threshold():
+    r1 = stats.chi2_test(warp.square_to_uniform_disk, warp.square_to_uniform_disk_pdf, "disk",
+                         n=10_000)
+    r10 = stats.chi2_test(warp.square_to_uniform_disk, warp.square_to_uniform_disk_pdf, "disk",
+                          n=10_000, test_count=10)
+    assert r10.significance < r1.significance == pytest.approx(0.01)
+    assert r10.significance == pytest.approx(1 - 0.99 ** 0.1)
+
+
+def test_two_sample_test_against_numpy(rng):
+    a = warp.square_to_cosine_hemisphere(mcs.uniform(200_000, seed=1))
+    # An independent cosine sampler written with numpy (polar form).
+    u = rng.random((150_000, 2))
+    r, phi = np.sqrt(1 - u[:, 1]), 2 * np.pi * u[:, 0]
+    b = np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(u[:, 1])], axis=1)
+    same = stats.two_sample_test(a, b, "hemisphere")
+    assert same.passed, same.message
+    c = warp.square_to_uniform_hemisphere(mcs.uniform(150_000, seed=2))
+    different = stats.two_sample_test(a, c, "hemisphere")
+    assert not different.passed
+
+
+def test_image_metrics(rng):
+    ref = rng.random((32, 32, 3)) + 0.5
+    assert stats.mse(ref, ref) == 0
+    assert stats.mse(ref + 0.1, ref) == pytest.approx(0.01)
+    assert stats.relmse(2 * ref, ref, eps=0) == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="same shape"):
+        stats.mse(ref, ref[:16])
+
+
+def test_image_ztest_accepts_agreement_and_rejects_bias(rng):
+    truth = rng.random((64, 64, 3))
+    var = np.full(truth.shape, 0.01)
+    a = truth + rng.normal(0, 0.1, truth.shape)
+    b = truth + rng.normal(0, 0.1, truth.shape)
+    ok = stats.image_ztest(a, var, b, var)
+    assert ok.passed, ok.message
+    assert abs(ok.mean) < 0.05 and 0.9 < ok.variance < 1.1
+    biased = stats.image_ztest(a + 0.03, var, b, var)
+    assert not biased.passed and "3 SE" in biased.message
+    shifted = np.roll(b, 1, axis=1)
+    assert not stats.image_ztest(a, var, shifted, var).passed
