@@ -10,9 +10,10 @@
   that have no density.
 - image comparison: :func:`mse`, :func:`relmse`, :func:`image_ztest`.
 
-Domains map target points to a measure-preserving parameter box, so that a
-density in the target measure (per steradian on the sphere, per unit area on
-the plane, per unit length on an interval) is also a density on the box.
+Domains map target points to a parameter box whose boundary is the domain's
+boundary (so no cell straddles an edge of the support) and give the Jacobian
+from the box's measure to the target measure (per steradian on the sphere,
+per unit area on the plane, per unit length on an interval).
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from ._core import uniform
 
 __all__ = [
     "Chi2Result",
+    "DiskDomain",
     "Domain",
     "HemisphereDomain",
     "ImageZTestResult",
@@ -64,6 +66,11 @@ class Domain:
     def from_param(self, xy: np.ndarray) -> np.ndarray:
         """Parameters (n, 2) → points (n, point_dim)."""
         raise NotImplementedError
+
+    def jacobian(self, xy: np.ndarray) -> np.ndarray | float:
+        """Target measure per unit parameter area at ``xy`` (1 when the map
+        preserves measure)."""
+        return 1.0
 
     def check_points(self, points: np.ndarray) -> str | None:
         """A message if the points are not of this domain's kind, else None."""
@@ -110,6 +117,26 @@ class PlanarDomain(Domain):
         return xy
 
 
+class DiskDomain(Domain):
+    """The unit disk, parameterised by (phi, r^2) ∈ [-pi, pi] × [0, 1], whose
+    area element is dA = r dr dphi = (1/2) d(r^2) dphi; densities per unit
+    area. The disk's rim is the box's edge, so no cell straddles it."""
+
+    bounds = ((-np.pi, np.pi), (0.0, 1.0))
+    aspect = 1.0
+
+    def to_param(self, points: np.ndarray) -> np.ndarray:
+        return np.stack([np.arctan2(points[:, 1], points[:, 0]),
+                         points[:, 0] ** 2 + points[:, 1] ** 2], axis=1)
+
+    def from_param(self, xy: np.ndarray) -> np.ndarray:
+        r = np.sqrt(np.maximum(xy[:, 1], 0.0))
+        return np.stack([r * np.cos(xy[:, 0]), r * np.sin(xy[:, 0])], axis=1)
+
+    def jacobian(self, xy: np.ndarray) -> float:
+        return 0.5
+
+
 class SphericalDomain(Domain):
     """The unit sphere, parameterised by (phi, cos theta) ∈ [-pi, pi] × [-1, 1]
     (Archimedes' map, area-preserving); densities per steradian."""
@@ -148,7 +175,8 @@ DomainLike = Union[str, Domain, Sequence[Any]]
 
 
 def make_domain(domain: DomainLike) -> Domain:
-    """A :class:`Domain` from a name ("interval", "square", "disk", "sphere",
+    """A :class:`Domain` from a name ("interval" [0, 1], "square" [0, 1]^2,
+    "disk" (the unit disk, :class:`DiskDomain`), "plane" ([-1, 1]^2), "sphere",
     "hemisphere"), an interval ``(a, b)``, a rectangle ``((x0, x1), (y0, y1))``
     or a Domain (returned as is)."""
     if isinstance(domain, Domain):
@@ -157,7 +185,8 @@ def make_domain(domain: DomainLike) -> Domain:
         named: dict[str, Callable[[], Domain]] = {
             "interval": IntervalDomain,
             "square": PlanarDomain,
-            "disk": lambda: PlanarDomain(((-1.0, 1.0), (-1.0, 1.0))),
+            "disk": DiskDomain,
+            "plane": lambda: PlanarDomain(((-1.0, 1.0), (-1.0, 1.0))),
             "sphere": SphericalDomain,
             "hemisphere": HemisphereDomain,
         }
@@ -251,6 +280,7 @@ def _integrate_pdf(domain: Domain, pdf: Callable[[np.ndarray], Any], shape: tupl
     if values.shape[0] != xy.shape[0]:
         raise ValueError(f"pdf must return one value per point: {xy.shape[0]} points "
                          f"gave shape {np.shape(values)}")
+    values = values * domain.jacobian(xy)
     values = values.reshape(ny, iy_res, nx, ires)
     cell_area = hx * (1.0 if one_d else hy)
     weights = wy[None, :, None, None] * wx[None, None, None, :]
@@ -380,8 +410,9 @@ def chi2_test(
         Density of points (m, point_dim) → (m,), in the domain's measure
         (per steradian on the sphere, per unit area / length otherwise).
     domain : str, tuple or Domain
-        "interval" ([0, 1]), "square" ([0, 1]^2), "disk" ([-1, 1]^2),
-        "sphere", "hemisphere", an interval ``(a, b)``, a rectangle
+        "interval" ([0, 1]), "square" ([0, 1]^2), "disk" (unit disk),
+        "plane" ([-1, 1]^2), "sphere", "hemisphere", an interval ``(a, b)``,
+        a rectangle
         ``((x0, x1), (y0, y1))``, or a :class:`Domain`.
     n : int
         Number of samples.

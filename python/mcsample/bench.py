@@ -1,0 +1,146 @@
+"""``python -m mcsample bench``: throughput of mcsample's kernels side by
+side with a vectorised numpy implementation and, when it runs here, Mitsuba
+3's llvm_ad_rgb variant, in one run.
+
+Each case is timed as the median of ``repeat`` runs after ``warmup`` runs
+(which also exclude Mitsuba's JIT compilation), and reported in millions of
+samples per second. Later issues add their cases to :data:`SUITES`.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from typing import Callable, NamedTuple
+
+import numpy as np
+
+import mcsample as mcs
+
+
+class Timing(NamedTuple):
+    case: str
+    implementation: str
+    dtype: str
+    n: int
+    seconds: float
+
+    @property
+    def msamples_per_s(self) -> float:
+        return self.n / self.seconds / 1e6
+
+
+def measure(fn: Callable[[], object], repeat: int = 7, warmup: int = 2) -> float:
+    """Median wall time of ``fn()`` in seconds over ``repeat`` runs, after
+    ``warmup`` runs."""
+    for _ in range(warmup):
+        fn()
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return statistics.median(times)
+
+
+def _numpy_cosine_hemisphere(u: np.ndarray) -> np.ndarray:
+    """Malley's method on the concentric disk, vectorised with numpy."""
+    a, b = 2 * u[:, 0] - 1, 2 * u[:, 1] - 1
+    horizontal = np.abs(a) >= np.abs(b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.where(horizontal, a, b)
+        phi = np.where(horizontal, (np.pi / 4) * (b / a), np.pi / 2 - (np.pi / 4) * (a / b))
+    phi = np.where(r == 0, 0, phi)
+    x, y = r * np.cos(phi), r * np.sin(phi)
+    z = np.sqrt(np.maximum(0, 1 - x * x - y * y))
+    return np.stack([x, y, z], axis=1)
+
+
+def _numpy_uniform_sphere(u: np.ndarray) -> np.ndarray:
+    z = 1 - 2 * u[:, 1]
+    r = np.sqrt(np.maximum(0, 1 - z * z))
+    phi = 2 * np.pi * u[:, 0]
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def _mitsuba():
+    from . import mitsuba as mcs_mitsuba
+
+    if not mcs_mitsuba.available() or mcs_mitsuba.choose_variant() != "llvm_ad_rgb":
+        return None
+    return mcs_mitsuba.load("llvm_ad_rgb")
+
+
+def suite_rng(n: int, repeat: int, mi) -> list[Timing]:
+    out = [Timing("uniform (n, 2)", "mcsample", "float64", n,
+                  measure(lambda: mcs.uniform(n // 2, 2), repeat)),
+           Timing("uniform (n, 2)", "mcsample", "float32", n,
+                  measure(lambda: mcs.uniform(n // 2, 2, dtype=np.float32), repeat))]
+    gen = np.random.default_rng(0)
+    out.append(Timing("uniform (n, 2)", "numpy PCG64", "float64", n,
+                      measure(lambda: gen.random((n // 2, 2)), repeat)))
+    out.append(Timing("uniform (n, 2)", "numpy PCG64", "float32", n,
+                      measure(lambda: gen.random((n // 2, 2), dtype=np.float32), repeat)))
+    if mi is not None:
+        import drjit as dr
+
+        def drjit_pcg32():
+            rng = mi.PCG32(size=n)
+            x = rng.next_float32()
+            dr.eval(x)
+            dr.sync_thread()
+
+        out.append(Timing("uniform (n, 2)", "Dr.Jit PCG32 (llvm)", "float32", n,
+                          measure(drjit_pcg32, repeat)))
+    return out
+
+
+def suite_warps(n: int, repeat: int, mi) -> list[Timing]:
+    u64 = mcs.uniform(n, 2, seed=1)
+    u32 = u64.astype(np.float32)
+    cases = [
+        ("square_to_cosine_hemisphere", mcs.warp.square_to_cosine_hemisphere,
+         _numpy_cosine_hemisphere),
+        ("square_to_uniform_sphere", mcs.warp.square_to_uniform_sphere, _numpy_uniform_sphere),
+    ]
+    out = []
+    for name, ours, numpy_impl in cases:
+        for dtype, u in (("float64", u64), ("float32", u32)):
+            out.append(Timing(name, "mcsample", dtype, n, measure(lambda: ours(u), repeat)))
+            out.append(Timing(name, "numpy", dtype, n, measure(lambda: numpy_impl(u), repeat)))
+        if mi is not None:
+            import drjit as dr
+
+            p = mi.Point2f(u32[:, 0], u32[:, 1])
+            fn = getattr(mi.warp, name)
+
+            def run():
+                d = fn(p)
+                dr.eval(d)
+                dr.sync_thread()
+
+            out.append(Timing(name, "Mitsuba 3 llvm", "float32", n, measure(run, repeat)))
+    return out
+
+
+SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
+    "rng": suite_rng,
+    "warps": suite_warps,
+}
+
+
+def main(n: int = 10_000_000, repeat: int = 7, only: list[str] | None = None) -> list[Timing]:
+    """Runs the suites (all, or those named in ``only``) and prints a table."""
+    mi = _mitsuba()
+    print(f"mcsample {mcs.__version__}, {mcs.get_num_threads()} threads, n = {n:,}; "
+          f"Mitsuba: {'llvm_ad_rgb' if mi is not None else 'not available (llvm variant)'}")
+    timings: list[Timing] = []
+    for name, suite in SUITES.items():
+        if only and name not in only:
+            continue
+        timings.extend(suite(n, repeat, mi))
+    print(f"{'case':32s} {'implementation':22s} {'dtype':8s} {'median ms':>10s} {'M/s':>9s}")
+    for t in timings:
+        print(f"{t.case:32s} {t.implementation:22s} {t.dtype:8s} "
+              f"{t.seconds * 1e3:10.2f} {t.msamples_per_s:9.1f}")
+    return timings
