@@ -20,6 +20,7 @@ rustup component add rustfmt clippy >/dev/null 2>&1 || true
 cargo fmt --check
 cargo clippy --all-targets --all-features --quiet -- -D warnings
 cargo test --quiet
+python -m mypy.stubtest mcsample._core --allowlist scripts/stubtest-allowlist.txt
 
 # Run pytest from outside the source tree so it imports the installed
 # package, not python/mcsample without its compiled core.

@@ -85,8 +85,7 @@ pub fn read_exr(path: &Path) -> Result<Raster> {
             |raster: &mut Raster, pos: Vec2<usize>, (r, g, b, a): (f32, f32, f32, f32)| {
                 let start = (pos.y() * raster.width + pos.x()) * raster.channels;
                 let px = [r, g, b, a];
-                raster.data[start..start + raster.channels]
-                    .copy_from_slice(&px[..raster.channels]);
+                raster.data[start..start + raster.channels].copy_from_slice(&px[..raster.channels]);
             },
         )
         .first_valid_layer()
@@ -277,7 +276,9 @@ mod tests {
         std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
         let err = read_exr(&path).unwrap_err().to_string();
         assert!(err.contains("t.exr"), "{err}");
-        let err = read_hdr(&dir.path().join("nope.hdr")).unwrap_err().to_string();
+        let err = read_hdr(&dir.path().join("nope.hdr"))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("nope.hdr"), "{err}");
     }
 
@@ -297,6 +298,9 @@ mod tests {
         write_png(&dir.path().join("ok.png"), &image, 0.0, true).unwrap();
         image.data[3 * 7 + 4] = f32::NAN;
         let err = write_png(&dir.path().join("bad.png"), &image, 0.0, true).unwrap_err();
-        assert_eq!(err.to_string(), "image[1, 1, 1] = NaN: a PNG cannot show NaN");
+        assert_eq!(
+            err.to_string(),
+            "image[1, 1, 1] = NaN: a PNG cannot show NaN"
+        );
     }
 }

@@ -132,16 +132,17 @@ fn default_threads() -> Result<usize> {
 fn pool(threads: usize) -> Result<Arc<ThreadPool>> {
     let mut guard = POOL.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let pid = std::process::id();
-    if let Some(p) = guard.as_ref() {
-        if p.pid == pid && p.threads == threads {
-            return Ok(Arc::clone(&p.pool));
-        }
+    if let Some(p) = guard.as_ref()
+        && p.pid == pid
+        && p.threads == threads
+    {
+        return Ok(Arc::clone(&p.pool));
     }
-    if let Some(old) = guard.take() {
-        if old.pid != pid {
-            // The pool's threads do not exist in a forked child: never touch it.
-            std::mem::forget(old);
-        }
+    if let Some(old) = guard.take()
+        && old.pid != pid
+    {
+        // The pool's threads do not exist in a forked child: never touch it.
+        std::mem::forget(old);
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -211,7 +212,10 @@ mod tests {
         let mut out = vec![0usize; n];
         let mut twice = vec![0usize; n];
         let ok = for_each_chunk(n, (&mut out[..], &mut twice[..]), |range, (a, b)| {
-            assert!(range.start % CHUNK == 0, "chunks start at multiples of CHUNK");
+            assert!(
+                range.start % CHUNK == 0,
+                "chunks start at multiples of CHUNK"
+            );
             for (k, i) in range.enumerate() {
                 a[k] = i;
                 b[k] = 2 * i;

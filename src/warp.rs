@@ -26,7 +26,11 @@ fn turn_fraction<F: Real>(x: F, y: F) -> F {
     let phi = y.atan2(x) / two_pi::<F>();
     let phi = if phi < F::zero() { phi + F::one() } else { phi };
     // -0.0 and phi + 1 rounding up to 1 both map to the start of the turn.
-    if phi >= F::one() { F::zero() } else { phi.abs() }
+    if phi >= F::one() {
+        F::zero()
+    } else {
+        phi.abs()
+    }
 }
 
 /// Tolerance of support tests (the boundary of a disk or hemisphere), in
@@ -65,7 +69,10 @@ pub fn square_to_uniform_disk_pdf<F: Real>(p: P2<F>) -> F {
 /// Inverse of [`square_to_uniform_disk`].
 #[inline(always)]
 pub fn uniform_disk_to_square<F: Real>(p: P2<F>) -> P2<F> {
-    [turn_fraction(p[0], p[1]), (p[0] * p[0] + p[1] * p[1]).min(F::one())]
+    [
+        turn_fraction(p[0], p[1]),
+        (p[0] * p[0] + p[1] * p[1]).min(F::one()),
+    ]
 }
 
 /// Uniform point on the unit disk by Shirley and Chiu's concentric map,
@@ -129,7 +136,10 @@ pub fn uniform_disk_to_square_concentric<F: Real>(p: P2<F>) -> P2<F> {
         (t, r)
     };
     let half = F::c(0.5);
-    [clamp01((a + F::one()) * half), clamp01((b + F::one()) * half)]
+    [
+        clamp01((a + F::one()) * half),
+        clamp01((b + F::one()) * half),
+    ]
 }
 
 #[inline(always)]
@@ -162,7 +172,10 @@ pub fn square_to_uniform_sphere_pdf<F: Real>(_d: V3<F>) -> F {
 /// Inverse of [`square_to_uniform_sphere`].
 #[inline(always)]
 pub fn uniform_sphere_to_square<F: Real>(d: V3<F>) -> P2<F> {
-    [turn_fraction(d[0], d[1]), clamp01((F::one() - d[2]) * F::c(0.5))]
+    [
+        turn_fraction(d[0], d[1]),
+        clamp01((F::one() - d[2]) * F::c(0.5)),
+    ]
 }
 
 /// Uniform direction on the +z hemisphere, by lifting a concentric disk

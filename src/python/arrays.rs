@@ -56,7 +56,9 @@ pub fn index_arg(ob: &Bound<'_, PyAny>, arg: &'static str, min: u64, max: u64) -
         .map_err(|_| {
             PyTypeError::new_err(format!(
                 "{arg} must be an integer, got {}",
-                ob.get_type().name().map_or_else(|_| "?".into(), |n| n.to_string())
+                ob.get_type()
+                    .name()
+                    .map_or_else(|_| "?".into(), |n| n.to_string())
             ))
         })?;
     if int.lt(min)? || int.gt(max)? {
@@ -67,7 +69,7 @@ pub fn index_arg(ob: &Bound<'_, PyAny>, arg: &'static str, min: u64, max: u64) -
         }
         .into());
     }
-    Ok(int.extract()?)
+    int.extract()
 }
 
 /// What every input value must satisfy.
@@ -113,9 +115,9 @@ pub struct Points<'py, F: Element, const K: usize> {
 impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
     /// Reads `ob` as points of dimension `K`.
     pub fn extract(ob: &Bound<'py, PyAny>, arg: &'static str) -> PyResult<Self> {
-        let array: PyArrayLikeDyn<'py, F, AllowTypeChange> = ob.extract().map_err(|e| {
-            PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}"))
-        })?;
+        let array: PyArrayLikeDyn<'py, F, AllowTypeChange> = ob
+            .extract()
+            .map_err(|e| PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}")))?;
         let shape = array.shape().to_vec();
         let (n, batched) = match (K, shape.as_slice()) {
             (1, []) => (1, false),

@@ -11,7 +11,9 @@ use std::path::PathBuf;
 
 fn to_numpy<'py>(py: Python<'py>, raster: Raster) -> PyResult<Bound<'py, PyAny>> {
     let shape = [raster.height, raster.width, raster.channels];
-    Ok(PyArray1::from_vec(py, raster.data).reshape(shape)?.into_any())
+    Ok(PyArray1::from_vec(py, raster.data)
+        .reshape(shape)?
+        .into_any())
 }
 
 fn from_numpy(image: &Bound<'_, PyAny>) -> PyResult<Raster> {
@@ -59,7 +61,12 @@ pub fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAn
 ///     Write 16-bit half floats instead of 32-bit floats.
 #[pyfunction]
 #[pyo3(signature = (path, image, half = false))]
-pub fn write_exr(py: Python<'_>, path: PathBuf, image: &Bound<'_, PyAny>, half: bool) -> PyResult<()> {
+pub fn write_exr(
+    py: Python<'_>,
+    path: PathBuf,
+    image: &Bound<'_, PyAny>,
+    half: bool,
+) -> PyResult<()> {
     let raster = from_numpy(image)?;
     detached(py, || io::write_exr(&path, &raster, half))
 }

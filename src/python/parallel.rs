@@ -52,7 +52,10 @@ pub fn get_num_threads() -> PyResult<usize> {
 pub fn _trigger_panic(py: Python<'_>) -> PyResult<()> {
     let n = 4 * parallel::CHUNK;
     run_batch(py, n, (), |range, ()| {
-        assert!(!range.contains(&(n - 1)), "deliberate panic for the test suite");
+        assert!(
+            !range.contains(&(n - 1)),
+            "deliberate panic for the test suite"
+        );
         true
     })?;
     Ok(())

@@ -28,7 +28,9 @@ fn parse_shape(shape: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<usize>> {
     } else {
         vec![index_arg(shape, "shape", 0, MAX_COUNT)? as usize]
     };
-    let total = dims.iter().try_fold(1u64, |acc, &d| acc.checked_mul(d as u64));
+    let total = dims
+        .iter()
+        .try_fold(1u64, |acc, &d| acc.checked_mul(d as u64));
     match total {
         Some(t) if t <= MAX_COUNT => Ok(dims),
         _ => Err(crate::error::Error::Integer {

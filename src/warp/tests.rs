@@ -3,18 +3,21 @@
 use super::*;
 use std::f64::consts::PI;
 
+/// A density on points of a warp's domain.
+type Pdf = fn(&[f64]) -> f64;
+
 /// A planar or spherical warp under test, in f64.
 struct Case {
     name: &'static str,
     sample: fn([f64; 2]) -> Vec<f64>,
-    pdf: fn(&[f64]) -> f64,
+    pdf: Pdf,
     invert: fn(&[f64]) -> [f64; 2],
     /// Integral of the pdf over its domain, by quadrature.
-    integrate: fn(fn(&[f64]) -> f64) -> f64,
+    integrate: fn(Pdf) -> f64,
 }
 
 /// Midpoint rule over `[-1, 1]²` with `n²` cells.
-fn integrate_plane(pdf: fn(&[f64]) -> f64) -> f64 {
+fn integrate_plane(pdf: Pdf) -> f64 {
     let n = 800;
     let h = 2.0 / n as f64;
     let mut sum = 0.0;
@@ -28,7 +31,7 @@ fn integrate_plane(pdf: fn(&[f64]) -> f64) -> f64 {
 }
 
 /// Midpoint rule over the sphere in (φ, cos θ), which is area-preserving.
-fn integrate_sphere(pdf: fn(&[f64]) -> f64) -> f64 {
+fn integrate_sphere(pdf: Pdf) -> f64 {
     let (n_phi, n_z) = (200, 4000);
     let (h_phi, h_z) = (2.0 * PI / n_phi as f64, 2.0 / n_z as f64);
     let mut sum = 0.0;
@@ -115,7 +118,9 @@ fn cases() -> Vec<Case> {
 
 /// An open grid `1e-6 .. 1 − 1e-6` plus points within 1e-12 of the edges.
 fn grid() -> Vec<f64> {
-    let mut g: Vec<f64> = (0..=40).map(|i| 1e-6 + (1.0 - 2e-6) * i as f64 / 40.0).collect();
+    let mut g: Vec<f64> = (0..=40)
+        .map(|i| 1e-6 + (1.0 - 2e-6) * i as f64 / 40.0)
+        .collect();
     g.extend([1e-12, 1.0 - 1e-12, 0.5 - 1e-12, 0.5 + 1e-12]);
     g
 }
@@ -151,7 +156,11 @@ fn sample_of_invert_is_identity() {
                 let x = (case.sample)([a, b]);
                 let u = (case.invert)(&x);
                 let y = (case.sample)(u);
-                let err = x.iter().zip(&y).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+                let err = x
+                    .iter()
+                    .zip(&y)
+                    .map(|(p, q)| (p - q).abs())
+                    .fold(0.0, f64::max);
                 assert!(err < 1e-9, "{}: {x:?} -> {u:?} -> {y:?}", case.name);
             }
         }
@@ -162,7 +171,11 @@ fn sample_of_invert_is_identity() {
 fn pdfs_integrate_to_one_and_are_positive_on_samples() {
     for case in cases() {
         let total = (case.integrate)(case.pdf);
-        assert!((total - 1.0).abs() < 5e-3, "{}: integral {total}", case.name);
+        assert!(
+            (total - 1.0).abs() < 5e-3,
+            "{}: integral {total}",
+            case.name
+        );
         for &a in &grid() {
             for &b in &grid() {
                 let x = (case.sample)([a, b]);
@@ -196,10 +209,18 @@ fn u_equal_one_stays_in_the_domain() {
     for case in cases() {
         for u in [[1.0, 1.0], [1.0, 0.0], [0.0, 1.0], [0.0, 0.0], [1.0, 0.5]] {
             let x = (case.sample)(u);
-            assert!(x.iter().all(|v| v.is_finite()), "{}: {u:?} -> {x:?}", case.name);
+            assert!(
+                x.iter().all(|v| v.is_finite()),
+                "{}: {u:?} -> {x:?}",
+                case.name
+            );
             // The cosine lobes vanish on the rim z = 0, which is still inside.
             let on_rim = case.name.starts_with("cosine") && x[2] == 0.0;
-            assert!(on_rim || (case.pdf)(&x) > 0.0, "{}: {u:?} -> {x:?} outside", case.name);
+            assert!(
+                on_rim || (case.pdf)(&x) > 0.0,
+                "{}: {u:?} -> {x:?} outside",
+                case.name
+            );
         }
     }
     assert!(interval_to_power(1.0f32, 3.0) <= 1.0);
@@ -226,7 +247,10 @@ fn pdfs_vanish_off_the_support() {
     assert_eq!(square_to_uniform_disk_pdf([1.0, 1.0]), 0.0);
     assert_eq!(square_to_uniform_hemisphere_pdf([0.0, 0.0, -1.0]), 0.0);
     assert_eq!(square_to_cosine_hemisphere_pdf([0.0, 0.6, -0.8]), 0.0);
-    assert_eq!(square_to_cosine_power_hemisphere_pdf([1.0, 0.0, 0.0], 0.0), 0.0);
+    assert_eq!(
+        square_to_cosine_power_hemisphere_pdf([1.0, 0.0, 0.0], 0.0),
+        0.0
+    );
     assert_eq!(square_to_uniform_cone_pdf([1.0, 0.0, 0.0], 0.5), 0.0);
     assert_eq!(square_to_uniform_triangle_pdf([0.8, 0.8]), 0.0);
     assert_eq!(interval_to_power_pdf(1.5f64, 2.0), 0.0);
