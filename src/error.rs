@@ -8,12 +8,12 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// A table weight that is NaN, infinite or negative.
-    #[error("{arg}[{index}] = {value}: {arg} must be finite and >= 0")]
+    #[error("{arg}{index} = {value}: {arg} must be finite and >= 0")]
     InvalidWeight {
         /// Name of the argument.
         arg: &'static str,
-        /// Flat index of the first offending entry.
-        index: usize,
+        /// Index of the first offending entry, formatted as `[i]` or `[i, j]`.
+        index: String,
         /// The offending value.
         value: f64,
     },
@@ -65,6 +65,16 @@ pub enum Error {
         /// What the value must satisfy.
         requirement: String,
     },
+    /// A table too large for 32-bit indices.
+    #[error("{arg} has {len} entries: at most {max} are supported")]
+    TooLarge {
+        /// Name of the argument.
+        arg: &'static str,
+        /// Number of entries given.
+        len: usize,
+        /// The largest number accepted.
+        max: usize,
+    },
     /// A file that cannot be read or written, or whose content is invalid.
     #[error("{path}: {message}")]
     Io {
@@ -97,7 +107,7 @@ mod tests {
     fn messages_name_argument_index_and_value() {
         let e = Error::InvalidWeight {
             arg: "weights",
-            index: 17,
+            index: "[17]".into(),
             value: -0.5,
         };
         assert_eq!(

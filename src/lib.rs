@@ -8,6 +8,9 @@
 //! - [`rng`]: PCG32 with jump-ahead, uniform batches.
 //! - [`parallel`]: the batch engine (chunks on a rayon pool, thread count).
 //! - [`warp`]: `square_to_*` warps, their densities and inverses.
+//! - [`distr`]: discrete tables (CDF inversion, alias), 2D tables and
+//!   piecewise-constant densities.
+//! - [`frame`]: orthonormal frames around a normal.
 //! - [`io`]: EXR, Radiance HDR and PNG files.
 //! - [`math`]: the [`math::Real`] scalar trait (`f32` / `f64`) and helpers.
 //! - [`error`]: the one error type.
@@ -23,7 +26,9 @@
 #![deny(missing_docs)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
+pub mod distr;
 pub mod error;
+pub mod frame;
 pub mod io;
 pub mod math;
 pub mod parallel;

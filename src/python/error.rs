@@ -16,7 +16,8 @@ impl From<Error> for PyErr {
             | Error::Shape { .. }
             | Error::Parameter { .. }
             | Error::Element { .. }
-            | Error::Integer { .. } => PyValueError::new_err(e.to_string()),
+            | Error::Integer { .. }
+            | Error::TooLarge { .. } => PyValueError::new_err(e.to_string()),
         }
     }
 }

@@ -1,0 +1,194 @@
+//! [`AliasTable`]: O(1) sampling of a discrete distribution (Vose's method).
+
+use super::check_weights;
+use crate::error::{Error, Result};
+use crate::math::Real;
+
+/// One cell of the table: keep the cell's own index when the fractional
+/// part of `u·n` is below `threshold`, else take `alias`.
+#[derive(Clone, Copy, Debug, Default)]
+struct Cell {
+    threshold: f64,
+    alias: u32,
+}
+
+/// A discrete distribution over `0..n` with probabilities proportional to
+/// non-negative weights, sampled in O(1) with one uniform number.
+///
+/// # Probability
+/// `P(i) = w_i / Σw`, the same as [`super::Discrete1D`] (a different map
+/// from `u` to indices).
+///
+/// # Sampling
+/// With `t = u·n`, cell `c = ⌊t⌋` keeps its own index when `t − c` is below
+/// the cell's threshold, and otherwise returns the cell's alias. Every cell
+/// holds mass `1/n`: its own share `w_c·n/Σw`, topped up from one donor.
+/// An entry of weight 0 has threshold 0 and is never returned.
+///
+/// # References
+/// M. D. Vose, "A linear algorithm for generating random numbers with a
+/// given distribution", IEEE Transactions on Software Engineering 17(9),
+/// 1991.
+#[derive(Clone, Debug)]
+pub struct AliasTable {
+    cells: Vec<Cell>,
+    pmf: Vec<f64>,
+    sum: f64,
+}
+
+impl AliasTable {
+    /// An alias table proportional to `weights`.
+    ///
+    /// # Errors
+    /// As [`super::Discrete1D::new`].
+    pub fn new(weights: &[f64]) -> Result<Self> {
+        check_weights("weights", weights, |i| format!("[{i}]"))?;
+        let sum: f64 = weights.iter().sum();
+        if !(sum > 0.0 && sum.is_finite()) {
+            return Err(Error::AllZero { arg: "weights" });
+        }
+        let n = weights.len();
+        let pmf: Vec<f64> = weights.iter().map(|&w| w / sum).collect();
+
+        // Vose: cells below their 1/n share ("small") are topped up by cells
+        // above it ("large"). One index array holds both stacks: smalls grow
+        // from the front, larges from the back.
+        let mut scaled: Vec<f64> = pmf.iter().map(|&p| p * n as f64).collect();
+        let mut cells = vec![Cell::default(); n];
+        let mut stack = vec![0u32; n];
+        let (mut n_small, mut n_large) = (0usize, 0usize);
+        for (i, &s) in scaled.iter().enumerate() {
+            if s < 1.0 {
+                stack[n_small] = i as u32;
+                n_small += 1;
+            } else {
+                n_large += 1;
+                stack[n - n_large] = i as u32;
+            }
+        }
+        while n_small > 0 && n_large > 0 {
+            n_small -= 1;
+            let small = stack[n_small] as usize;
+            let large = stack[n - n_large] as usize;
+            cells[small] = Cell {
+                threshold: scaled[small],
+                alias: large as u32,
+            };
+            scaled[large] = (scaled[large] + scaled[small]) - 1.0;
+            if scaled[large] < 1.0 {
+                // The donor became small: move it from the large stack.
+                n_large -= 1;
+                stack[n_small] = large as u32;
+                n_small += 1;
+            }
+        }
+        // What is left holds (up to round-off) exactly one share each.
+        let donor = pmf
+            .iter()
+            .enumerate()
+            .fold(0, |best, (i, &p)| if p > pmf[best] { i } else { best });
+        for &i in stack[..n_small].iter().chain(&stack[n - n_large..]) {
+            let i = i as usize;
+            cells[i] = if pmf[i] > 0.0 {
+                Cell {
+                    threshold: 1.0,
+                    alias: i as u32,
+                }
+            } else {
+                Cell {
+                    threshold: 0.0,
+                    alias: donor as u32,
+                }
+            };
+        }
+        Ok(AliasTable { cells, pmf, sum })
+    }
+
+    /// Number of entries.
+    pub fn len(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// Whether the table has no entries (never true for a built table).
+    pub fn is_empty(&self) -> bool {
+        self.cells.is_empty()
+    }
+
+    /// The sum of the weights.
+    pub fn sum(&self) -> f64 {
+        self.sum
+    }
+
+    /// Probability of index `i`: `w_i / Σw` (0 outside the table).
+    pub fn pmf(&self, i: usize) -> f64 {
+        self.pmf.get(i).copied().unwrap_or(0.0)
+    }
+
+    /// An index drawn with probability `pmf(i)`; `u` in `[0, 1]`.
+    #[inline]
+    pub fn sample<F: Real>(&self, u: F) -> usize {
+        let n = self.cells.len();
+        let t = u.f64() * n as f64;
+        let c = (t as usize).min(n - 1);
+        let cell = self.cells[c];
+        if t - (c as f64) < cell.threshold {
+            c
+        } else {
+            cell.alias as usize
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The probability of each index, read off the table: each cell gives
+    /// `threshold/n` to itself and the rest to its alias.
+    fn table_pmf(t: &AliasTable) -> Vec<f64> {
+        let n = t.len();
+        let mut p = vec![0.0; n];
+        for (i, cell) in t.cells.iter().enumerate() {
+            let keep = cell.threshold.min(1.0);
+            p[i] += keep / n as f64;
+            p[cell.alias as usize] += (1.0 - keep) / n as f64;
+        }
+        p
+    }
+
+    #[test]
+    fn table_realises_the_pmf() {
+        let w = [0.0, 1.0, 0.0, 2.0, 3.0, 0.0, 10.0];
+        let t = AliasTable::new(&w).unwrap();
+        for (i, p) in table_pmf(&t).into_iter().enumerate() {
+            assert!((p - w[i] / 16.0).abs() < 1e-12, "index {i}: {p}");
+        }
+        assert_eq!(t.sample(1.0), t.sample(f64::ONE_MINUS_EPSILON));
+    }
+
+    #[test]
+    fn errors() {
+        assert!(AliasTable::new(&[]).is_err());
+        assert!(AliasTable::new(&[0.0]).is_err());
+        assert!(AliasTable::new(&[1.0, f64::INFINITY]).is_err());
+    }
+
+    proptest! {
+        #[test]
+        fn never_returns_a_zero_weight_and_keeps_the_pmf(
+            weights in prop::collection::vec(prop_oneof![Just(0.0), 0.0..10.0f64, 1e-300..1e-290f64], 1..500),
+            us in prop::collection::vec(0.0..=1.0f64, 50),
+        ) {
+            if let Ok(t) = AliasTable::new(&weights) {
+                for u in us.into_iter().chain([0.0, 1.0]) {
+                    let i = t.sample(u);
+                    prop_assert!(weights[i] > 0.0, "u = {} gave zero-weight index {}", u, i);
+                }
+                for (i, p) in table_pmf(&t).into_iter().enumerate() {
+                    prop_assert!((p - t.pmf(i)).abs() < 1e-9, "index {}: {} vs {}", i, p, t.pmf(i));
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,282 @@
+//! [`Discrete1D`]: a discrete distribution sampled by inverting its CDF.
+
+use super::check_weights;
+use crate::error::{Error, Result};
+use crate::math::Real;
+
+/// Tables shorter than this are searched without a guide table: a binary
+/// search over a few cache lines is as fast.
+const GUIDE_MIN_LEN: usize = 1024;
+
+/// A discrete distribution over the indices `0..n`, with probabilities
+/// proportional to non-negative weights `w`.
+///
+/// # Probability
+/// `P(i) = w_i / Σ w`. The running sums `C_i = w_0 + … + w_i` are
+/// accumulated in `f64`.
+///
+/// # Sampling
+/// `sample(u)` returns the index `i` with `C_{i−1} < u·Σw ≤ C_i` (as
+/// Mitsuba 3's `DiscreteDistribution`), restricted to the range from the
+/// first to the last entry of positive weight, so an entry of weight 0 is
+/// never returned (`u = 0` and `u = 1` included). A guide table (the
+/// cutpoint method of Chen and Asau) narrows the binary search to an
+/// expected O(1) entries.
+///
+/// # References
+/// H.-C. Chen, Y. Asau, "On generating random variates from an empirical
+/// distribution", AIIE Transactions 6(2), 1974.
+#[derive(Clone, Debug)]
+pub struct Discrete1D {
+    weights: Vec<f64>,
+    cdf: Vec<f64>,
+    sum: f64,
+    first: usize,
+    last: usize,
+    /// `guide[k]`: the first index whose running sum reaches `k/G · Σw`,
+    /// clamped to `[first, last]`, for `k = 0..=G` (empty for short tables).
+    guide: Vec<u32>,
+}
+
+impl Discrete1D {
+    /// A distribution proportional to `weights`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidWeight`] for a NaN, infinite or negative weight,
+    /// [`Error::AllZero`] if the table is empty or sums to 0,
+    /// [`Error::TooLarge`] above [`super::MAX_ENTRIES`] entries.
+    pub fn new(weights: &[f64]) -> Result<Self> {
+        check_weights("weights", weights, |i| format!("[{i}]"))?;
+        Self::from_checked(weights.to_vec()).ok_or(Error::AllZero { arg: "weights" })
+    }
+
+    /// A distribution from weights already checked to be finite and
+    /// `>= 0`; `None` when they are empty or sum to 0.
+    pub(crate) fn from_checked(weights: Vec<f64>) -> Option<Self> {
+        let mut cdf = Vec::with_capacity(weights.len());
+        let mut acc = 0.0;
+        for &w in &weights {
+            acc += w;
+            cdf.push(acc);
+        }
+        let first = weights.iter().position(|&w| w > 0.0)?;
+        let last = weights.iter().rposition(|&w| w > 0.0)?;
+        if !(acc > 0.0 && acc.is_finite()) {
+            return None;
+        }
+        let mut table = Discrete1D {
+            weights,
+            cdf,
+            sum: acc,
+            first,
+            last,
+            guide: Vec::new(),
+        };
+        table.guide = table.build_guide();
+        Some(table)
+    }
+
+    fn build_guide(&self) -> Vec<u32> {
+        let n = self.weights.len();
+        if n < GUIDE_MIN_LEN {
+            return Vec::new();
+        }
+        let cells = n;
+        let scale = self.sum / cells as f64;
+        let mut guide = Vec::with_capacity(cells + 1);
+        let mut i = self.first;
+        for k in 0..=cells {
+            let threshold = k as f64 * scale;
+            while i < self.last && self.cdf[i] < threshold {
+                i += 1;
+            }
+            guide.push(i as u32);
+        }
+        guide
+    }
+
+    /// Number of entries.
+    pub fn len(&self) -> usize {
+        self.weights.len()
+    }
+
+    /// Whether the table has no entries (never true for a built table).
+    pub fn is_empty(&self) -> bool {
+        self.weights.is_empty()
+    }
+
+    /// The sum of the weights (the normalisation constant).
+    pub fn sum(&self) -> f64 {
+        self.sum
+    }
+
+    /// The weight of entry `i` as given (0 outside the table).
+    pub fn weight(&self, i: usize) -> f64 {
+        self.weights.get(i).copied().unwrap_or(0.0)
+    }
+
+    /// The weights as given.
+    pub fn weights(&self) -> &[f64] {
+        &self.weights
+    }
+
+    /// Probability of index `i`: `w_i / Σw` (0 outside the table).
+    pub fn pmf(&self, i: usize) -> f64 {
+        self.weight(i) / self.sum
+    }
+
+    /// Running sum of the weights before entry `i`: `C_{i−1}` (0 for i = 0).
+    pub fn sum_before(&self, i: usize) -> f64 {
+        match i {
+            0 => 0.0,
+            _ => self.cdf.get(i - 1).copied().unwrap_or(self.sum),
+        }
+    }
+
+    /// Cumulative probability `P(index ≤ i) = C_i / Σw` (1 past the end).
+    pub fn cdf(&self, i: usize) -> f64 {
+        self.cdf.get(i).map_or(1.0, |&c| c / self.sum)
+    }
+
+    /// The index `i` with `C_{i−1} < u·Σw ≤ C_i`, among entries of positive
+    /// weight. `u` in `[0, 1]`.
+    #[inline]
+    pub fn sample<F: Real>(&self, u: F) -> usize {
+        let value = u.f64() * self.sum;
+        let (lo, hi) = self.bracket(u.f64(), value);
+        lo + self.cdf[lo..hi].partition_point(|&c| c < value)
+    }
+
+    /// The index as [`Discrete1D::sample`], and `u` rescaled within that
+    /// entry's share to `[0, 1)`: `(u·Σw − C_{i−1}) / w_i`, a fresh uniform
+    /// number for a second decision.
+    #[inline]
+    pub fn sample_reuse<F: Real>(&self, u: F) -> (usize, F) {
+        let i = self.sample(u);
+        let value = u.f64() * self.sum;
+        let rescaled = (value - self.sum_before(i)) / self.weights[i];
+        (i, F::c(rescaled.clamp(0.0, f64::ONE_MINUS_EPSILON)))
+    }
+
+    /// The range `[lo, hi]` (inclusive) that holds the answer for `value`:
+    /// from the guide table when it provably brackets `value`, else the
+    /// whole range of positive weights.
+    #[inline(always)]
+    fn bracket(&self, u: f64, value: f64) -> (usize, usize) {
+        let full = (self.first, self.last);
+        if self.guide.is_empty() {
+            return full;
+        }
+        let cells = self.guide.len() - 1;
+        let k = ((u * cells as f64) as usize).min(cells - 1);
+        let (lo, hi) = (self.guide[k] as usize, self.guide[k + 1] as usize);
+        // Round-off in u·G against the guide's thresholds can miss by one
+        // cell: check the bracket and fall back to the full range.
+        let lo_ok = lo == self.first || self.cdf[lo - 1] < value;
+        let hi_ok = hi == self.last || self.cdf[hi] >= value;
+        if lo_ok && hi_ok { (lo, hi) } else { full }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The reference: a linear scan for `C_{i−1} < u·Σw ≤ C_i` over the
+    /// entries of positive weight.
+    fn linear(table: &Discrete1D, u: f64) -> usize {
+        let value = u * table.sum;
+        (table.first..=table.last)
+            .find(|&i| table.cdf[i] >= value)
+            .unwrap_or(table.last)
+    }
+
+    #[test]
+    fn known_values_as_mitsuba() {
+        // Mitsuba 3: DiscreteDistribution([0, 1, 0, 2, 3, 0]).sample(u)
+        let d = Discrete1D::new(&[0.0, 1.0, 0.0, 2.0, 3.0, 0.0]).unwrap();
+        assert_eq!(d.sample(0.0), 1);
+        assert_eq!(d.sample(1.0 / 6.0), 1);
+        assert_eq!(d.sample(0.5), 3);
+        assert_eq!(d.sample(1.0), 4);
+        let (i, r) = d.sample_reuse(0.25f64);
+        assert_eq!(i, 3);
+        assert!((r - 0.25).abs() < 1e-12, "{r}");
+        assert_eq!(d.sum(), 6.0);
+        assert_eq!(d.pmf(3), 1.0 / 3.0);
+        assert_eq!(d.cdf(5), 1.0);
+    }
+
+    #[test]
+    fn errors() {
+        assert!(matches!(
+            Discrete1D::new(&[1.0, -0.5]),
+            Err(Error::InvalidWeight { .. })
+        ));
+        assert!(matches!(
+            Discrete1D::new(&[1.0, f64::NAN]),
+            Err(Error::InvalidWeight { .. })
+        ));
+        assert!(matches!(
+            Discrete1D::new(&[0.0, 0.0]),
+            Err(Error::AllZero { .. })
+        ));
+        assert!(matches!(Discrete1D::new(&[]), Err(Error::AllZero { .. })));
+        // A sum that overflows is no distribution either.
+        assert!(Discrete1D::new(&[f64::MAX, f64::MAX]).is_err());
+    }
+
+    #[test]
+    fn guide_table_agrees_with_a_linear_scan() {
+        let n = 5000;
+        let weights: Vec<f64> = (0..n)
+            .map(|i| {
+                if i % 7 == 3 {
+                    0.0
+                } else {
+                    ((i * 37) % 11) as f64
+                }
+            })
+            .collect();
+        let d = Discrete1D::new(&weights).unwrap();
+        assert!(!d.guide.is_empty());
+        for k in 0..=20_000 {
+            let u = k as f64 / 20_000.0;
+            assert_eq!(d.sample(u), linear(&d, u), "u = {u}");
+        }
+        // Exactly on every running sum.
+        for i in 0..n {
+            let u = d.cdf[i] / d.sum;
+            assert_eq!(d.sample(u), linear(&d, u), "u = C_{i}");
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn never_returns_a_zero_weight(
+            weights in prop::collection::vec(prop_oneof![Just(0.0), 0.0..10.0f64], 1..3000),
+            us in prop::collection::vec(0.0..=1.0f64, 50),
+        ) {
+            if let Ok(d) = Discrete1D::new(&weights) {
+                for u in us.into_iter().chain([0.0, 1.0, f64::ONE_MINUS_EPSILON]) {
+                    let (i, r) = d.sample_reuse(u);
+                    prop_assert!(weights[i] > 0.0, "u = {} gave zero-weight index {}", u, i);
+                    prop_assert_eq!(i, linear(&d, u));
+                    prop_assert!((0.0..1.0).contains(&r));
+                }
+                // The CDF is monotone and ends at 1.
+                prop_assert!((0..d.len()).all(|i| i == 0 || d.cdf(i) >= d.cdf(i - 1)));
+                prop_assert_eq!(d.cdf(d.len() - 1), 1.0);
+            }
+        }
+
+        #[test]
+        fn constructor_never_panics(weights in prop::collection::vec(
+            prop_oneof![Just(f64::NAN), Just(f64::INFINITY), Just(-0.0), Just(f64::MAX), any::<f64>()],
+            0..20,
+        )) {
+            let _ = Discrete1D::new(&weights);
+        }
+    }
+}

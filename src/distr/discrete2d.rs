@@ -1,0 +1,170 @@
+//! [`Discrete2D`]: a discrete distribution over the cells of a table.
+
+use super::{Discrete1D, check_weights};
+use crate::error::{Error, Result};
+use crate::math::Real;
+
+/// A discrete distribution over the cells `(row, col)` of a `rows × cols`
+/// table of non-negative weights, sampled by the two-step method.
+///
+/// # Probability
+/// `P(row, col) = w[row][col] / Σw`.
+///
+/// # Sampling
+/// A row from the marginal distribution (the row sums) by `u[1]`, then a
+/// column from that row's conditional distribution by `u[0]`: the same
+/// assignment of `u` as Mitsuba 3's `DiscreteDistribution2D` (whose
+/// `Point2u` is `(col, row)`). Both steps are [`Discrete1D`] searches, so a
+/// cell of weight 0 is never returned.
+#[derive(Clone, Debug)]
+pub struct Discrete2D {
+    marginal: Discrete1D,
+    /// One conditional per row; `None` for rows of weight 0 (never drawn).
+    conditionals: Vec<Option<Discrete1D>>,
+    cols: usize,
+}
+
+impl Discrete2D {
+    /// A distribution over the cells of the row-major `rows × cols` table
+    /// `weights`.
+    ///
+    /// # Errors
+    /// [`Error::Shape`] if `weights.len() != rows·cols`; otherwise as
+    /// [`Discrete1D::new`], with the offending entry named `[row, col]`.
+    pub fn new(weights: &[f64], rows: usize, cols: usize) -> Result<Self> {
+        Self::with_arg("weights", weights, rows, cols)
+    }
+
+    /// As [`Discrete2D::new`], naming the argument `arg` in errors.
+    pub fn with_arg(arg: &'static str, weights: &[f64], rows: usize, cols: usize) -> Result<Self> {
+        if rows.checked_mul(cols) != Some(weights.len()) {
+            return Err(Error::Shape {
+                arg,
+                expected: format!("({rows}, {cols})"),
+                got: format!("{} values", weights.len()),
+            });
+        }
+        let cols_nz = cols.max(1);
+        check_weights(arg, weights, |i| {
+            format!("[{}, {}]", i / cols_nz, i % cols_nz)
+        })?;
+        if rows > super::MAX_ENTRIES || cols > super::MAX_ENTRIES {
+            return Err(Error::TooLarge {
+                arg,
+                len: rows.max(cols),
+                max: super::MAX_ENTRIES,
+            });
+        }
+        let conditionals: Vec<Option<Discrete1D>> = weights
+            .chunks(cols_nz)
+            .map(|row| Discrete1D::from_checked(row.to_vec()))
+            .collect();
+        let row_sums: Vec<f64> = conditionals
+            .iter()
+            .map(|c| c.as_ref().map_or(0.0, Discrete1D::sum))
+            .collect();
+        let marginal = Discrete1D::from_checked(row_sums).ok_or(Error::AllZero { arg })?;
+        Ok(Discrete2D {
+            marginal,
+            conditionals,
+            cols,
+        })
+    }
+
+    /// `(rows, cols)`.
+    pub fn shape(&self) -> (usize, usize) {
+        (self.conditionals.len(), self.cols)
+    }
+
+    /// The sum of all weights.
+    pub fn sum(&self) -> f64 {
+        self.marginal.sum()
+    }
+
+    /// The marginal distribution of rows (weights: the row sums).
+    pub fn marginal(&self) -> &Discrete1D {
+        &self.marginal
+    }
+
+    /// The conditional distribution of columns in `row` (`None` for a row
+    /// of weight 0).
+    pub fn conditional(&self, row: usize) -> Option<&Discrete1D> {
+        self.conditionals.get(row).and_then(Option::as_ref)
+    }
+
+    /// The weight of cell `(row, col)` as given (0 outside the table).
+    pub fn weight(&self, row: usize, col: usize) -> f64 {
+        self.conditional(row).map_or(0.0, |c| c.weight(col))
+    }
+
+    /// Probability of cell `(row, col)`: `w / Σw` (0 outside the table).
+    pub fn pmf(&self, row: usize, col: usize) -> f64 {
+        self.weight(row, col) / self.sum()
+    }
+
+    /// A cell `(row, col)` drawn with probability `pmf`; `u` in `[0, 1]²`.
+    #[inline]
+    pub fn sample<F: Real>(&self, u: [F; 2]) -> (usize, usize) {
+        self.sample_reuse(u).0
+    }
+
+    /// The cell as [`Discrete2D::sample`], and `u` rescaled within the
+    /// chosen row and column shares to `[0, 1)²` (see
+    /// [`Discrete1D::sample_reuse`]).
+    #[inline]
+    pub fn sample_reuse<F: Real>(&self, u: [F; 2]) -> ((usize, usize), [F; 2]) {
+        let (row, u_row) = self.marginal.sample_reuse(u[1]);
+        // The marginal never draws a row of weight 0.
+        match &self.conditionals[row] {
+            Some(conditional) => {
+                let (col, u_col) = conditional.sample_reuse(u[0]);
+                ((row, col), [u_col, u_row])
+            }
+            None => ((row, 0), [u[0], u_row]),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn known_values_as_mitsuba() {
+        // Mitsuba 3: DiscreteDistribution2D([[1, 2, 3], [4, 5, 6]]).sample(u)
+        // gives Point2u (col, row).
+        let d = Discrete2D::new(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0], 2, 3).unwrap();
+        assert_eq!(d.sample([0.1, 0.1]), (0, 0));
+        assert_eq!(d.sample([0.9, 0.1]), (0, 2));
+        assert_eq!(d.sample([0.1, 0.9]), (1, 0));
+        assert_eq!(d.sample([0.9, 0.9]), (1, 2));
+        assert_eq!(d.sample([0.5, 0.5]), (1, 1));
+        assert!((d.pmf(1, 2) - 6.0 / 21.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn zero_rows_and_cells_are_never_drawn() {
+        let d = Discrete2D::new(&[0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0], 3, 3).unwrap();
+        for u in [[0.0, 0.0], [1.0, 1.0], [0.5, 0.0], [0.0, 1.0]] {
+            assert_eq!(d.sample(u), (1, 1));
+        }
+    }
+
+    #[test]
+    fn errors_name_row_and_column() {
+        let e = Discrete2D::new(&[1.0, 2.0, 3.0, -4.0], 2, 2).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "weights[1, 1] = -4: weights must be finite and >= 0"
+        );
+        assert!(matches!(
+            Discrete2D::new(&[0.0; 4], 2, 2),
+            Err(Error::AllZero { .. })
+        ));
+        assert!(matches!(
+            Discrete2D::new(&[1.0; 3], 2, 2),
+            Err(Error::Shape { .. })
+        ));
+        assert!(Discrete2D::new(&[], 0, 3).is_err());
+    }
+}

@@ -1,0 +1,60 @@
+//! Tabulated distributions: discrete tables in one and two dimensions, and
+//! piecewise-constant densities built on them.
+//!
+//! | table | sample cost | inverse | 2D | built on |
+//! |---|---|---|---|---|
+//! | [`Discrete1D`] | O(1) expected (guide table + binary search on the CDF) | via [`Discrete1D::sample_reuse`] | no | — |
+//! | [`AliasTable`] | O(1) (one table lookup) | no | no | — |
+//! | [`Discrete2D`] | two [`Discrete1D`] searches | via `sample_reuse` | yes | [`Discrete1D`] |
+//! | [`PiecewiseConstant1D`] | one [`Discrete1D`] search | [`PiecewiseConstant1D::invert`] | no | [`Discrete1D`] |
+//! | [`PiecewiseConstant2D`] | two [`Discrete1D`] searches | [`PiecewiseConstant2D::invert`] | yes | [`Discrete2D`] |
+//!
+//! Constructors validate their weights (finite, `>= 0`, not all zero) and
+//! return [`crate::Error`]; sampling is infallible and never returns an
+//! entry of weight 0. Sums are accumulated in `f64`.
+
+mod alias;
+mod discrete;
+mod discrete2d;
+mod piecewise;
+
+pub use alias::AliasTable;
+pub use discrete::Discrete1D;
+pub use discrete2d::Discrete2D;
+pub use piecewise::{PiecewiseConstant1D, PiecewiseConstant2D};
+
+use crate::error::{Error, Result};
+
+/// The largest number of entries a table may have (indices are `u32`).
+pub const MAX_ENTRIES: usize = u32::MAX as usize;
+
+/// Checks that every weight is finite and `>= 0` and that there are at most
+/// [`MAX_ENTRIES`]; `index` formats the position of an offending entry.
+fn check_weights(
+    arg: &'static str,
+    weights: &[f64],
+    index: impl Fn(usize) -> String,
+) -> Result<()> {
+    if weights.len() > MAX_ENTRIES {
+        return Err(Error::TooLarge {
+            arg,
+            len: weights.len(),
+            max: MAX_ENTRIES,
+        });
+    }
+    // One branch-free pass for the common case; find the index only on failure.
+    let valid = weights
+        .iter()
+        .fold(true, |ok, &w| ok & (w >= 0.0 && w.is_finite()));
+    if valid {
+        return Ok(());
+    }
+    match weights.iter().position(|&w| !(w >= 0.0 && w.is_finite())) {
+        Some(i) => Err(Error::InvalidWeight {
+            arg,
+            index: index(i),
+            value: weights[i],
+        }),
+        None => Ok(()),
+    }
+}
