@@ -53,7 +53,7 @@ pub enum Error {
         /// The offending value.
         value: f64,
         /// What every entry must satisfy.
-        requirement: &'static str,
+        requirement: String,
     },
     /// An integer argument that is negative or too large.
     #[error("{arg} = {value}: {requirement}")]
@@ -64,6 +64,18 @@ pub enum Error {
         value: String,
         /// What the value must satisfy.
         requirement: String,
+    },
+    /// An index outside its table.
+    #[error("{arg}{index} = {value}: must be an index in [0, {len})")]
+    Index {
+        /// Name of the argument.
+        arg: &'static str,
+        /// Position of the first offending entry, formatted as `[i]` or `[i, j]`.
+        index: String,
+        /// The offending index.
+        value: i64,
+        /// The table's length along that axis.
+        len: usize,
     },
     /// A table too large for 32-bit indices.
     #[error("{arg} has {len} entries: at most {max} are supported")]
@@ -118,7 +130,7 @@ mod tests {
             arg: "u",
             index: "[3, 1]".into(),
             value: f64::NAN,
-            requirement: "must lie in [0, 1]",
+            requirement: "must lie in [0, 1]".into(),
         };
         assert_eq!(e.to_string(), "u[3, 1] = NaN: must lie in [0, 1]");
     }

@@ -201,7 +201,7 @@ pub fn write_png(path: &Path, image: &Raster, exposure: f32, srgb: bool) -> Resu
             arg: "image",
             index: format!("[{}, {}, {}]", pixel / image.width, pixel % image.width, ch),
             value: f64::NAN,
-            requirement: "a PNG cannot show NaN",
+            requirement: "a PNG cannot show NaN".into(),
         });
     }
     let bytes: Vec<u8> = image

@@ -6,14 +6,30 @@ Conventions (sample-major batches, float32 in / float32 out, densities per
 steradian on directions, +z normal) are in the README.
 """
 
-from . import io, stats, warp
-from ._core import Rng, __version__, get_num_threads, set_num_threads, uniform
+from . import distr, io, stats, warp
+from ._core import Frame, Rng, __version__, get_num_threads, set_num_threads, uniform
+from .distr import (
+    AliasTable,
+    Discrete1D,
+    Discrete2D,
+    PiecewiseConstant1D,
+    PiecewiseConstant2D,
+    rejection_sample,
+)
 
 __all__ = [
+    "AliasTable",
+    "Discrete1D",
+    "Discrete2D",
+    "Frame",
+    "PiecewiseConstant1D",
+    "PiecewiseConstant2D",
     "Rng",
+    "distr",
     "__version__",
     "get_num_threads",
     "io",
+    "rejection_sample",
     "set_num_threads",
     "stats",
     "uniform",

@@ -79,21 +79,42 @@ pub enum Check {
     Unit,
     /// Finite (points, directions).
     Finite,
+    /// Component `k` in the closed interval `bounds[k]` (points of a
+    /// rectangle or, for one component, an interval).
+    Within([[f64; 2]; 2]),
 }
 
 impl Check {
+    /// Whether component `k` of a point may be `x`.
     #[inline(always)]
-    fn holds<F: Real>(self, x: F) -> bool {
+    fn holds<F: Real>(self, k: usize, x: F) -> bool {
         match self {
             Check::Unit => x >= F::zero() && x <= F::one(),
             Check::Finite => x.is_finite(),
+            Check::Within(bounds) => {
+                let [lo, hi] = bounds[k.min(1)];
+                x.f64() >= lo && x.f64() <= hi
+            }
         }
     }
 
-    fn requirement(self) -> &'static str {
+    /// Whether every component of `point` passes.
+    #[inline(always)]
+    fn holds_all<F: Real, const K: usize>(self, point: &[F; K]) -> bool {
+        point
+            .iter()
+            .enumerate()
+            .fold(true, |acc, (k, &v)| acc & self.holds(k, v))
+    }
+
+    fn requirement(self, k: usize) -> String {
         match self {
-            Check::Unit => "must lie in [0, 1]",
-            Check::Finite => "must be finite",
+            Check::Unit => "must lie in [0, 1]".into(),
+            Check::Finite => "must be finite".into(),
+            Check::Within(bounds) => {
+                let [lo, hi] = bounds[k.min(1)];
+                format!("must lie in [{lo}, {hi}]")
+            }
         }
     }
 }
@@ -176,7 +197,7 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
     /// The error for the first value that fails `check`.
     pub fn invalid(&self, check: Check) -> PyErr {
         for (i, row) in self.rows().iter().enumerate() {
-            if let Some(j) = row.iter().position(|&x| !check.holds(x)) {
+            if let Some(j) = (0..K).find(|&k| !check.holds(k, row[k])) {
                 let index = match (self.batched, K) {
                     (true, 1) => format!("[{i}]"),
                     (true, _) => format!("[{i}, {j}]"),
@@ -187,7 +208,7 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
                     arg: self.arg,
                     index,
                     value: row[j].f64(),
-                    requirement: check.requirement(),
+                    requirement: check.requirement(j),
                 }
                 .into();
             }
@@ -196,7 +217,7 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
             arg: self.arg,
             index: String::new(),
             value: f64::NAN,
-            requirement: check.requirement(),
+            requirement: check.requirement(0),
         }
         .into()
     }
@@ -217,28 +238,28 @@ pub fn finish<'py, F: Element>(array: Bound<'py, PyArrayDyn<F>>) -> PyResult<Bou
     }
 }
 
-/// Maps every point through `kernel` (`K` values in, `M` out), checking
-/// each input value in the same pass; the GIL is released and the batch
-/// runs on all cores.
-pub fn map<'py, F, const K: usize, const M: usize>(
+/// Maps every point through `kernel` (`K` values in, `M` out, of any
+/// element type), checking each input value in the same pass; the GIL is
+/// released and the batch runs on all cores.
+pub fn map<'py, F, T, const K: usize, const M: usize>(
     py: Python<'py>,
     x: &Points<'py, F, K>,
     check: Check,
-    kernel: impl Fn([F; K]) -> [F; M] + Sync + Send,
+    kernel: impl Fn([F; K]) -> [T; M] + Sync + Send,
 ) -> PyResult<Bound<'py, PyAny>>
 where
     F: PyFloat,
+    T: Element + Copy + Send,
 {
-    let out = zeros::<F>(py, &x.out_shape(M));
+    let out = zeros::<T>(py, &x.out_shape(M));
     {
         let mut guard = out.readwrite();
-        let flat = guard.as_slice_mut()?;
-        let out_rows = flat.as_chunks_mut::<M>().0;
+        let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
         let in_rows = x.rows();
-        let valid = run_batch(py, x.n, out_rows, |range, chunk: &mut [[F; M]]| {
+        let valid = run_batch(py, x.n, out_rows, |range, chunk: &mut [[T; M]]| {
             let mut ok = true;
             for (o, u) in chunk.iter_mut().zip(&in_rows[range]) {
-                ok &= u.iter().fold(true, |acc, &v| acc & check.holds(v));
+                ok &= check.holds_all(u);
                 *o = kernel(*u);
             }
             ok
@@ -248,4 +269,170 @@ where
         }
     }
     finish(out)
+}
+
+/// As [`map`] for kernels with two results (`M` and `L` values per point),
+/// returned as two arrays.
+pub fn map2<'py, F, T, S, const K: usize, const M: usize, const L: usize>(
+    py: Python<'py>,
+    x: &Points<'py, F, K>,
+    check: Check,
+    kernel: impl Fn([F; K]) -> ([T; M], [S; L]) + Sync + Send,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)>
+where
+    F: PyFloat,
+    T: Element + Copy + Send,
+    S: Element + Copy + Send,
+{
+    let first = zeros::<T>(py, &x.out_shape(M));
+    let second = zeros::<S>(py, &x.out_shape(L));
+    {
+        let (mut g1, mut g2) = (first.readwrite(), second.readwrite());
+        let rows1 = g1.as_slice_mut()?.as_chunks_mut::<M>().0;
+        let rows2 = g2.as_slice_mut()?.as_chunks_mut::<L>().0;
+        let in_rows = x.rows();
+        let valid = run_batch(py, x.n, (rows1, rows2), |range, (c1, c2)| {
+            let mut ok = true;
+            for ((o1, o2), u) in c1.iter_mut().zip(c2.iter_mut()).zip(&in_rows[range]) {
+                ok &= check.holds_all(u);
+                (*o1, *o2) = kernel(*u);
+            }
+            ok
+        })?;
+        if !valid {
+            return Err(x.invalid(check));
+        }
+    }
+    Ok((finish(first)?, finish(second)?))
+}
+
+/// Integer indices read from an array-like: `(N, K)` or `(K,)` (for
+/// `K = 1`, `(N,)` or a scalar), each column `k` checked to lie in
+/// `[0, bounds[k])`.
+pub struct Indices<const K: usize> {
+    /// The indices, one `[usize; K]` per point.
+    pub rows: Vec<[usize; K]>,
+    /// False for a single point given without the batch axis.
+    pub batched: bool,
+}
+
+impl<const K: usize> Indices<K> {
+    /// Reads and checks `ob` (argument `arg`); floats raise TypeError, an
+    /// index out of range ValueError naming its position.
+    pub fn extract(ob: &Bound<'_, PyAny>, arg: &'static str, bounds: [usize; K]) -> PyResult<Self> {
+        let py = ob.py();
+        let array = py
+            .import(pyo3::intern!(py, "numpy"))?
+            .call_method1(pyo3::intern!(py, "asarray"), (ob,))?;
+        let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
+        if kind != "i" && kind != "u" {
+            return Err(PyTypeError::new_err(format!(
+                "{arg} must be integers, got an array of dtype {}",
+                array.getattr("dtype")?
+            )));
+        }
+        let array: PyArrayLikeDyn<'_, i64, AllowTypeChange> = array.extract()?;
+        let shape = array.shape().to_vec();
+        let batched = match (K, shape.as_slice()) {
+            (1, []) => false,
+            (1, [_]) => true,
+            (_, [k]) if *k == K => false,
+            (_, [_, k]) if *k == K => true,
+            _ => {
+                let expected = if K == 1 {
+                    "(N,) or ()".to_string()
+                } else {
+                    format!("(N, {K}) or ({K},)")
+                };
+                return Err(Error::Shape {
+                    arg,
+                    expected,
+                    got: shape_str(&shape),
+                }
+                .into());
+            }
+        };
+        let flat: Vec<i64> = array.as_array().iter().copied().collect();
+        let mut rows = Vec::with_capacity(flat.len() / K);
+        for (i, chunk) in flat.as_chunks::<K>().0.iter().enumerate() {
+            let mut row = [0usize; K];
+            for (k, (&v, &bound)) in chunk.iter().zip(&bounds).enumerate() {
+                if v < 0 || v as u64 >= bound as u64 {
+                    let index = match (batched, K) {
+                        (true, 1) => format!("[{i}]"),
+                        (true, _) => format!("[{i}, {k}]"),
+                        (false, 1) => String::new(),
+                        (false, _) => format!("[{k}]"),
+                    };
+                    return Err(Error::Index {
+                        arg,
+                        index,
+                        value: v,
+                        len: bound,
+                    }
+                    .into());
+                }
+                row[k] = v as usize;
+            }
+            rows.push(row);
+        }
+        Ok(Indices { rows, batched })
+    }
+
+    /// Maps every index row to one float64 value; shape `(N,)`, or a
+    /// scalar for an unbatched row.
+    pub fn map_f64<'py>(
+        &self,
+        py: Python<'py>,
+        f: impl Fn([usize; K]) -> f64 + Sync + Send,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let shape: Vec<usize> = if self.batched {
+            vec![self.rows.len()]
+        } else {
+            vec![]
+        };
+        let out = zeros::<f64>(py, &shape);
+        {
+            let mut guard = out.readwrite();
+            let values = guard.as_slice_mut()?;
+            let rows = &self.rows;
+            run_batch(py, rows.len(), values, |range, chunk: &mut [f64]| {
+                for (o, &r) in chunk.iter_mut().zip(&rows[range]) {
+                    *o = f(r);
+                }
+                true
+            })?;
+        }
+        finish(out)
+    }
+}
+
+/// A table of weights read as float64 with its shape; `ndim` must be 1 or 2
+/// as asked (the values are checked by the core constructors).
+pub fn table(
+    ob: &Bound<'_, PyAny>,
+    arg: &'static str,
+    ndim: usize,
+) -> PyResult<(Vec<f64>, Vec<usize>)> {
+    let array: PyArrayLikeDyn<'_, f64, AllowTypeChange> = ob
+        .extract()
+        .map_err(|e| PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}")))?;
+    let shape = array.shape().to_vec();
+    if shape.len() != ndim {
+        return Err(Error::Shape {
+            arg,
+            expected: if ndim == 1 {
+                "(N,)".into()
+            } else {
+                "(rows, cols)".into()
+            },
+            got: shape_str(&shape),
+        }
+        .into());
+    }
+    let values = match array.as_slice() {
+        Ok(s) if array.is_c_contiguous() => s.to_vec(),
+        _ => array.as_array().iter().copied().collect(),
+    };
+    Ok((values, shape))
 }

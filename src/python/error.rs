@@ -17,7 +17,8 @@ impl From<Error> for PyErr {
             | Error::Parameter { .. }
             | Error::Element { .. }
             | Error::Integer { .. }
-            | Error::TooLarge { .. } => PyValueError::new_err(e.to_string()),
+            | Error::TooLarge { .. }
+            | Error::Index { .. } => PyValueError::new_err(e.to_string()),
         }
     }
 }

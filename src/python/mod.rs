@@ -3,7 +3,9 @@
 //! sampling logic lives here.
 
 mod arrays;
+mod distr;
 mod error;
+mod frame;
 mod io;
 mod parallel;
 mod rng;
@@ -38,6 +40,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parallel::set_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(parallel::get_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(parallel::_trigger_panic, m)?)?;
+    distr::register(m)?;
+    m.add_class::<frame::PyFrame>()?;
     submodule(m, "warp", warp::register)?;
     submodule(m, "io", io::register)?;
     Ok(())

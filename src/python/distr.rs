@@ -1,0 +1,543 @@
+//! `mcsample.Discrete1D`, `AliasTable`, `Discrete2D`, `PiecewiseConstant1D`
+//! and `PiecewiseConstant2D`: batched bindings of [`crate::distr`]. Tables
+//! are built with the GIL released; every `u` is checked to lie in [0, 1]
+//! in the sampling pass.
+
+use super::arrays::{Check, Indices, Points, map, map2, table, with_precision};
+use super::parallel::detached;
+use crate::distr;
+use numpy::PyArray1;
+use pyo3::prelude::*;
+
+/// The `(N,)` array of `f(i)` for `i in 0..n`.
+fn per_index<'py>(
+    py: Python<'py>,
+    n: usize,
+    f: impl Fn(usize) -> f64,
+) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_iter(py, (0..n).map(f))
+}
+
+/// A discrete distribution over 0..n-1 proportional to ``weights``,
+/// sampled by inverting its CDF (binary search on running sums accumulated
+/// in float64, narrowed by a guide table).
+///
+/// ``sample(u)`` returns the index i with C[i-1] < u * sum <= C[i], as
+/// Mitsuba 3's ``DiscreteDistribution``; an entry of weight 0 is never
+/// returned.
+///
+/// Parameters
+/// ----------
+/// weights : array_like, shape (n,)
+///     Finite, >= 0, not all zero.
+#[pyclass(module = "mcsample._core", name = "Discrete1D", frozen)]
+pub struct PyDiscrete1D(distr::Discrete1D);
+
+#[pymethods]
+impl PyDiscrete1D {
+    #[new]
+    fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (w, _) = table(weights, "weights", 1)?;
+        Ok(Self(detached(py, || distr::Discrete1D::new(&w))?))
+    }
+
+    /// Indices drawn from the distribution.
+    ///
+    /// Parameters
+    /// ----------
+    /// u : float or array_like, shape (N,), values in [0, 1]
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) int64 (a scalar for a scalar u).
+    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(u, F => {
+            let u = Points::<F, 1>::extract(u, "u")?;
+            map(py, &u, Check::Unit, |u| [self.0.sample(u[0]) as i64])
+        })
+    }
+
+    /// Indices as ``sample``, and u rescaled within the chosen entry's share
+    /// to [0, 1): (u * sum - C[i-1]) / w[i], a fresh uniform number.
+    ///
+    /// Returns
+    /// -------
+    /// (ndarray (N,) int64, ndarray (N,) float of u's precision)
+    fn sample_reuse<'py>(
+        &self,
+        py: Python<'py>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        with_precision!(u, F => {
+            let u = Points::<F, 1>::extract(u, "u")?;
+            map2(py, &u, Check::Unit, |u| {
+                let (i, r) = self.0.sample_reuse(u[0]);
+                ([i as i64], [r])
+            })
+        })
+    }
+
+    /// Probabilities w[i] / sum of the indices ``i`` (all n when omitted).
+    ///
+    /// Parameters
+    /// ----------
+    /// i : int or array_like of int, shape (N,), optional
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) float64 (a scalar for a scalar i).
+    #[pyo3(signature = (i = None))]
+    fn pmf<'py>(
+        &self,
+        py: Python<'py>,
+        i: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        match i {
+            None => Ok(per_index(py, self.0.len(), |k| self.0.pmf(k)).into_any()),
+            Some(i) => {
+                Indices::<1>::extract(i, "i", [self.0.len()])?.map_f64(py, |[k]| self.0.pmf(k))
+            }
+        }
+    }
+
+    /// The normalised CDF, shape (n,): P(index <= i); the last entry is 1.
+    #[getter]
+    fn cdf<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        per_index(py, self.0.len(), |k| self.0.cdf(k))
+    }
+
+    /// The sum of the weights (the normalisation constant).
+    #[getter]
+    fn sum(&self) -> f64 {
+        self.0.sum()
+    }
+
+    fn __len__(&self) -> usize {
+        self.0.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Discrete1D(n={}, sum={})", self.0.len(), self.0.sum())
+    }
+}
+
+/// An alias table (Vose's method): O(1) sampling of the distribution over
+/// 0..n-1 proportional to ``weights``, with one uniform number per sample.
+/// Same probabilities as ``Discrete1D``, a different map from u to indices;
+/// an entry of weight 0 is never returned.
+///
+/// Parameters
+/// ----------
+/// weights : array_like, shape (n,)
+///     Finite, >= 0, not all zero.
+#[pyclass(module = "mcsample._core", name = "AliasTable", frozen)]
+pub struct PyAliasTable(distr::AliasTable);
+
+#[pymethods]
+impl PyAliasTable {
+    #[new]
+    fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (w, _) = table(weights, "weights", 1)?;
+        Ok(Self(detached(py, || distr::AliasTable::new(&w))?))
+    }
+
+    /// Indices drawn from the distribution.
+    ///
+    /// Parameters
+    /// ----------
+    /// u : float or array_like, shape (N,), values in [0, 1]
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) int64 (a scalar for a scalar u).
+    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(u, F => {
+            let u = Points::<F, 1>::extract(u, "u")?;
+            map(py, &u, Check::Unit, |u| [self.0.sample(u[0]) as i64])
+        })
+    }
+
+    /// Probabilities w[i] / sum of the indices ``i`` (all n when omitted).
+    #[pyo3(signature = (i = None))]
+    fn pmf<'py>(
+        &self,
+        py: Python<'py>,
+        i: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        match i {
+            None => Ok(per_index(py, self.0.len(), |k| self.0.pmf(k)).into_any()),
+            Some(i) => {
+                Indices::<1>::extract(i, "i", [self.0.len()])?.map_f64(py, |[k]| self.0.pmf(k))
+            }
+        }
+    }
+
+    /// The sum of the weights.
+    #[getter]
+    fn sum(&self) -> f64 {
+        self.0.sum()
+    }
+
+    fn __len__(&self) -> usize {
+        self.0.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("AliasTable(n={}, sum={})", self.0.len(), self.0.sum())
+    }
+}
+
+/// Reads a 2D table argument: (values, rows, cols).
+fn table_2d(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<(Vec<f64>, usize, usize)> {
+    let (values, shape) = table(ob, arg, 2)?;
+    Ok((values, shape[0], shape[1]))
+}
+
+/// A discrete distribution over the cells (row, col) of a table,
+/// proportional to ``weights``: a row from the marginal (row sums) by
+/// u[:, 1], then a column from that row's conditional by u[:, 0] — the
+/// assignment of Mitsuba 3's ``DiscreteDistribution2D`` (whose results are
+/// (col, row)).
+///
+/// Parameters
+/// ----------
+/// weights : array_like, shape (rows, cols)
+///     Finite, >= 0, not all zero.
+#[pyclass(module = "mcsample._core", name = "Discrete2D", frozen)]
+pub struct PyDiscrete2D(distr::Discrete2D);
+
+#[pymethods]
+impl PyDiscrete2D {
+    #[new]
+    fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (w, rows, cols) = table_2d(weights, "weights")?;
+        Ok(Self(detached(py, || {
+            distr::Discrete2D::new(&w, rows, cols)
+        })?))
+    }
+
+    /// Cells drawn from the distribution.
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,) int64: (row, col).
+    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(u, F => {
+            let u = Points::<F, 2>::extract(u, "u")?;
+            map(py, &u, Check::Unit, |u| {
+                let (r, c) = self.0.sample(u);
+                [r as i64, c as i64]
+            })
+        })
+    }
+
+    /// Cells as ``sample``, and u rescaled within the chosen row and column
+    /// shares to [0, 1)^2.
+    ///
+    /// Returns
+    /// -------
+    /// (ndarray (N, 2) int64 (row, col), ndarray (N, 2) float of u's precision)
+    fn sample_reuse<'py>(
+        &self,
+        py: Python<'py>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        with_precision!(u, F => {
+            let u = Points::<F, 2>::extract(u, "u")?;
+            map2(py, &u, Check::Unit, |u| {
+                let ((r, c), v) = self.0.sample_reuse(u);
+                ([r as i64, c as i64], v)
+            })
+        })
+    }
+
+    /// Probabilities w[row, col] / sum of the cells ``idx`` (rows of
+    /// (row, col)); the whole (rows, cols) table when omitted.
+    ///
+    /// Parameters
+    /// ----------
+    /// idx : array_like of int, shape (N, 2) or (2,), optional
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) float64 (a scalar for one cell).
+    #[pyo3(signature = (idx = None))]
+    fn pmf<'py>(
+        &self,
+        py: Python<'py>,
+        idx: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (rows, cols) = self.0.shape();
+        match idx {
+            None => {
+                let flat = per_index(py, rows * cols, |k| self.0.pmf(k / cols, k % cols));
+                Ok(flat.call_method1("reshape", (rows, cols))?)
+            }
+            Some(idx) => Indices::<2>::extract(idx, "idx", [rows, cols])?
+                .map_f64(py, |[r, c]| self.0.pmf(r, c)),
+        }
+    }
+
+    /// (rows, cols) of the table.
+    #[getter]
+    fn shape(&self) -> (usize, usize) {
+        self.0.shape()
+    }
+
+    /// The sum of the weights.
+    #[getter]
+    fn sum(&self) -> f64 {
+        self.0.sum()
+    }
+
+    fn __repr__(&self) -> String {
+        let (rows, cols) = self.0.shape();
+        format!("Discrete2D(shape=({rows}, {cols}), sum={})", self.0.sum())
+    }
+}
+
+/// A piecewise-constant density on [a, b]: n equal cells with densities
+/// proportional to ``values``, sampled by inverting its piecewise-linear
+/// CDF. p(x) = values[i] / (sum(values) * h) on cell i, h = (b - a) / n;
+/// 0 outside [a, b]. Per unit length.
+///
+/// Parameters
+/// ----------
+/// values : array_like, shape (n,)
+///     Finite, >= 0, not all zero.
+/// a, b : float
+///     The interval, finite with a < b.
+#[pyclass(module = "mcsample._core", name = "PiecewiseConstant1D", frozen)]
+pub struct PyPiecewiseConstant1D(distr::PiecewiseConstant1D);
+
+#[pymethods]
+impl PyPiecewiseConstant1D {
+    #[new]
+    #[pyo3(signature = (values, a = 0.0, b = 1.0))]
+    fn new(py: Python<'_>, values: &Bound<'_, PyAny>, a: f64, b: f64) -> PyResult<Self> {
+        let (v, _) = table(values, "values", 1)?;
+        Ok(Self(detached(py, || {
+            distr::PiecewiseConstant1D::new(&v, a, b)
+        })?))
+    }
+
+    /// Points drawn from the density, and their densities.
+    ///
+    /// Parameters
+    /// ----------
+    /// u : float or array_like, shape (N,), values in [0, 1]
+    ///
+    /// Returns
+    /// -------
+    /// (x, pdf): ndarrays of shape (N,) in u's precision (scalars for a
+    /// scalar u); pdf per unit length.
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        with_precision!(u, F => {
+            let u = Points::<F, 1>::extract(u, "u")?;
+            map2(py, &u, Check::Unit, |u| {
+                let (x, pdf) = self.0.sample(u[0]);
+                ([x], [pdf])
+            })
+        })
+    }
+
+    /// The density at ``x`` (0 outside [a, b]), per unit length.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : float or array_like, shape (N,)
+    fn pdf<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(x, F => {
+            let x = Points::<F, 1>::extract(x, "x")?;
+            map(py, &x, Check::Finite, |x| [self.0.pdf(x[0])])
+        })
+    }
+
+    /// The CDF P(X <= x): 0 below a, 1 above b.
+    ///
+    /// Parameters
+    /// ----------
+    /// x : float or array_like, shape (N,)
+    fn cdf<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(x, F => {
+            let x = Points::<F, 1>::extract(x, "x")?;
+            map(py, &x, Check::Finite, |x| [self.0.cdf(x[0])])
+        })
+    }
+
+    /// The u that ``sample`` maps to ``x`` (the CDF on [a, b]).
+    ///
+    /// Parameters
+    /// ----------
+    /// x : float or array_like, shape (N,), values in [a, b]
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     For x outside [a, b], naming the first such index.
+    fn invert<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let (a, b) = self.0.domain();
+        with_precision!(x, F => {
+            let x = Points::<F, 1>::extract(x, "x")?;
+            map(py, &x, Check::Within([[a, b], [a, b]]), |x| {
+                [self.0.invert(x[0]).unwrap_or(0.0)]
+            })
+        })
+    }
+
+    /// The interval (a, b).
+    #[getter]
+    fn domain(&self) -> (f64, f64) {
+        self.0.domain()
+    }
+
+    /// The integral of ``values`` over [a, b] (sum(values) * h).
+    #[getter]
+    fn integral(&self) -> f64 {
+        self.0.integral()
+    }
+
+    fn __len__(&self) -> usize {
+        self.0.table().len()
+    }
+
+    fn __repr__(&self) -> String {
+        let (a, b) = self.0.domain();
+        format!(
+            "PiecewiseConstant1D(n={}, a={a}, b={b})",
+            self.0.table().len()
+        )
+    }
+}
+
+/// A piecewise-constant density on the rectangle
+/// ``domain = ((x0, x1), (y0, y1))``, constant on the cells of a
+/// (rows, cols) grid with densities proportional to ``values[row, col]``
+/// (rows along y, row 0 at y0; columns along x). Sampled by the marginal
+/// along y (u[:, 1]) and the conditional along x (u[:, 0]). Per unit area.
+///
+/// Parameters
+/// ----------
+/// values : array_like, shape (rows, cols)
+///     Finite, >= 0, not all zero.
+/// domain : ((x0, x1), (y0, y1)), finite with x0 < x1 and y0 < y1
+#[pyclass(module = "mcsample._core", name = "PiecewiseConstant2D", frozen)]
+pub struct PyPiecewiseConstant2D(distr::PiecewiseConstant2D);
+
+#[pymethods]
+impl PyPiecewiseConstant2D {
+    #[new]
+    #[pyo3(signature = (values, domain = ((0.0, 1.0), (0.0, 1.0))))]
+    fn new(
+        py: Python<'_>,
+        values: &Bound<'_, PyAny>,
+        domain: ((f64, f64), (f64, f64)),
+    ) -> PyResult<Self> {
+        let (v, rows, cols) = table_2d(values, "values")?;
+        let d = [[domain.0.0, domain.0.1], [domain.1.0, domain.1.1]];
+        Ok(Self(detached(py, || {
+            distr::PiecewiseConstant2D::new(&v, rows, cols, d)
+        })?))
+    }
+
+    /// Points drawn from the density, and their densities.
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    ///
+    /// Returns
+    /// -------
+    /// (xy (N, 2), pdf (N,)) in u's precision; pdf per unit area.
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        with_precision!(u, F => {
+            let u = Points::<F, 2>::extract(u, "u")?;
+            map2(py, &u, Check::Unit, |u| {
+                let (p, pdf) = self.0.sample(u);
+                (p, [pdf])
+            })
+        })
+    }
+
+    /// The density at ``xy`` (0 outside the rectangle), per unit area.
+    ///
+    /// Parameters
+    /// ----------
+    /// xy : array_like, shape (N, 2) or (2,)
+    fn pdf<'py>(&self, py: Python<'py>, xy: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(xy, F => {
+            let xy = Points::<F, 2>::extract(xy, "xy")?;
+            map(py, &xy, Check::Finite, |p| [self.0.pdf(p)])
+        })
+    }
+
+    /// The u that ``sample`` maps to ``xy``: (conditional CDF along x in
+    /// the point's row, marginal CDF along y).
+    ///
+    /// Parameters
+    /// ----------
+    /// xy : array_like, shape (N, 2) or (2,), inside the rectangle
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     For a point outside the rectangle, naming the first such index.
+    fn invert<'py>(&self, py: Python<'py>, xy: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let domain = self.0.domain();
+        with_precision!(xy, F => {
+            let xy = Points::<F, 2>::extract(xy, "xy")?;
+            map(py, &xy, Check::Within(domain), |p| {
+                self.0.invert(p).unwrap_or([0.0; 2])
+            })
+        })
+    }
+
+    /// ((x0, x1), (y0, y1)).
+    #[getter]
+    fn domain(&self) -> ((f64, f64), (f64, f64)) {
+        let [[x0, x1], [y0, y1]] = self.0.domain();
+        ((x0, x1), (y0, y1))
+    }
+
+    /// (rows, cols) of the grid.
+    #[getter]
+    fn shape(&self) -> (usize, usize) {
+        self.0.table().shape()
+    }
+
+    /// The integral of ``values`` over the rectangle.
+    #[getter]
+    fn integral(&self) -> f64 {
+        self.0.integral()
+    }
+
+    fn __repr__(&self) -> String {
+        let (rows, cols) = self.0.table().shape();
+        format!(
+            "PiecewiseConstant2D(shape=({rows}, {cols}), domain={:?})",
+            self.0.domain()
+        )
+    }
+}
+
+/// Registers the distribution classes in module `m`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyDiscrete1D>()?;
+    m.add_class::<PyAliasTable>()?;
+    m.add_class::<PyDiscrete2D>()?;
+    m.add_class::<PyPiecewiseConstant1D>()?;
+    m.add_class::<PyPiecewiseConstant2D>()?;
+    Ok(())
+}

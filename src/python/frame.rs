@@ -1,0 +1,191 @@
+//! `mcsample.Frame`: orthonormal frames around one normal or a batch of
+//! normals (see [`crate::frame`]).
+
+use super::arrays::{Check, Points, PyFloat, finish, map, with_precision, zeros};
+use super::parallel::run_batch;
+use crate::error::{Error, shape_str};
+use crate::frame::Frame;
+use crate::math::Real;
+use numpy::PyArrayMethods;
+use pyo3::prelude::*;
+
+/// An orthonormal frame (s, t, n) around a normal, built without a branch
+/// that breaks near +-z (Duff et al. 2017); right-handed, s x t = n. The
+/// local shading frame of mcsample has the normal along +z: ``to_local``
+/// gives a vector's coordinates (v.s, v.t, v.n), ``to_world`` maps them
+/// back.
+///
+/// Parameters
+/// ----------
+/// normal : array_like, shape (3,) or (N, 3)
+///     One normal, or one per row of the vectors to transform. Normalised
+///     here; must be finite and non-zero.
+#[pyclass(module = "mcsample._core", name = "Frame", frozen)]
+pub struct PyFrame {
+    frames: Vec<Frame<f64>>,
+    batched: bool,
+}
+
+fn cast<F: Real>(f: &Frame<f64>) -> Frame<F> {
+    let c = |v: [f64; 3]| v.map(F::c);
+    Frame {
+        s: c(f.s),
+        t: c(f.t),
+        n: c(f.n),
+    }
+}
+
+impl PyFrame {
+    /// `op(frame, v)` for every row: one frame for all rows, or frame i for
+    /// row i.
+    fn apply<'py, F: PyFloat>(
+        &self,
+        py: Python<'py>,
+        v: &Bound<'py, PyAny>,
+        op: fn(&Frame<F>, [F; 3]) -> [F; 3],
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let v = Points::<F, 3>::extract(v, "v")?;
+        let frames: Vec<Frame<F>> = self.frames.iter().map(cast).collect();
+        if !self.batched {
+            let f = frames[0];
+            return map(py, &v, Check::Finite, move |x| op(&f, x));
+        }
+        if v.batched && v.n != frames.len() {
+            return Err(Error::Shape {
+                arg: "v",
+                expected: format!("({}, 3) or (3,), one row per normal", frames.len()),
+                got: shape_str(&[v.n, 3]),
+            }
+            .into());
+        }
+        let n = frames.len();
+        let out = zeros::<F>(py, &[n, 3]);
+        {
+            let mut guard = out.readwrite();
+            let rows = guard.as_slice_mut()?.as_chunks_mut::<3>().0;
+            let inputs = v.rows();
+            let valid = run_batch(py, n, rows, |range, chunk: &mut [[F; 3]]| {
+                let mut ok = true;
+                for (k, i) in range.enumerate() {
+                    let x = inputs[if v.batched { i } else { 0 }];
+                    ok &= x.iter().all(|c| c.is_finite());
+                    chunk[k] = op(&frames[i], x);
+                }
+                ok
+            })?;
+            if !valid {
+                return Err(v.invalid(Check::Finite));
+            }
+        }
+        finish(out)
+    }
+
+    fn axis<'py>(
+        &self,
+        py: Python<'py>,
+        pick: fn(&Frame<f64>) -> [f64; 3],
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let shape: Vec<usize> = if self.batched {
+            vec![self.frames.len(), 3]
+        } else {
+            vec![3]
+        };
+        let out = zeros::<f64>(py, &shape);
+        {
+            let mut guard = out.readwrite();
+            let flat = guard.as_slice_mut()?;
+            for (row, f) in flat.as_chunks_mut::<3>().0.iter_mut().zip(&self.frames) {
+                *row = pick(f);
+            }
+        }
+        finish(out)
+    }
+}
+
+#[pymethods]
+impl PyFrame {
+    #[new]
+    fn new(normal: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let normals = Points::<f64, 3>::extract(normal, "normal")?;
+        let mut frames = Vec::with_capacity(normals.n);
+        for (i, n) in normals.rows().iter().enumerate() {
+            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            if !(len.is_finite() && len > 0.0) {
+                return Err(Error::Element {
+                    arg: "normal",
+                    index: if normals.batched {
+                        format!("[{i}]")
+                    } else {
+                        String::new()
+                    },
+                    value: len,
+                    requirement: "the normal must be finite and non-zero (this is its length)"
+                        .into(),
+                }
+                .into());
+            }
+            frames.push(Frame::from_normal(n.map(|c| c / len)));
+        }
+        Ok(PyFrame {
+            frames,
+            batched: normals.batched,
+        })
+    }
+
+    /// Local coordinates (v.s, v.t, v.n) of world vectors ``v``.
+    ///
+    /// Parameters
+    /// ----------
+    /// v : array_like, shape (N, 3) or (3,)
+    ///     With a batch of N normals, one row per normal (or one (3,) vector
+    ///     for all).
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape of the batch (N, 3) or (3,), in v's precision.
+    fn to_local<'py>(&self, py: Python<'py>, v: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(v, F => self.apply::<F>(py, v, |f, x| f.to_local(x)))
+    }
+
+    /// World vectors v.x s + v.y t + v.z n from local coordinates ``v``.
+    ///
+    /// Parameters
+    /// ----------
+    /// v : array_like, shape (N, 3) or (3,)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape of the batch (N, 3) or (3,), in v's precision.
+    fn to_world<'py>(&self, py: Python<'py>, v: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(v, F => self.apply::<F>(py, v, |f, x| f.to_world(x)))
+    }
+
+    /// First tangent(s), shape (3,) or (N, 3).
+    #[getter]
+    fn s<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.axis(py, |f| f.s)
+    }
+
+    /// Second tangent(s), shape (3,) or (N, 3).
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.axis(py, |f| f.t)
+    }
+
+    /// The unit normal(s), shape (3,) or (N, 3).
+    #[getter]
+    fn n<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.axis(py, |f| f.n)
+    }
+
+    fn __len__(&self) -> usize {
+        self.frames.len()
+    }
+
+    fn __repr__(&self) -> String {
+        match (self.batched, self.frames.first()) {
+            (false, Some(f)) => format!("Frame(n={:?})", f.n),
+            _ => format!("Frame({} normals)", self.frames.len()),
+        }
+    }
+}
