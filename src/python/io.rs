@@ -112,7 +112,7 @@ pub fn write_png(
         return Err(Error::Parameter {
             arg: "exposure",
             value: exposure,
-            requirement: "must be finite".into(),
+            requirement: "must be finite",
         }
         .into());
     }
