@@ -4,14 +4,6 @@ use super::check_weights;
 use crate::error::{Error, Result};
 use crate::math::Real;
 
-/// One cell of the table: keep the cell's own index when the fractional
-/// part of `u·n` is below `threshold`, else take `alias`.
-#[derive(Clone, Copy, Debug, Default)]
-struct Cell {
-    threshold: f64,
-    alias: u32,
-}
-
 /// A discrete distribution over `0..n` with probabilities proportional to
 /// non-negative weights, sampled in O(1) with one uniform number.
 ///
@@ -31,7 +23,10 @@ struct Cell {
 /// 1991.
 #[derive(Clone, Debug)]
 pub struct AliasTable {
-    cells: Vec<Cell>,
+    /// Cell `c` keeps its own index when the fractional part of `u·n` is
+    /// below `threshold[c]`, else returns `alias[c]`.
+    threshold: Vec<f64>,
+    alias: Vec<u32>,
     pmf: Vec<f64>,
     sum: f64,
 }
@@ -52,9 +47,10 @@ impl AliasTable {
 
         // Vose: cells below their 1/n share ("small") are topped up by cells
         // above it ("large"). One index array holds both stacks: smalls grow
-        // from the front, larges from the back.
+        // from the front, larges from the back. A small cell's scaled mass
+        // is final once it is popped, so `scaled` becomes the thresholds.
         let mut scaled: Vec<f64> = pmf.iter().map(|&p| p * n as f64).collect();
-        let mut cells = vec![Cell::default(); n];
+        let mut alias: Vec<u32> = (0..n as u32).collect();
         let mut stack = vec![0u32; n];
         let (mut n_small, mut n_large) = (0usize, 0usize);
         for (i, &s) in scaled.iter().enumerate() {
@@ -70,10 +66,7 @@ impl AliasTable {
             n_small -= 1;
             let small = stack[n_small] as usize;
             let large = stack[n - n_large] as usize;
-            cells[small] = Cell {
-                threshold: scaled[small],
-                alias: large as u32,
-            };
+            alias[small] = large as u32;
             scaled[large] = (scaled[large] + scaled[small]) - 1.0;
             if scaled[large] < 1.0 {
                 // The donor became small: move it from the large stack.
@@ -82,36 +75,38 @@ impl AliasTable {
                 n_small += 1;
             }
         }
-        // What is left holds (up to round-off) exactly one share each.
+        // What is left holds (up to round-off) exactly one share each; an
+        // entry of weight 0 left over (only by round-off) points at the
+        // most likely entry instead.
         let donor = pmf
             .iter()
             .enumerate()
             .fold(0, |best, (i, &p)| if p > pmf[best] { i } else { best });
         for &i in stack[..n_small].iter().chain(&stack[n - n_large..]) {
             let i = i as usize;
-            cells[i] = if pmf[i] > 0.0 {
-                Cell {
-                    threshold: 1.0,
-                    alias: i as u32,
-                }
+            if pmf[i] > 0.0 {
+                (scaled[i], alias[i]) = (1.0, i as u32);
             } else {
-                Cell {
-                    threshold: 0.0,
-                    alias: donor as u32,
-                }
-            };
+                (scaled[i], alias[i]) = (0.0, donor as u32);
+            }
         }
-        Ok(AliasTable { cells, pmf, sum })
+        let threshold = scaled;
+        Ok(AliasTable {
+            threshold,
+            alias,
+            pmf,
+            sum,
+        })
     }
 
     /// Number of entries.
     pub fn len(&self) -> usize {
-        self.cells.len()
+        self.pmf.len()
     }
 
     /// Whether the table has no entries (never true for a built table).
     pub fn is_empty(&self) -> bool {
-        self.cells.is_empty()
+        self.pmf.is_empty()
     }
 
     /// The sum of the weights.
@@ -127,14 +122,13 @@ impl AliasTable {
     /// An index drawn with probability `pmf(i)`; `u` in `[0, 1]`.
     #[inline]
     pub fn sample<F: Real>(&self, u: F) -> usize {
-        let n = self.cells.len();
+        let n = self.pmf.len();
         let t = u.f64() * n as f64;
         let c = (t as usize).min(n - 1);
-        let cell = self.cells[c];
-        if t - (c as f64) < cell.threshold {
+        if t - (c as f64) < self.threshold[c] {
             c
         } else {
-            cell.alias as usize
+            self.alias[c] as usize
         }
     }
 }
@@ -149,10 +143,10 @@ mod tests {
     fn table_pmf(t: &AliasTable) -> Vec<f64> {
         let n = t.len();
         let mut p = vec![0.0; n];
-        for (i, cell) in t.cells.iter().enumerate() {
-            let keep = cell.threshold.min(1.0);
+        for i in 0..n {
+            let keep = t.threshold[i].min(1.0);
             p[i] += keep / n as f64;
-            p[cell.alias as usize] += (1.0 - keep) / n as f64;
+            p[t.alias[i] as usize] += (1.0 - keep) / n as f64;
         }
         p
     }

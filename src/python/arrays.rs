@@ -407,32 +407,40 @@ impl<const K: usize> Indices<K> {
     }
 }
 
-/// A table of weights read as float64 with its shape; `ndim` must be 1 or 2
-/// as asked (the values are checked by the core constructors).
-pub fn table(
-    ob: &Bound<'_, PyAny>,
-    arg: &'static str,
-    ndim: usize,
-) -> PyResult<(Vec<f64>, Vec<usize>)> {
-    let array: PyArrayLikeDyn<'_, f64, AllowTypeChange> = ob
-        .extract()
-        .map_err(|e| PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}")))?;
-    let shape = array.shape().to_vec();
-    if shape.len() != ndim {
-        return Err(Error::Shape {
-            arg,
-            expected: if ndim == 1 {
-                "(N,)".into()
-            } else {
-                "(rows, cols)".into()
-            },
-            got: shape_str(&shape),
+/// A table of weights read as float64 (converted only if it is not already
+/// a C-ordered float64 array); `ndim` must be 1 or 2 as asked. The values
+/// are checked by the core constructors.
+pub struct Table<'py> {
+    array: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
+    owned: Option<Vec<f64>>,
+    /// The table's shape.
+    pub shape: Vec<usize>,
+}
+
+impl<'py> Table<'py> {
+    /// Reads `ob` (argument `arg`).
+    pub fn extract(ob: &Bound<'py, PyAny>, arg: &'static str, ndim: usize) -> PyResult<Self> {
+        let array: PyArrayLikeDyn<'py, f64, AllowTypeChange> = ob
+            .extract()
+            .map_err(|e| PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}")))?;
+        let shape = array.shape().to_vec();
+        if shape.len() != ndim {
+            return Err(Error::Shape {
+                arg,
+                expected: if ndim == 1 { "(N,)".into() } else { "(rows, cols)".into() },
+                got: shape_str(&shape),
+            }
+            .into());
         }
-        .into());
+        let owned = (!array.is_c_contiguous()).then(|| array.as_array().iter().copied().collect());
+        Ok(Table { array, owned, shape })
     }
-    let values = match array.as_slice() {
-        Ok(s) if array.is_c_contiguous() => s.to_vec(),
-        _ => array.as_array().iter().copied().collect(),
-    };
-    Ok((values, shape))
+
+    /// The values in row-major order.
+    pub fn values(&self) -> &[f64] {
+        match &self.owned {
+            Some(v) => v,
+            None => self.array.as_slice().unwrap_or_default(),
+        }
+    }
 }

@@ -3,7 +3,7 @@
 //! are built with the GIL released; every `u` is checked to lie in [0, 1]
 //! in the sampling pass.
 
-use super::arrays::{Check, Indices, Points, map, map2, table, with_precision};
+use super::arrays::{Check, Indices, Points, Table, map, map2, with_precision};
 use super::parallel::detached;
 use crate::distr;
 use numpy::PyArray1;
@@ -37,8 +37,9 @@ pub struct PyDiscrete1D(distr::Discrete1D);
 impl PyDiscrete1D {
     #[new]
     fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let (w, _) = table(weights, "weights", 1)?;
-        Ok(Self(detached(py, || distr::Discrete1D::new(&w))?))
+        let w = Table::extract(weights, "weights", 1)?;
+        let w = w.values();
+        Ok(Self(detached(py, || distr::Discrete1D::new(w))?))
     }
 
     /// Indices drawn from the distribution.
@@ -137,8 +138,9 @@ pub struct PyAliasTable(distr::AliasTable);
 impl PyAliasTable {
     #[new]
     fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let (w, _) = table(weights, "weights", 1)?;
-        Ok(Self(detached(py, || distr::AliasTable::new(&w))?))
+        let w = Table::extract(weights, "weights", 1)?;
+        let w = w.values();
+        Ok(Self(detached(py, || distr::AliasTable::new(w))?))
     }
 
     /// Indices drawn from the distribution.
@@ -187,11 +189,6 @@ impl PyAliasTable {
     }
 }
 
-/// Reads a 2D table argument: (values, rows, cols).
-fn table_2d(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<(Vec<f64>, usize, usize)> {
-    let (values, shape) = table(ob, arg, 2)?;
-    Ok((values, shape[0], shape[1]))
-}
 
 /// A discrete distribution over the cells (row, col) of a table,
 /// proportional to ``weights``: a row from the marginal (row sums) by
@@ -210,10 +207,9 @@ pub struct PyDiscrete2D(distr::Discrete2D);
 impl PyDiscrete2D {
     #[new]
     fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let (w, rows, cols) = table_2d(weights, "weights")?;
-        Ok(Self(detached(py, || {
-            distr::Discrete2D::new(&w, rows, cols)
-        })?))
+        let t = Table::extract(weights, "weights", 2)?;
+        let (w, rows, cols) = (t.values(), t.shape[0], t.shape[1]);
+        Ok(Self(detached(py, || distr::Discrete2D::new(w, rows, cols))?))
     }
 
     /// Cells drawn from the distribution.
@@ -319,10 +315,9 @@ impl PyPiecewiseConstant1D {
     #[new]
     #[pyo3(signature = (values, a = 0.0, b = 1.0))]
     fn new(py: Python<'_>, values: &Bound<'_, PyAny>, a: f64, b: f64) -> PyResult<Self> {
-        let (v, _) = table(values, "values", 1)?;
-        Ok(Self(detached(py, || {
-            distr::PiecewiseConstant1D::new(&v, a, b)
-        })?))
+        let t = Table::extract(values, "values", 1)?;
+        let v = t.values();
+        Ok(Self(detached(py, || distr::PiecewiseConstant1D::new(v, a, b))?))
     }
 
     /// Points drawn from the density, and their densities.
@@ -441,10 +436,11 @@ impl PyPiecewiseConstant2D {
         values: &Bound<'_, PyAny>,
         domain: ((f64, f64), (f64, f64)),
     ) -> PyResult<Self> {
-        let (v, rows, cols) = table_2d(values, "values")?;
+        let t = Table::extract(values, "values", 2)?;
+        let (v, rows, cols) = (t.values(), t.shape[0], t.shape[1]);
         let d = [[domain.0.0, domain.0.1], [domain.1.0, domain.1.1]];
         Ok(Self(detached(py, || {
-            distr::PiecewiseConstant2D::new(&v, rows, cols, d)
+            distr::PiecewiseConstant2D::new(v, rows, cols, d)
         })?))
     }
 

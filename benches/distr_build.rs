@@ -1,0 +1,61 @@
+//! Build and sampling times of the discrete tables from 10^6 weights, in
+//! the pure-Rust core (no Python conversion): `cargo bench --bench distr_build`.
+
+use mcsample::distr::{AliasTable, Discrete1D};
+use std::hint::black_box;
+use std::time::Instant;
+
+fn median_ms(mut f: impl FnMut()) -> f64 {
+    f();
+    let mut times: Vec<f64> = (0..9)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
+}
+
+fn main() {
+    let n = 1_000_000;
+    // Uniform random weights (a SplitMix64 hash of the index).
+    let weights: Vec<f64> = (0..n as u64)
+        .map(|i| {
+            let mut z = i.wrapping_add(1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            (z >> 11) as f64 / (1u64 << 53) as f64
+        })
+        .collect();
+    let d = median_ms(|| {
+        black_box(Discrete1D::new(black_box(&weights)).ok());
+    });
+    let a = median_ms(|| {
+        black_box(AliasTable::new(black_box(&weights)).ok());
+    });
+    println!("build from 10^6 weights: Discrete1D {d:.2} ms, AliasTable {a:.2} ms");
+    for _ in 0..3 {
+        phases(&weights);
+    }
+}
+
+#[allow(dead_code)]
+fn phases(weights: &[f64]) {
+    let t = Instant::now();
+    let w = weights.to_vec();
+    let a = t.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    let mut cdf = Vec::with_capacity(w.len());
+    let mut acc = 0.0;
+    for &x in &w {
+        acc += x;
+        cdf.push(acc);
+    }
+    let b = t.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    let ok = w.iter().fold(true, |ok, &x| ok & (x >= 0.0 && x.is_finite()));
+    let c = t.elapsed().as_secs_f64() * 1e3;
+    println!("copy {a:.2} cdf {b:.2} check {c:.2} {ok} {}", black_box(cdf.len()));
+}
