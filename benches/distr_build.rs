@@ -55,7 +55,12 @@ fn phases(weights: &[f64]) {
     }
     let b = t.elapsed().as_secs_f64() * 1e3;
     let t = Instant::now();
-    let ok = w.iter().fold(true, |ok, &x| ok & (x >= 0.0 && x.is_finite()));
+    let ok = w
+        .iter()
+        .fold(true, |ok, &x| ok & (x >= 0.0 && x.is_finite()));
     let c = t.elapsed().as_secs_f64() * 1e3;
-    println!("copy {a:.2} cdf {b:.2} check {c:.2} {ok} {}", black_box(cdf.len()));
+    println!(
+        "copy {a:.2} cdf {b:.2} check {c:.2} {ok} {}",
+        black_box(cdf.len())
+    );
 }

@@ -12,6 +12,7 @@
 //!   piecewise-constant densities.
 //! - [`frame`]: orthonormal frames around a normal.
 //! - [`io`]: EXR, Radiance HDR and PNG files.
+//! - [`simd`]: runtime dispatch of batch loops to AVX2 + FMA.
 //! - [`math`]: the [`math::Real`] scalar trait (`f32` / `f64`) and helpers.
 //! - [`error`]: the one error type.
 //!
@@ -22,7 +23,7 @@
 //! - Uniform input `u` lies in `[0, 1]`; `u = 1` maps inside the domain.
 //! - Kernels are infallible and total; inputs are validated at the batch
 //!   boundary. Results are independent of the thread count.
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 #![deny(missing_docs)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
@@ -33,6 +34,7 @@ pub mod io;
 pub mod math;
 pub mod parallel;
 pub mod rng;
+pub mod simd;
 pub mod warp;
 
 #[cfg(feature = "python")]

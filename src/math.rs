@@ -22,10 +22,50 @@ pub trait Real: Float + FloatConst + Debug + Default + Send + Sync + 'static {
     /// the top 23 bits (`next_float32`), `f64` all 32 (`next_float64`), by
     /// filling the mantissa of a number in `[1, 2)` and subtracting 1.
     fn from_random_bits(bits: u32) -> Self;
+
+    /// `(sin x, cos x)` for `|x| ≤ π/4` by Taylor polynomials long enough
+    /// for this type's precision (to x⁹/x⁸ in `f32`, x¹⁷/x¹⁶ in `f64`):
+    /// branch-free and without library calls, so loops over it vectorise.
+    fn sin_cos_octant(x: Self) -> (Self, Self);
 }
+
+/// Horner evaluation of `c[0] + c[1] y + c[2] y² + …`.
+#[inline(always)]
+fn horner<F: Real>(y: F, c: &[f64]) -> F {
+    c.iter().rev().fold(F::zero(), |acc, &k| acc * y + F::c(k))
+}
+
+/// Taylor coefficients of `sin x / x` and `cos x` in powers of `x²`.
+const SIN_OVER_X: [f64; 9] = [
+    1.0,
+    -1.0 / 6.0,
+    1.0 / 120.0,
+    -1.0 / 5040.0,
+    1.0 / 362_880.0,
+    -1.0 / 39_916_800.0,
+    1.0 / 6_227_020_800.0,
+    -1.0 / 1_307_674_368_000.0,
+    1.0 / 355_687_428_096_000.0,
+];
+const COS: [f64; 9] = [
+    1.0,
+    -1.0 / 2.0,
+    1.0 / 24.0,
+    -1.0 / 720.0,
+    1.0 / 40_320.0,
+    -1.0 / 3_628_800.0,
+    1.0 / 479_001_600.0,
+    -1.0 / 87_178_291_200.0,
+    1.0 / 20_922_789_888_000.0,
+];
 
 impl Real for f32 {
     const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+    #[inline(always)]
+    fn sin_cos_octant(x: f32) -> (f32, f32) {
+        let y = x * x;
+        (x * horner(y, &SIN_OVER_X[..5]), horner(y, &COS[..5]))
+    }
     #[inline(always)]
     fn c(x: f64) -> f32 {
         x as f32
@@ -42,6 +82,11 @@ impl Real for f32 {
 
 impl Real for f64 {
     const ONE_MINUS_EPSILON: f64 = 1.0 - f64::EPSILON / 2.0;
+    #[inline(always)]
+    fn sin_cos_octant(x: f64) -> (f64, f64) {
+        let y = x * x;
+        (x * horner(y, &SIN_OVER_X), horner(y, &COS))
+    }
     #[inline(always)]
     fn c(x: f64) -> f64 {
         x
@@ -61,6 +106,28 @@ impl Real for f64 {
 #[inline(always)]
 pub fn safe_sqrt<F: Real>(x: F) -> F {
     x.max(F::zero()).sqrt()
+}
+
+/// `(sin 2πt, cos 2πt)` for `t` in `[0, 1]` (a fraction of a turn):
+/// reduced exactly to the nearest quarter turn `k` (`4t − k` is exact), then
+/// [`Real::sin_cos_octant`] and a branch-free swap and sign change per
+/// quadrant.
+#[inline(always)]
+pub fn sin_cos_turn<F: Real>(t: F) -> (F, F) {
+    let four = F::c(4.0);
+    let q = (four * t + F::c(0.5)).floor();
+    let (s, c) = F::sin_cos_octant((four * t - q) * F::FRAC_PI_2());
+    // Quadrant q mod 4: 0 → (s, c), 1 → (c, −s), 2 → (−s, −c), 3 → (−c, s).
+    let q = q - four * (q / four).floor();
+    let odd = q == F::one() || q == F::c(3.0);
+    let (s, c) = if odd { (c, s) } else { (s, c) };
+    let s = if q >= F::c(2.0) { -s } else { s };
+    let c = if q == F::one() || q == F::c(2.0) {
+        -c
+    } else {
+        c
+    };
+    (s, c)
 }
 
 /// Whether `x` lies in the closed unit interval (false for NaN).
@@ -83,6 +150,22 @@ mod tests {
     fn one_minus_epsilon_is_the_float_below_one() {
         assert_eq!(f32::ONE_MINUS_EPSILON.to_bits() + 1, 1.0f32.to_bits());
         assert_eq!(f64::ONE_MINUS_EPSILON.to_bits() + 1, 1.0f64.to_bits());
+    }
+
+    #[test]
+    fn sin_cos_match_the_library() {
+        for k in 0..=100_000 {
+            let t = k as f64 / 100_000.0;
+            let (s, c) = sin_cos_turn(t);
+            let (rs, rc) = (std::f64::consts::TAU * t).sin_cos();
+            assert!((s - rs).abs() < 1e-15 && (c - rc).abs() < 1e-15, "t = {t}");
+            let (s, c) = sin_cos_turn(t as f32);
+            let (rs, rc) = (std::f64::consts::TAU * (t as f32) as f64).sin_cos();
+            assert!(
+                (s as f64 - rs).abs() < 2e-7 && (c as f64 - rc).abs() < 2e-7,
+                "t = {t}"
+            );
+        }
     }
 
     #[test]

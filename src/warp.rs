@@ -8,7 +8,7 @@
 //! `u = 1` maps inside the domain, and inverses of degenerate points (the
 //! origin, a pole) return a valid point of the square.
 
-use crate::math::{Real, safe_sqrt};
+use crate::math::{Real, safe_sqrt, sin_cos_turn};
 
 /// A point of the unit square or a planar domain.
 pub type P2<F> = [F; 2];
@@ -51,7 +51,7 @@ fn slack<F: Real>() -> F {
 #[inline(always)]
 pub fn square_to_uniform_disk<F: Real>(u: P2<F>) -> P2<F> {
     let r = u[1].sqrt();
-    let (s, c) = (two_pi::<F>() * u[0]).sin_cos();
+    let (s, c) = sin_cos_turn(u[0]);
     [c * r, s * r]
 }
 
@@ -95,16 +95,18 @@ pub fn uniform_disk_to_square<F: Real>(p: P2<F>) -> P2<F> {
 pub fn square_to_uniform_disk_concentric<F: Real>(u: P2<F>) -> P2<F> {
     let two = F::c(2.0);
     let (a, b) = (two * u[0] - F::one(), two * u[1] - F::one());
-    let quarter_pi = F::FRAC_PI_4();
-    let (r, phi) = if a == F::zero() && b == F::zero() {
-        (F::zero(), F::zero())
-    } else if a.abs() >= b.abs() {
-        (a, quarter_pi * (b / a))
+    // Branch-free: the dominant coordinate is the radius, the ratio of the
+    // other to it the angle within the octant (φ measured from the nearer
+    // axis, so the vertical case swaps sine and cosine).
+    let horizontal = a.abs() >= b.abs();
+    let (r, other) = if horizontal { (a, b) } else { (b, a) };
+    let ratio = if r == F::zero() { F::zero() } else { other / r };
+    let (s, c) = F::sin_cos_octant(F::FRAC_PI_4() * ratio);
+    if horizontal {
+        [r * c, r * s]
     } else {
-        (b, F::FRAC_PI_2() - quarter_pi * (a / b))
-    };
-    let (s, c) = phi.sin_cos();
-    [r * c, r * s]
+        [r * s, r * c]
+    }
 }
 
 /// Density of [`square_to_uniform_disk_concentric`]: `1/π` on the unit disk.
@@ -159,7 +161,7 @@ fn clamp01<F: Real>(x: F) -> F {
 pub fn square_to_uniform_sphere<F: Real>(u: P2<F>) -> V3<F> {
     let z = F::one() - F::c(2.0) * u[1];
     let r = safe_sqrt(F::one() - z * z);
-    let (s, c) = (two_pi::<F>() * u[0]).sin_cos();
+    let (s, c) = sin_cos_turn(u[0]);
     [r * c, r * s, z]
 }
 
@@ -226,8 +228,8 @@ pub fn uniform_hemisphere_to_square<F: Real>(d: V3<F>) -> P2<F> {
 #[inline(always)]
 pub fn square_to_cosine_hemisphere<F: Real>(u: P2<F>) -> V3<F> {
     let p = square_to_uniform_disk_concentric(u);
-    let z = safe_sqrt(F::one() - p[0] * p[0] - p[1] * p[1]);
-    [p[0], p[1], z]
+    let r2 = p[0] * p[0] + p[1] * p[1];
+    [p[0], p[1], safe_sqrt(F::one() - r2)]
 }
 
 /// Density of the cosine-weighted hemisphere warps: `max(cos θ, 0)/π`.
@@ -251,7 +253,7 @@ pub fn cosine_hemisphere_to_square<F: Real>(d: V3<F>) -> P2<F> {
 #[inline(always)]
 pub fn square_to_cosine_hemisphere_polar<F: Real>(u: P2<F>) -> V3<F> {
     let r = safe_sqrt(F::one() - u[1]);
-    let (s, c) = (two_pi::<F>() * u[0]).sin_cos();
+    let (s, c) = sin_cos_turn(u[0]);
     [c * r, s * r, u[1].sqrt()]
 }
 
@@ -274,7 +276,7 @@ pub fn cosine_hemisphere_to_square_polar<F: Real>(d: V3<F>) -> P2<F> {
 pub fn square_to_cosine_power_hemisphere<F: Real>(u: P2<F>, exponent: F) -> V3<F> {
     let cos_theta = u[1].powf(F::one() / (exponent + F::one()));
     let sin_theta = safe_sqrt(F::one() - cos_theta * cos_theta);
-    let (s, c) = (two_pi::<F>() * u[0]).sin_cos();
+    let (s, c) = sin_cos_turn(u[0]);
     [c * sin_theta, s * sin_theta, cos_theta]
 }
 

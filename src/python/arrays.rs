@@ -257,18 +257,46 @@ where
         let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
         let in_rows = x.rows();
         let valid = run_batch(py, x.n, out_rows, |range, chunk: &mut [[T; M]]| {
-            let mut ok = true;
-            for (o, u) in chunk.iter_mut().zip(&in_rows[range]) {
-                ok &= check.holds_all(u);
-                *o = kernel(*u);
+            let inputs = &in_rows[range];
+            // One loop per check, so that the loop body has no dispatch left.
+            match check {
+                Check::Unit => map_chunk(chunk, inputs, &kernel, |u| {
+                    u.iter()
+                        .fold(true, |ok, &v| ok & (v >= F::zero()) & (v <= F::one()))
+                }),
+                Check::Finite => map_chunk(chunk, inputs, &kernel, |u| {
+                    u.iter().fold(true, |ok, &v| ok & v.is_finite())
+                }),
+                Check::Within(_) => map_chunk(chunk, inputs, &kernel, |u| check.holds_all(u)),
             }
-            ok
         })?;
         if !valid {
             return Err(x.invalid(check));
         }
     }
     finish(out)
+}
+
+/// `out[i] = kernel(inputs[i])` compiled for the widest vector unit, and
+/// whether `valid` holds for every input.
+#[inline(always)]
+fn map_chunk<F: Copy, T, const K: usize, const M: usize>(
+    out: &mut [[T; M]],
+    inputs: &[[F; K]],
+    kernel: &impl Fn([F; K]) -> [T; M],
+    valid: impl Fn(&[F; K]) -> bool,
+) -> bool {
+    crate::simd::dispatch(
+        #[inline(always)]
+        || {
+            let mut ok = true;
+            for (o, u) in out.iter_mut().zip(inputs) {
+                ok &= valid(u);
+                *o = kernel(*u);
+            }
+            ok
+        },
+    )
 }
 
 /// As [`map`] for kernels with two results (`M` and `L` values per point),
@@ -427,13 +455,21 @@ impl<'py> Table<'py> {
         if shape.len() != ndim {
             return Err(Error::Shape {
                 arg,
-                expected: if ndim == 1 { "(N,)".into() } else { "(rows, cols)".into() },
+                expected: if ndim == 1 {
+                    "(N,)".into()
+                } else {
+                    "(rows, cols)".into()
+                },
                 got: shape_str(&shape),
             }
             .into());
         }
         let owned = (!array.is_c_contiguous()).then(|| array.as_array().iter().copied().collect());
-        Ok(Table { array, owned, shape })
+        Ok(Table {
+            array,
+            owned,
+            shape,
+        })
     }
 
     /// The values in row-major order.

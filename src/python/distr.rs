@@ -189,7 +189,6 @@ impl PyAliasTable {
     }
 }
 
-
 /// A discrete distribution over the cells (row, col) of a table,
 /// proportional to ``weights``: a row from the marginal (row sums) by
 /// u[:, 1], then a column from that row's conditional by u[:, 0] — the
@@ -209,7 +208,9 @@ impl PyDiscrete2D {
     fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
         let t = Table::extract(weights, "weights", 2)?;
         let (w, rows, cols) = (t.values(), t.shape[0], t.shape[1]);
-        Ok(Self(detached(py, || distr::Discrete2D::new(w, rows, cols))?))
+        Ok(Self(detached(py, || {
+            distr::Discrete2D::new(w, rows, cols)
+        })?))
     }
 
     /// Cells drawn from the distribution.
@@ -317,7 +318,9 @@ impl PyPiecewiseConstant1D {
     fn new(py: Python<'_>, values: &Bound<'_, PyAny>, a: f64, b: f64) -> PyResult<Self> {
         let t = Table::extract(values, "values", 1)?;
         let v = t.values();
-        Ok(Self(detached(py, || distr::PiecewiseConstant1D::new(v, a, b))?))
+        Ok(Self(detached(py, || {
+            distr::PiecewiseConstant1D::new(v, a, b)
+        })?))
     }
 
     /// Points drawn from the density, and their densities.

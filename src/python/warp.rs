@@ -223,31 +223,37 @@ batch_fn! {
     /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
     fn uniform_hemisphere_to_square(x: [3; Finite]) = |F| warp::uniform_hemisphere_to_square::<F>
 }
-batch_fn! {
-    /// Cosine-weighted directions on the +z hemisphere (Malley's method).
-    ///
-    /// Parameters
-    /// ----------
-    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
-    /// method : "concentric" (default; lifts a concentric disk point, as
-    ///     ``mi.warp`` does) or "polar" (x = cos(2 pi u0) sqrt(1 - u1),
-    ///     y = sin(2 pi u0) sqrt(1 - u1), z = sqrt(u1))
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 3) or (3,), unit vectors; density cos(theta)/pi
-    /// per sr.
-    #[pyo3(signature = (u, method = "concentric"))]
-    fn square_to_cosine_hemisphere(u: [2; Unit], method: &str) = |F| {
-        let polar = polar_arg(method)?;
-        move |u: [F; 2]| {
-            if polar {
-                warp::square_to_cosine_hemisphere_polar(u)
-            } else {
-                warp::square_to_cosine_hemisphere(u)
-            }
+/// Cosine-weighted directions on the +z hemisphere (Malley's method).
+///
+/// Parameters
+/// ----------
+/// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+/// method : "concentric" (default; lifts a concentric disk point, as
+///     ``mi.warp`` does) or "polar" (x = cos(2 pi u0) sqrt(1 - u1),
+///     y = sin(2 pi u0) sqrt(1 - u1), z = sqrt(u1))
+///
+/// Returns
+/// -------
+/// ndarray, shape (N, 3) or (3,), unit vectors; density cos(theta)/pi
+/// per sr.
+#[pyfunction]
+#[pyo3(signature = (u, method = "concentric"))]
+pub fn square_to_cosine_hemisphere<'py>(
+    py: Python<'py>,
+    u: &Bound<'py, PyAny>,
+    method: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    // The method is chosen outside the batch loop, which must stay
+    // branch-free to vectorise.
+    let polar = polar_arg(method)?;
+    with_precision!(u, F => {
+        let points = Points::<F, 2>::extract(u, "u")?;
+        if polar {
+            map(py, &points, Check::Unit, warp::square_to_cosine_hemisphere_polar::<F>)
+        } else {
+            map(py, &points, Check::Unit, warp::square_to_cosine_hemisphere::<F>)
         }
-    }
+    })
 }
 batch_fn! {
     /// Density of ``square_to_cosine_hemisphere`` (either method):
