@@ -95,27 +95,51 @@ def suite_rng(n: int, repeat: int, mi) -> list[Timing]:
     return out
 
 
+def _numpy_uniform_disk(u: np.ndarray) -> np.ndarray:
+    r, phi = np.sqrt(u[:, 1]), 2 * np.pi * u[:, 0]
+    return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)
+
+
+def _numpy_uniform_triangle(u: np.ndarray) -> np.ndarray:
+    t = np.sqrt(1 - u[:, 0])
+    return np.stack([1 - t, t * u[:, 1]], axis=1)
+
+
 def suite_warps(n: int, repeat: int, mi) -> list[Timing]:
+    """Every forward warp, float64 and float32, beside numpy (where a
+    numpy version is written here) and Mitsuba 3 llvm (float32)."""
     u64 = mcs.uniform(n, 2, seed=1)
     u32 = u64.astype(np.float32)
+    w = mcs.warp
     cases = [
-        ("square_to_cosine_hemisphere", mcs.warp.square_to_cosine_hemisphere,
-         _numpy_cosine_hemisphere),
-        ("square_to_uniform_sphere", mcs.warp.square_to_uniform_sphere, _numpy_uniform_sphere),
+        ("square_to_uniform_disk", w.square_to_uniform_disk, _numpy_uniform_disk, ()),
+        ("square_to_uniform_disk_concentric", w.square_to_uniform_disk_concentric, None, ()),
+        ("square_to_uniform_sphere", w.square_to_uniform_sphere, _numpy_uniform_sphere, ()),
+        ("square_to_uniform_hemisphere", w.square_to_uniform_hemisphere, None, ()),
+        ("square_to_cosine_hemisphere", w.square_to_cosine_hemisphere,
+         _numpy_cosine_hemisphere, ()),
+        ("square_to_uniform_cone", w.square_to_uniform_cone, None, (0.3,)),
+        ("square_to_uniform_triangle", w.square_to_uniform_triangle,
+         _numpy_uniform_triangle, ()),
+        ("square_to_cosine_power_hemisphere", w.square_to_cosine_power_hemisphere, None,
+         (10.0,)),
     ]
     out = []
-    for name, ours, numpy_impl in cases:
+    for name, ours, numpy_impl, args in cases:
         for dtype, u in (("float64", u64), ("float32", u32)):
-            out.append(Timing(name, "mcsample", dtype, n, measure(lambda: ours(u), repeat)))
-            out.append(Timing(name, "numpy", dtype, n, measure(lambda: numpy_impl(u), repeat)))
-        if mi is not None:
+            out.append(Timing(name, "mcsample", dtype, n,
+                              measure(lambda: ours(u, *args), repeat)))
+            if numpy_impl is not None:
+                out.append(Timing(name, "numpy", dtype, n,
+                                  measure(lambda: numpy_impl(u), repeat)))
+        fn = getattr(mi.warp, name, None) if mi is not None else None
+        if fn is not None and not name.endswith("power_hemisphere"):
             import drjit as dr
 
             p = mi.Point2f(u32[:, 0], u32[:, 1])
-            fn = getattr(mi.warp, name)
 
             def run():
-                d = fn(p)
+                d = fn(p, *args)
                 dr.eval(d)
                 dr.sync_thread()
 
@@ -123,9 +147,64 @@ def suite_warps(n: int, repeat: int, mi) -> list[Timing]:
     return out
 
 
+def suite_distr(n: int, repeat: int, mi) -> list[Timing]:
+    """Discrete tables of 10^6 weights: building (reported per entry) and
+    sampling n indices, beside numpy, scipy and Mitsuba 3 llvm."""
+    size = 1_000_000
+    weights = np.random.default_rng(0).random(size)
+    u = mcs.uniform(n, 1, seed=2)[:, 0]
+    out = [
+        Timing("build 10^6 (entries/s)", "mcsample Discrete1D", "float64", size,
+               measure(lambda: mcs.Discrete1D(weights), repeat)),
+        Timing("build 10^6 (entries/s)", "mcsample AliasTable", "float64", size,
+               measure(lambda: mcs.AliasTable(weights), repeat)),
+    ]
+    d, a = mcs.Discrete1D(weights), mcs.AliasTable(weights)
+    out.append(Timing("sample 10^6 table", "mcsample Discrete1D", "float64", n,
+                      measure(lambda: d.sample(u), repeat)))
+    out.append(Timing("sample 10^6 table", "mcsample AliasTable", "float64", n,
+                      measure(lambda: a.sample(u), repeat)))
+    cdf = np.cumsum(weights)
+    out.append(Timing("sample 10^6 table", "numpy searchsorted", "float64", n,
+                      measure(lambda: np.searchsorted(cdf, u * cdf[-1]), repeat)))
+    try:
+        import warnings
+
+        from scipy.stats.sampling import DiscreteAliasUrn
+
+        # UNU.RAN warns about round-off for 10^6 entries; it still samples.
+        warnings.filterwarnings("ignore", category=RuntimeWarning, module="mcsample.bench")
+
+        out.append(Timing("build 10^6 (entries/s)", "scipy DiscreteAliasUrn", "float64", size,
+                          measure(lambda: DiscreteAliasUrn(weights, random_state=1), 3, 1)))
+        urn = DiscreteAliasUrn(weights, random_state=1)
+        out.append(Timing("sample 10^6 table", "scipy DiscreteAliasUrn", "float64", n,
+                          measure(lambda: urn.rvs(n), repeat)))
+    except ImportError:
+        pass
+    if mi is not None:
+        import drjit as dr
+
+        w32 = weights.astype(np.float32)
+        out.append(Timing("build 10^6 (entries/s)", "Mitsuba 3 llvm", "float32", size,
+                          measure(lambda: mi.DiscreteDistribution(w32), repeat)))
+        dist = mi.DiscreteDistribution(w32)
+        uf = mi.Float(u.astype(np.float32))
+
+        def run():
+            i = dist.sample(uf)
+            dr.eval(i)
+            dr.sync_thread()
+
+        out.append(Timing("sample 10^6 table", "Mitsuba 3 llvm", "float32", n,
+                          measure(run, repeat)))
+    return out
+
+
 SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
     "rng": suite_rng,
     "warps": suite_warps,
+    "distr": suite_distr,
 }
 
 
