@@ -41,7 +41,7 @@ fn main() {
     }
 }
 
-#[allow(dead_code)]
+/// Times of the build phases (copy, running sums, checks) on fresh memory.
 fn phases(weights: &[f64]) {
     let t = Instant::now();
     let w = weights.to_vec();
