@@ -8,6 +8,7 @@
 //! - [`rng`]: PCG32 with jump-ahead, uniform batches.
 //! - [`parallel`]: the batch engine (chunks on a rayon pool, thread count).
 //! - [`warp`]: `square_to_*` warps, their densities and inverses.
+//! - [`buffer`]: large flat arrays on huge pages.
 //! - [`distr`]: discrete tables (CDF inversion, alias), 2D tables and
 //!   piecewise-constant densities.
 //! - [`frame`]: orthonormal frames around a normal.
@@ -27,6 +28,7 @@
 #![deny(missing_docs)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
+pub mod buffer;
 pub mod distr;
 pub mod error;
 pub mod frame;

@@ -27,12 +27,43 @@ pub trait Real: Float + FloatConst + Debug + Default + Send + Sync + 'static {
     /// for this type's precision (to x⁹/x⁸ in `f32`, x¹⁷/x¹⁶ in `f64`):
     /// branch-free and without library calls, so loops over it vectorise.
     fn sin_cos_octant(x: Self) -> (Self, Self);
+
+    /// `(sin, cos)` of `θ + q·π/2` from `(s, c) = (sin θ, cos θ)`, for a
+    /// whole number `q` in `[0, 4]`: a swap and sign flips on the bits,
+    /// without branches.
+    fn quarter_turns(q: Self, s: Self, c: Self) -> (Self, Self);
 }
 
-/// Horner evaluation of `c[0] + c[1] y + c[2] y² + …`.
+/// Horner evaluation of `c[0] + c[1] y + c[2] y² + …`, one fused
+/// multiply-add a step (exactly rounded, so the same bits with or without
+/// FMA hardware).
 #[inline(always)]
 fn horner<F: Real>(y: F, c: &[f64]) -> F {
-    c.iter().rev().fold(F::zero(), |acc, &k| acc * y + F::c(k))
+    c.iter()
+        .rev()
+        .fold(F::zero(), |acc, &k| acc.mul_add(y, F::c(k)))
+}
+
+/// [`Real::quarter_turns`] for one float type and its same-width unsigned
+/// integer. Adding 2^(mantissa bits) puts the whole number `q` in the low
+/// bits of the mantissa (no float-to-int conversion).
+macro_rules! quarter_turns {
+    ($F:ty, $U:ty) => {
+        #[inline(always)]
+        fn quarter_turns(q: $F, s: $F, c: $F) -> ($F, $F) {
+            let k = (q + (1u64 << (<$F>::MANTISSA_DIGITS - 1)) as $F).to_bits();
+            let swap = k & 1 != 0;
+            let (s, c) = (if swap { c } else { s }, if swap { s } else { c });
+            // Sine negative in quadrants 2 and 3, cosine in 1 and 2.
+            let shift = <$U>::BITS - 2;
+            let s_sign = (k & 2) << shift;
+            let c_sign = (k.wrapping_add(1) & 2) << shift;
+            (
+                <$F>::from_bits(s.to_bits() ^ s_sign),
+                <$F>::from_bits(c.to_bits() ^ c_sign),
+            )
+        }
+    };
 }
 
 /// Taylor coefficients of `sin x / x` and `cos x` in powers of `x²`.
@@ -66,6 +97,7 @@ impl Real for f32 {
         let y = x * x;
         (x * horner(y, &SIN_OVER_X[..5]), horner(y, &COS[..5]))
     }
+    quarter_turns!(f32, u32);
     #[inline(always)]
     fn c(x: f64) -> f32 {
         x as f32
@@ -87,6 +119,7 @@ impl Real for f64 {
         let y = x * x;
         (x * horner(y, &SIN_OVER_X), horner(y, &COS))
     }
+    quarter_turns!(f64, u64);
     #[inline(always)]
     fn c(x: f64) -> f64 {
         x
@@ -110,24 +143,13 @@ pub fn safe_sqrt<F: Real>(x: F) -> F {
 
 /// `(sin 2πt, cos 2πt)` for `t` in `[0, 1]` (a fraction of a turn):
 /// reduced exactly to the nearest quarter turn `k` (`4t − k` is exact), then
-/// [`Real::sin_cos_octant`] and a branch-free swap and sign change per
-/// quadrant.
+/// [`Real::sin_cos_octant`] and [`Real::quarter_turns`].
 #[inline(always)]
 pub fn sin_cos_turn<F: Real>(t: F) -> (F, F) {
     let four = F::c(4.0);
     let q = (four * t + F::c(0.5)).floor();
     let (s, c) = F::sin_cos_octant((four * t - q) * F::FRAC_PI_2());
-    // Quadrant q mod 4: 0 → (s, c), 1 → (c, −s), 2 → (−s, −c), 3 → (−c, s).
-    let q = q - four * (q / four).floor();
-    let odd = q == F::one() || q == F::c(3.0);
-    let (s, c) = if odd { (c, s) } else { (s, c) };
-    let s = if q >= F::c(2.0) { -s } else { s };
-    let c = if q == F::one() || q == F::c(2.0) {
-        -c
-    } else {
-        c
-    };
-    (s, c)
+    F::quarter_turns(q, s, c)
 }
 
 /// Whether `x` lies in the closed unit interval (false for NaN).

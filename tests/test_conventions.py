@@ -151,3 +151,39 @@ def test_pool_survives_fork():
 
 def test_version():
     assert mcs.__version__.count(".") == 2
+
+
+def test_out_receives_the_result_as_numpy_ufuncs_do():
+    u = mcs.uniform(1000, 2, seed=5)
+    out = np.empty((1000, 3))
+    got = warp.square_to_uniform_sphere(u, out=out)
+    assert got is out
+    assert np.array_equal(out, warp.square_to_uniform_sphere(u))
+    out32 = np.empty((1000, 3), np.float32)
+    warp.square_to_cosine_hemisphere(u.astype(np.float32), "polar", out=out32)
+    assert np.array_equal(out32, warp.square_to_cosine_hemisphere(u.astype(np.float32), "polar"))
+    pdf = np.empty(1000)
+    assert warp.square_to_uniform_sphere_pdf(out, out=pdf) is pdf
+
+
+@pytest.mark.parametrize("out,exc,fragment", [
+    (np.empty((1000, 3), np.float32), TypeError, "dtype float64"),
+    (np.empty((999, 3)), ValueError, "out must have shape a writeable C-ordered array of shape (1000, 3)"),
+    (np.empty((3, 1000)).T, ValueError, "C-ordered"),
+    ([[0.0] * 3] * 1000, TypeError, "out must be a numpy array"),
+])
+def test_bad_out_is_refused(out, exc, fragment):
+    u = mcs.uniform(1000, 2, seed=5)
+    with pytest.raises(exc) as info:
+        warp.square_to_uniform_sphere(u, out=out)
+    assert fragment in str(info.value)
+
+
+def test_out_must_not_be_an_input():
+    u = mcs.uniform(1000, 2, seed=5)
+    with pytest.raises(ValueError, match="share memory"):
+        warp.square_to_uniform_disk(u, out=u)
+    frozen = np.empty((1000, 2))
+    frozen.flags.writeable = False
+    with pytest.raises(ValueError, match="writeable"):
+        warp.square_to_uniform_disk(u, out=frozen)

@@ -1,6 +1,7 @@
 //! [`AliasTable`]: O(1) sampling of a discrete distribution (Vose's method).
 
 use super::check_weights;
+use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
 
@@ -25,9 +26,9 @@ use crate::math::Real;
 pub struct AliasTable {
     /// Cell `c` keeps its own index when the fractional part of `u·n` is
     /// below `threshold[c]`, else returns `alias[c]`.
-    threshold: Vec<f64>,
-    alias: Vec<u32>,
-    pmf: Vec<f64>,
+    threshold: Buffer<f64>,
+    alias: Buffer<u32>,
+    pmf: Buffer<f64>,
     sum: f64,
 }
 
@@ -43,24 +44,30 @@ impl AliasTable {
             return Err(Error::AllZero { arg: "weights" });
         }
         let n = weights.len();
-        let pmf: Vec<f64> = weights.iter().map(|&w| w / sum).collect();
+        let mut pmf = Buffer::zeroed(n);
+        for (p, &w) in pmf.iter_mut().zip(weights) {
+            *p = w / sum;
+        }
 
         // Vose: cells below their 1/n share ("small") are topped up by cells
         // above it ("large"). One index array holds both stacks: smalls grow
         // from the front, larges from the back. A small cell's scaled mass
         // is final once it is popped, so `scaled` becomes the thresholds.
-        let mut scaled: Vec<f64> = pmf.iter().map(|&p| p * n as f64).collect();
-        let mut alias: Vec<u32> = (0..n as u32).collect();
-        let mut stack = vec![0u32; n];
+        let mut scaled = Buffer::zeroed(n);
+        for (s, &p) in scaled.iter_mut().zip(pmf.iter()) {
+            *s = p * n as f64;
+        }
+        let mut alias = Buffer::zeroed(n);
+        let mut stack = Buffer::<u32>::zeroed(n);
         let (mut n_small, mut n_large) = (0usize, 0usize);
+        // Branch-free (the weights' order is random to the branch
+        // predictor): write to both free slots, keep the one that counts.
         for (i, &s) in scaled.iter().enumerate() {
-            if s < 1.0 {
-                stack[n_small] = i as u32;
-                n_small += 1;
-            } else {
-                n_large += 1;
-                stack[n - n_large] = i as u32;
-            }
+            let small = (s < 1.0) as usize;
+            stack[n_small] = i as u32;
+            stack[n - 1 - n_large] = i as u32;
+            n_small += small;
+            n_large += 1 - small;
         }
         while n_small > 0 && n_large > 0 {
             n_small -= 1;
@@ -68,12 +75,12 @@ impl AliasTable {
             let large = stack[n - n_large] as usize;
             alias[small] = large as u32;
             scaled[large] = (scaled[large] + scaled[small]) - 1.0;
-            if scaled[large] < 1.0 {
-                // The donor became small: move it from the large stack.
-                n_large -= 1;
-                stack[n_small] = large as u32;
-                n_small += 1;
-            }
+            // A donor that became small moves to the small stack (into
+            // the slot just freed), branch-free as above.
+            let moved = (scaled[large] < 1.0) as usize;
+            stack[n_small] = large as u32;
+            n_small += moved;
+            n_large -= moved;
         }
         // What is left holds (up to round-off) exactly one share each; an
         // entry of weight 0 left over (only by round-off) points at the

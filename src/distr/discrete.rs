@@ -1,6 +1,7 @@
 //! [`Discrete1D`]: a discrete distribution sampled by inverting its CDF.
 
 use super::check_weights;
+use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
 
@@ -28,14 +29,14 @@ const GUIDE_MIN_LEN: usize = 1024;
 /// distribution", AIIE Transactions 6(2), 1974.
 #[derive(Clone, Debug)]
 pub struct Discrete1D {
-    weights: Vec<f64>,
-    cdf: Vec<f64>,
+    weights: Buffer<f64>,
+    cdf: Buffer<f64>,
     sum: f64,
     first: usize,
     last: usize,
     /// `guide[k]`: the first index whose running sum reaches `k/G · Σw`,
     /// clamped to `[first, last]`, for `k = 0..=G` (empty for short tables).
-    guide: Vec<u32>,
+    guide: Buffer<u32>,
 }
 
 impl Discrete1D {
@@ -47,17 +48,17 @@ impl Discrete1D {
     /// [`Error::TooLarge`] above [`super::MAX_ENTRIES`] entries.
     pub fn new(weights: &[f64]) -> Result<Self> {
         check_weights("weights", weights, |i| format!("[{i}]"))?;
-        Self::from_checked(weights.to_vec()).ok_or(Error::AllZero { arg: "weights" })
+        Self::from_checked(weights).ok_or(Error::AllZero { arg: "weights" })
     }
 
     /// A distribution from weights already checked to be finite and
     /// `>= 0`; `None` when they are empty or sum to 0.
-    pub(crate) fn from_checked(weights: Vec<f64>) -> Option<Self> {
-        let mut cdf = Vec::with_capacity(weights.len());
+    pub(crate) fn from_checked(weights: &[f64]) -> Option<Self> {
+        let mut cdf = Buffer::zeroed(weights.len());
         let mut acc = 0.0;
-        for &w in &weights {
+        for (c, &w) in cdf.iter_mut().zip(weights) {
             acc += w;
-            cdf.push(acc);
+            *c = acc;
         }
         let first = weights.iter().position(|&w| w > 0.0)?;
         let last = weights.iter().rposition(|&w| w > 0.0)?;
@@ -65,33 +66,33 @@ impl Discrete1D {
             return None;
         }
         let mut table = Discrete1D {
-            weights,
+            weights: Buffer::from_slice(weights),
             cdf,
             sum: acc,
             first,
             last,
-            guide: Vec::new(),
+            guide: Buffer::zeroed(0),
         };
         table.guide = table.build_guide();
         Some(table)
     }
 
-    fn build_guide(&self) -> Vec<u32> {
+    fn build_guide(&self) -> Buffer<u32> {
         let n = self.weights.len();
         if n < GUIDE_MIN_LEN {
-            return Vec::new();
+            return Buffer::zeroed(0);
         }
         // One guide cell per 4 entries: a short search, a small table.
         let cells = n / 4;
         let scale = self.sum / cells as f64;
-        let mut guide = Vec::with_capacity(cells + 1);
+        let mut guide = Buffer::zeroed(cells + 1);
         let mut i = self.first;
-        for k in 0..=cells {
+        for (k, g) in guide.iter_mut().enumerate() {
             let threshold = k as f64 * scale;
             while i < self.last && self.cdf[i] < threshold {
                 i += 1;
             }
-            guide.push(i as u32);
+            *g = i as u32;
         }
         guide
     }

@@ -57,13 +57,13 @@ impl Discrete2D {
         }
         let conditionals: Vec<Option<Discrete1D>> = weights
             .chunks(cols_nz)
-            .map(|row| Discrete1D::from_checked(row.to_vec()))
+            .map(Discrete1D::from_checked)
             .collect();
         let row_sums: Vec<f64> = conditionals
             .iter()
             .map(|c| c.as_ref().map_or(0.0, Discrete1D::sum))
             .collect();
-        let marginal = Discrete1D::from_checked(row_sums).ok_or(Error::AllZero { arg })?;
+        let marginal = Discrete1D::from_checked(&row_sums).ok_or(Error::AllZero { arg })?;
         Ok(Discrete2D {
             marginal,
             conditionals,

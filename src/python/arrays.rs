@@ -11,6 +11,7 @@
 use super::parallel::run_batch;
 use crate::error::{Error, shape_str};
 use crate::math::Real;
+use crate::simd::map_rows;
 use numpy::{AllowTypeChange, Element, PyArray, PyArrayDescrMethods, PyArrayDyn, PyArrayLikeDyn};
 use numpy::{PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
@@ -249,25 +250,75 @@ pub fn map<'py, F, T, const K: usize, const M: usize>(
 ) -> PyResult<Bound<'py, PyAny>>
 where
     F: PyFloat,
-    T: Element + Copy + Send,
+    T: Element + Copy + Default + Send,
 {
-    let out = zeros::<T>(py, &x.out_shape(M));
+    map_into(py, x, check, None, kernel)
+}
+
+/// The array results go to: `out` when given (checked to be a writeable,
+/// C-ordered array of `shape` and of dtype `T`, as numpy's ufuncs check
+/// theirs), else a fresh one.
+pub fn output<'py, T: Element>(
+    py: Python<'py>,
+    shape: &[usize],
+    out: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
+    let Some(out) = out.filter(|o| !o.is_none()) else {
+        return Ok(zeros::<T>(py, shape));
+    };
+    let array = out.cast::<PyArrayDyn<T>>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "out must be a numpy array of dtype {}, got {}",
+            numpy::dtype::<T>(py),
+            out.get_type()
+                .name()
+                .map_or_else(|_| "?".into(), |n| n.to_string())
+        ))
+    })?;
+    let writeable: bool = array.getattr("flags")?.getattr("writeable")?.extract()?;
+    let fits = array.shape() == shape && array.is_c_contiguous() && writeable;
+    if !fits {
+        return Err(Error::Shape {
+            arg: "out",
+            expected: format!("a writeable C-ordered array of shape {}", shape_str(shape)),
+            got: shape_str(array.shape()),
+        }
+        .into());
+    }
+    Ok(array.clone())
+}
+
+/// As [`map`], writing into `out` when it is given (see [`output`]).
+pub fn map_into<'py, F, T, const K: usize, const M: usize>(
+    py: Python<'py>,
+    x: &Points<'py, F, K>,
+    check: Check,
+    out: Option<&Bound<'py, PyAny>>,
+    kernel: impl Fn([F; K]) -> [T; M] + Sync + Send,
+) -> PyResult<Bound<'py, PyAny>>
+where
+    F: PyFloat,
+    T: Element + Copy + Default + Send,
+{
+    let out = output::<T>(py, &x.out_shape(M), out)?;
     {
-        let mut guard = out.readwrite();
+        let mut guard = out.try_readwrite().map_err(|_| {
+            pyo3::exceptions::PyValueError::new_err("out must not share memory with an input array")
+        })?;
         let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
         let in_rows = x.rows();
         let valid = run_batch(py, x.n, out_rows, |range, chunk: &mut [[T; M]]| {
             let inputs = &in_rows[range];
             // One loop per check, so that the loop body has no dispatch left.
             match check {
-                Check::Unit => map_chunk(chunk, inputs, &kernel, |u| {
+                Check::Unit => map_rows(chunk, inputs, &kernel, |u| {
                     u.iter()
                         .fold(true, |ok, &v| ok & (v >= F::zero()) & (v <= F::one()))
                 }),
-                Check::Finite => map_chunk(chunk, inputs, &kernel, |u| {
+                Check::Finite => map_rows(chunk, inputs, &kernel, |u| {
                     u.iter().fold(true, |ok, &v| ok & v.is_finite())
                 }),
-                Check::Within(_) => map_chunk(chunk, inputs, &kernel, |u| check.holds_all(u)),
+                Check::Within(_) => map_rows(chunk, inputs, &kernel, |u| check.holds_all(u)),
             }
         })?;
         if !valid {
@@ -275,28 +326,6 @@ where
         }
     }
     finish(out)
-}
-
-/// `out[i] = kernel(inputs[i])` compiled for the widest vector unit, and
-/// whether `valid` holds for every input.
-#[inline(always)]
-fn map_chunk<F: Copy, T, const K: usize, const M: usize>(
-    out: &mut [[T; M]],
-    inputs: &[[F; K]],
-    kernel: &impl Fn([F; K]) -> [T; M],
-    valid: impl Fn(&[F; K]) -> bool,
-) -> bool {
-    crate::simd::dispatch(
-        #[inline(always)]
-        || {
-            let mut ok = true;
-            for (o, u) in out.iter_mut().zip(inputs) {
-                ok &= valid(u);
-                *o = kernel(*u);
-            }
-            ok
-        },
-    )
 }
 
 /// As [`map`] for kernels with two results (`M` and `L` values per point),
@@ -309,8 +338,8 @@ pub fn map2<'py, F, T, S, const K: usize, const M: usize, const L: usize>(
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)>
 where
     F: PyFloat,
-    T: Element + Copy + Send,
-    S: Element + Copy + Send,
+    T: Element + Copy + Default + Send,
+    S: Element + Copy + Default + Send,
 {
     let first = zeros::<T>(py, &x.out_shape(M));
     let second = zeros::<S>(py, &x.out_shape(L));

@@ -3,7 +3,7 @@
 //! float32, checks `u ∈ [0, 1]` (or finiteness of points) in the kernel's
 //! own pass, and runs on all cores with the GIL released.
 
-use super::arrays::{Check, Points, map, with_precision};
+use super::arrays::{Check, Points, map_into, with_precision};
 use crate::error::Error;
 use crate::math::Real;
 use crate::warp;
@@ -12,6 +12,8 @@ use pyo3::prelude::*;
 /// Defines one `#[pyfunction]` mapping `$x` (points of `$k` values, checked
 /// with `Check::$check`) through the kernel `$kernel` (built with the
 /// precision alias `$F` in scope; `?` may be used to validate parameters).
+/// Every function also takes a keyword `out`: an array to write into, as
+/// numpy's ufuncs do (it must have the result's shape and dtype).
 macro_rules! batch_fn {
     (
         $(#[$meta:meta])*
@@ -19,15 +21,17 @@ macro_rules! batch_fn {
         = |$F:ident| $kernel:expr
     ) => {
         #[pyfunction]
+        #[pyo3(signature = ($x $(, $p)*, *, out = None))]
         $(#[$meta])*
         pub fn $name<'py>(
             py: Python<'py>,
             $x: &Bound<'py, PyAny>
-            $(, $p: $pty)*
+            $(, $p: $pty)*,
+            out: Option<&Bound<'py, PyAny>>,
         ) -> PyResult<Bound<'py, PyAny>> {
             with_precision!($x, $F => {
                 let points = Points::<$F, $k>::extract($x, stringify!($x))?;
-                map(py, &points, Check::$check, $kernel)
+                map_into(py, &points, Check::$check, out, $kernel)
             })
         }
     };
@@ -237,11 +241,12 @@ batch_fn! {
 /// ndarray, shape (N, 3) or (3,), unit vectors; density cos(theta)/pi
 /// per sr.
 #[pyfunction]
-#[pyo3(signature = (u, method = "concentric"))]
+#[pyo3(signature = (u, method = "concentric", *, out = None))]
 pub fn square_to_cosine_hemisphere<'py>(
     py: Python<'py>,
     u: &Bound<'py, PyAny>,
     method: &str,
+    out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     // The method is chosen outside the batch loop, which must stay
     // branch-free to vectorise.
@@ -249,9 +254,9 @@ pub fn square_to_cosine_hemisphere<'py>(
     with_precision!(u, F => {
         let points = Points::<F, 2>::extract(u, "u")?;
         if polar {
-            map(py, &points, Check::Unit, warp::square_to_cosine_hemisphere_polar::<F>)
+            map_into(py, &points, Check::Unit, out, warp::square_to_cosine_hemisphere_polar::<F>)
         } else {
-            map(py, &points, Check::Unit, warp::square_to_cosine_hemisphere::<F>)
+            map_into(py, &points, Check::Unit, out, warp::square_to_cosine_hemisphere::<F>)
         }
     })
 }
@@ -268,28 +273,33 @@ batch_fn! {
     /// ndarray, shape (N,) (a scalar for one direction).
     fn square_to_cosine_hemisphere_pdf(x: [3; Finite]) = |F| |d| [warp::square_to_cosine_hemisphere_pdf::<F>(d)]
 }
-batch_fn! {
-    /// Inverse of ``square_to_cosine_hemisphere`` for the same ``method``.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 3) or (3,), unit vectors with z >= 0
-    /// method : "concentric" (default) or "polar"
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
-    #[pyo3(signature = (x, method = "concentric"))]
-    fn cosine_hemisphere_to_square(x: [3; Finite], method: &str) = |F| {
-        let polar = polar_arg(method)?;
-        move |d: [F; 3]| {
-            if polar {
-                warp::cosine_hemisphere_to_square_polar(d)
-            } else {
-                warp::cosine_hemisphere_to_square(d)
-            }
+/// Inverse of ``square_to_cosine_hemisphere`` for the same ``method``.
+///
+/// Parameters
+/// ----------
+/// x : array_like, shape (N, 3) or (3,), unit vectors with z >= 0
+/// method : "concentric" (default) or "polar"
+///
+/// Returns
+/// -------
+/// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
+#[pyfunction]
+#[pyo3(signature = (x, method = "concentric", *, out = None))]
+pub fn cosine_hemisphere_to_square<'py>(
+    py: Python<'py>,
+    x: &Bound<'py, PyAny>,
+    method: &str,
+    out: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let polar = polar_arg(method)?;
+    with_precision!(x, F => {
+        let points = Points::<F, 3>::extract(x, "x")?;
+        if polar {
+            map_into(py, &points, Check::Finite, out, warp::cosine_hemisphere_to_square_polar::<F>)
+        } else {
+            map_into(py, &points, Check::Finite, out, warp::cosine_hemisphere_to_square::<F>)
         }
-    }
+    })
 }
 batch_fn! {
     /// Directions of the cos^n lobe around +z (the Phong lobe):
