@@ -8,10 +8,10 @@ use std::time::Instant;
 
 fn rate<const M: usize>(name: &str, u: &[[f32; 2]], kernel: impl Fn([f32; 2]) -> [f32; M]) {
     // An optional argument picks the warps whose name contains it.
-    if let Some(only) = std::env::args().nth(1).filter(|a| !a.starts_with('-')) {
-        if !name.contains(&only) {
-            return;
-        }
+    if let Some(only) = std::env::args().nth(1).filter(|a| !a.starts_with('-'))
+        && !name.contains(&only)
+    {
+        return;
     }
     let mut out = vec![[0.0f32; M]; u.len()];
     let unit = |v: &[f32; 2]| v.iter().fold(true, |ok, &x| ok & (x >= 0.0) & (x <= 1.0));
