@@ -14,7 +14,7 @@ fn rate<const M: usize>(name: &str, u: &[[f32; 2]], kernel: impl Fn([f32; 2]) ->
         return;
     }
     let mut out = vec![[0.0f32; M]; u.len()];
-    let unit = |v: &[f32; 2]| v.iter().fold(true, |ok, &x| ok & (x >= 0.0) & (x <= 1.0));
+    let unit = |v: &[f32; 2]| v.iter().fold(true, |ok, &x| ok & (0.0..=1.0).contains(&x));
     let mut best = f64::INFINITY;
     for _ in 0..7 {
         let t = Instant::now();
