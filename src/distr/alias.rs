@@ -25,9 +25,9 @@ use crate::math::Real;
 #[derive(Clone, Debug)]
 pub struct AliasTable {
     /// Cell `c` keeps its own index when the fractional part of `u·n` is
-    /// below `threshold[c]`, else returns `alias[c]`.
-    threshold: Buffer<f64>,
-    alias: Buffer<u32>,
+    /// below its threshold, else returns its alias: `[threshold bits,
+    /// alias]` side by side, so a draw touches one cache line.
+    cells: Buffer<[u64; 2]>,
     pmf: Buffer<f64>,
     sum: f64,
 }
@@ -97,13 +97,11 @@ impl AliasTable {
                 (scaled[i], alias[i]) = (0.0, donor as u32);
             }
         }
-        let threshold = scaled;
-        Ok(AliasTable {
-            threshold,
-            alias,
-            pmf,
-            sum,
-        })
+        let mut cells = Buffer::zeroed(n);
+        for (cell, (&t, &a)) in cells.iter_mut().zip(scaled.iter().zip(alias.iter())) {
+            *cell = [f64::to_bits(t), a as u64];
+        }
+        Ok(AliasTable { cells, pmf, sum })
     }
 
     /// Number of entries.
@@ -132,11 +130,11 @@ impl AliasTable {
         let n = self.pmf.len();
         let t = u.f64() * n as f64;
         let c = (t as usize).min(n - 1);
-        if t - (c as f64) < self.threshold[c] {
-            c
-        } else {
-            self.alias[c] as usize
-        }
+        let [threshold, alias] = self.cells[c];
+        // A select, not a branch: the outcome is random, and a mispredicted
+        // branch would stall the other draws' memory loads.
+        let keep = t - (c as f64) < f64::from_bits(threshold);
+        if keep { c } else { alias as usize }
     }
 }
 
@@ -151,9 +149,10 @@ mod tests {
         let n = t.len();
         let mut p = vec![0.0; n];
         for i in 0..n {
-            let keep = t.threshold[i].min(1.0);
+            let [threshold, alias] = t.cells[i];
+            let keep = f64::from_bits(threshold).min(1.0);
             p[i] += keep / n as f64;
-            p[t.alias[i] as usize] += (1.0 - keep) / n as f64;
+            p[alias as usize] += (1.0 - keep) / n as f64;
         }
         p
     }
