@@ -120,6 +120,30 @@ impl Check {
     }
 }
 
+/// `(N, batched)` of a batch of `K`-vectors of `shape`: `(N, K)` or `(K,)`,
+/// or for `K = 1`, `(N,)` or `()`; else the error naming `arg`.
+fn batch_shape<const K: usize>(arg: &'static str, shape: &[usize]) -> PyResult<(usize, bool)> {
+    match (K, shape) {
+        (1, []) => Ok((1, false)),
+        (1, [n]) => Ok((*n, true)),
+        (_, [k]) if *k == K => Ok((1, false)),
+        (_, [n, k]) if *k == K => Ok((*n, true)),
+        _ => {
+            let expected = if K == 1 {
+                "(N,) or ()".to_string()
+            } else {
+                format!("(N, {K}) or ({K},)")
+            };
+            Err(Error::Shape {
+                arg,
+                expected,
+                got: shape_str(shape),
+            }
+            .into())
+        }
+    }
+}
+
 /// A batch of `K`-vectors read from an array-like: `(N, K)` or `(K,)`, or
 /// for `K = 1`, `(N,)` or a scalar.
 pub struct Points<'py, F: Element, const K: usize> {
@@ -141,25 +165,7 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
             .extract()
             .map_err(|e| PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}")))?;
         let shape = array.shape().to_vec();
-        let (n, batched) = match (K, shape.as_slice()) {
-            (1, []) => (1, false),
-            (1, [n]) => (*n, true),
-            (_, [k]) if *k == K => (1, false),
-            (_, [n, k]) if *k == K => (*n, true),
-            _ => {
-                let expected = if K == 1 {
-                    "(N,) or ()".to_string()
-                } else {
-                    format!("(N, {K}) or ({K},)")
-                };
-                return Err(Error::Shape {
-                    arg,
-                    expected,
-                    got: shape_str(&shape),
-                }
-                .into());
-            }
-        };
+        let (n, batched) = batch_shape::<K>(arg, &shape)?;
         // Only C order can be read in place (a Fortran-ordered array is
         // contiguous too, in the wrong order): copy anything else once.
         let owned = if array.is_c_contiguous() {
@@ -390,25 +396,7 @@ impl<const K: usize> Indices<K> {
         }
         let array: PyArrayLikeDyn<'_, i64, AllowTypeChange> = array.extract()?;
         let shape = array.shape().to_vec();
-        let batched = match (K, shape.as_slice()) {
-            (1, []) => false,
-            (1, [_]) => true,
-            (_, [k]) if *k == K => false,
-            (_, [_, k]) if *k == K => true,
-            _ => {
-                let expected = if K == 1 {
-                    "(N,) or ()".to_string()
-                } else {
-                    format!("(N, {K}) or ({K},)")
-                };
-                return Err(Error::Shape {
-                    arg,
-                    expected,
-                    got: shape_str(&shape),
-                }
-                .into());
-            }
-        };
+        let (_, batched) = batch_shape::<K>(arg, &shape)?;
         let flat: Vec<i64> = array.as_array().iter().copied().collect();
         let mut rows = Vec::with_capacity(flat.len() / K);
         for (i, chunk) in flat.as_chunks::<K>().0.iter().enumerate() {

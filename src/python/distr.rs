@@ -6,6 +6,7 @@
 use super::arrays::{Check, Indices, Points, Table, map, map2, with_precision};
 use super::parallel::detached;
 use crate::distr;
+use crate::math::Real;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
@@ -16,6 +17,63 @@ fn per_index<'py>(
     f: impl Fn(usize) -> f64,
 ) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_iter(py, (0..n).map(f))
+}
+
+/// What the two 1D index tables share, for the method bodies they share.
+trait IndexTable: Sync {
+    fn size(&self) -> usize;
+    fn probability(&self, i: usize) -> f64;
+    fn draw<F: Real>(&self, u: F) -> usize;
+}
+
+impl IndexTable for distr::Discrete1D {
+    fn size(&self) -> usize {
+        self.len()
+    }
+    fn probability(&self, i: usize) -> f64 {
+        self.pmf(i)
+    }
+    fn draw<F: Real>(&self, u: F) -> usize {
+        self.sample(u)
+    }
+}
+
+impl IndexTable for distr::AliasTable {
+    fn size(&self) -> usize {
+        self.len()
+    }
+    fn probability(&self, i: usize) -> f64 {
+        self.pmf(i)
+    }
+    fn draw<F: Real>(&self, u: F) -> usize {
+        self.sample(u)
+    }
+}
+
+/// Indices drawn from `table` for every u (int64, (N,) or a scalar).
+fn sample_indices<'py>(
+    table: &impl IndexTable,
+    py: Python<'py>,
+    u: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyAny>> {
+    with_precision!(u, F => {
+        let u = Points::<F, 1>::extract(u, "u")?;
+        map(py, &u, Check::Unit, |u| [table.draw(u[0]) as i64])
+    })
+}
+
+/// Probabilities of the indices `i` (all of them when `None`).
+fn pmf_of<'py>(
+    table: &impl IndexTable,
+    py: Python<'py>,
+    i: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    match i {
+        None => Ok(per_index(py, table.size(), |k| table.probability(k)).into_any()),
+        Some(i) => {
+            Indices::<1>::extract(i, "i", [table.size()])?.map_f64(py, |[k]| table.probability(k))
+        }
+    }
 }
 
 /// A discrete distribution over 0..n-1 proportional to ``weights``,
@@ -52,10 +110,7 @@ impl PyDiscrete1D {
     /// -------
     /// ndarray, shape (N,) int64 (a scalar for a scalar u).
     fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        with_precision!(u, F => {
-            let u = Points::<F, 1>::extract(u, "u")?;
-            map(py, &u, Check::Unit, |u| [self.0.sample(u[0]) as i64])
-        })
+        sample_indices(&self.0, py, u)
     }
 
     /// Indices as ``sample``, and u rescaled within the chosen entry's share
@@ -93,12 +148,7 @@ impl PyDiscrete1D {
         py: Python<'py>,
         i: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        match i {
-            None => Ok(per_index(py, self.0.len(), |k| self.0.pmf(k)).into_any()),
-            Some(i) => {
-                Indices::<1>::extract(i, "i", [self.0.len()])?.map_f64(py, |[k]| self.0.pmf(k))
-            }
-        }
+        pmf_of(&self.0, py, i)
     }
 
     /// The normalised CDF, shape (n,): P(index <= i); the last entry is 1.
@@ -153,10 +203,7 @@ impl PyAliasTable {
     /// -------
     /// ndarray, shape (N,) int64 (a scalar for a scalar u).
     fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        with_precision!(u, F => {
-            let u = Points::<F, 1>::extract(u, "u")?;
-            map(py, &u, Check::Unit, |u| [self.0.sample(u[0]) as i64])
-        })
+        sample_indices(&self.0, py, u)
     }
 
     /// Probabilities w[i] / sum of the indices ``i`` (all n when omitted).
@@ -166,12 +213,7 @@ impl PyAliasTable {
         py: Python<'py>,
         i: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        match i {
-            None => Ok(per_index(py, self.0.len(), |k| self.0.pmf(k)).into_any()),
-            Some(i) => {
-                Indices::<1>::extract(i, "i", [self.0.len()])?.map_f64(py, |[k]| self.0.pmf(k))
-            }
-        }
+        pmf_of(&self.0, py, i)
     }
 
     /// The sum of the weights.
