@@ -1,12 +1,14 @@
-//! Single-thread throughput of the vectorised warp loops in the core, on
-//! reused buffers (no allocation): `cargo bench --bench warps`.
+//! Throughput of the vectorised warp loops in the core on one thread and
+//! through the batch engine on all cores, into reused buffers (no
+//! allocation): `cargo bench --bench warps [name]`.
 
+use mcsample::parallel::for_each_chunk;
 use mcsample::simd::map_rows;
 use mcsample::warp;
 use std::hint::black_box;
 use std::time::Instant;
 
-fn rate<const M: usize>(name: &str, u: &[[f32; 2]], kernel: impl Fn([f32; 2]) -> [f32; M]) {
+fn rate<const M: usize>(name: &str, u: &[[f32; 2]], kernel: impl Fn([f32; 2]) -> [f32; M] + Sync) {
     // An optional argument picks the warps whose name contains it.
     if let Some(only) = std::env::args().nth(1).filter(|a| !a.starts_with('-'))
         && !name.contains(&only)
@@ -14,21 +16,34 @@ fn rate<const M: usize>(name: &str, u: &[[f32; 2]], kernel: impl Fn([f32; 2]) ->
         return;
     }
     let mut out = vec![[0.0f32; M]; u.len()];
+    let stream = std::env::var_os("NO_STREAM").is_none()
+        && size_of_val(&out[..]) >= mcsample::simd::STREAM_MIN_BYTES;
     let unit = |v: &[f32; 2]| v.iter().fold(true, |ok, &x| ok & (0.0..=1.0).contains(&x));
     let mut best = f64::INFINITY;
     for _ in 0..7 {
         let t = Instant::now();
-        black_box(map_rows(&mut out, black_box(u), &kernel, unit));
+        black_box(map_rows(&mut out, black_box(u), &kernel, unit, stream));
         best = best.min(t.elapsed().as_secs_f64());
     }
+    // All cores, through the batch engine.
+    let mut best_all = f64::INFINITY;
+    for _ in 0..7 {
+        let t = Instant::now();
+        let ok = for_each_chunk(u.len(), &mut out[..], |range, chunk: &mut [[f32; M]]| {
+            map_rows(chunk, &u[range], &kernel, unit, stream)
+        });
+        black_box(ok.ok());
+        best_all = best_all.min(t.elapsed().as_secs_f64());
+    }
     println!(
-        "{name:36} {:8.1} M/s (1 thread, f32)",
-        u.len() as f64 / best / 1e6
+        "{name:36} {:7.1} M/s on 1 thread, {:7.1} M/s on all cores (f32)",
+        u.len() as f64 / best / 1e6,
+        u.len() as f64 / best_all / 1e6
     );
 }
 
 fn main() {
-    let n = 1 << 22;
+    let n = 10_000_000;
     let u: Vec<[f32; 2]> = (0..n)
         .map(|i| {
             let x = (i as f32 * 0.618_034) % 1.0;

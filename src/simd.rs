@@ -46,49 +46,126 @@ fn avx2_fma<R>(f: impl FnOnce() -> R) -> R {
 /// Rows per block of [`map_rows`].
 const BLOCK: usize = 64;
 
+/// Outputs of at least this many bytes are written with non-temporal
+/// stores: they would not stay in the caches anyway, and such stores skip
+/// reading each line before writing it, which halves the write traffic.
+pub const STREAM_MIN_BYTES: usize = 16 << 20;
+
 /// `out[i] = kernel(inputs[i])` for every row, compiled for the widest
 /// vector unit (see [`dispatch`]); returns whether `valid` holds for every
 /// input row. Both closures must be branch-free for the loop to vectorise.
 ///
 /// Rows are interleaved (`[x, y]`, `[x, y, z]`), which the vectoriser
-/// handles only at half width; each block of [`BLOCK`] rows is therefore
-/// transposed into one array per component, mapped at full width, and
-/// transposed back.
+/// handles only at half width inside a kernel loop; each block of [`BLOCK`]
+/// rows is therefore transposed into one array per component, mapped at
+/// full width, and transposed back. With `stream`, the block is written to
+/// `out` with non-temporal stores (for outputs of [`STREAM_MIN_BYTES`] or
+/// more).
 #[inline(always)]
 pub fn map_rows<F, T, const K: usize, const M: usize>(
     out: &mut [[T; M]],
     inputs: &[[F; K]],
     kernel: &impl Fn([F; K]) -> [T; M],
     valid: impl Fn(&[F; K]) -> bool,
+    stream: bool,
 ) -> bool
 where
     F: Copy + Default,
     T: Copy + Default,
 {
-    dispatch(
+    let ok = dispatch(
         #[inline(always)]
         || {
             let mut ok = true;
             for (out, inputs) in out.chunks_mut(BLOCK).zip(inputs.chunks(BLOCK)) {
+                let n = inputs.len();
                 let mut columns = [[F::default(); BLOCK]; K];
                 for (i, u) in inputs.iter().enumerate() {
-                    ok &= valid(u);
                     for k in 0..K {
                         columns[k][i] = u[k];
                     }
                 }
                 let mut results = [[T::default(); BLOCK]; M];
-                for i in 0..BLOCK {
-                    let r = kernel(std::array::from_fn(|k| columns[k][i]));
+                for i in 0..n {
+                    let x = std::array::from_fn(|k| columns[k][i]);
+                    ok &= valid(&x);
+                    let r = kernel(x);
                     for m in 0..M {
                         results[m][i] = r[m];
                     }
                 }
-                for (i, o) in out.iter_mut().enumerate() {
-                    *o = std::array::from_fn(|m| results[m][i]);
+                // Written as one flat loop, the interleave vectorises.
+                if stream {
+                    let mut rows = [[T::default(); M]; BLOCK];
+                    interleave(&results, &mut rows);
+                    stream_copy(out, &rows[..n]);
+                } else {
+                    interleave(&results, out);
                 }
             }
             ok
         },
-    )
+    );
+    if stream {
+        store_fence();
+    }
+    ok
+}
+
+/// `rows[i][m] = columns[m][i]` for the rows given (at most `BLOCK`), as
+/// one flat loop, which vectorises where a loop over rows does not.
+#[inline(always)]
+fn interleave<T: Copy, const M: usize>(columns: &[[T; BLOCK]; M], rows: &mut [[T; M]]) {
+    let flat = rows.as_flattened_mut();
+    let n = (flat.len() / M).min(BLOCK);
+    for i in 0..n {
+        for m in 0..M {
+            flat[i * M + m] = columns[m][i];
+        }
+    }
+}
+
+/// Copies `src` into `dst` (same length) with non-temporal stores for the
+/// 16-byte-aligned part of `dst`.
+#[inline(always)]
+fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{__m128i, _mm_loadu_si128, _mm_stream_si128};
+        let len = size_of_val(src).min(size_of_val(dst));
+        let (d, s) = (dst.as_mut_ptr().cast::<u8>(), src.as_ptr().cast::<u8>());
+        let head = d.align_offset(16).min(len);
+        let body = (len - head) / 16 * 16;
+        #[allow(unsafe_code)]
+        // SAFETY: `d` and `s` point to `len` valid bytes of two distinct
+        // slices (one borrowed mutably); `T: Copy` has no drop glue, and the
+        // bytes copied are those of valid `T` values. The streamed stores go
+        // to `d + head + 16·j`, 16-byte aligned and within `len`.
+        unsafe {
+            std::ptr::copy_nonoverlapping(s, d, head);
+            for j in (head..head + body).step_by(16) {
+                let v = _mm_loadu_si128(s.add(j).cast::<__m128i>());
+                _mm_stream_si128(d.add(j).cast::<__m128i>(), v);
+            }
+            std::ptr::copy_nonoverlapping(
+                s.add(head + body),
+                d.add(head + body),
+                len - head - body,
+            );
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    dst.copy_from_slice(src);
+}
+
+/// Orders non-temporal stores before whatever follows (another thread
+/// reading the output after the batch joins).
+#[inline(always)]
+fn store_fence() {
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    // SAFETY: SSE is part of every x86-64 CPU.
+    unsafe {
+        std::arch::x86_64::_mm_sfence();
+    }
 }

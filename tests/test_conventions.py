@@ -187,3 +187,22 @@ def test_out_must_not_be_an_input():
     frozen.flags.writeable = False
     with pytest.raises(ValueError, match="writeable"):
         warp.square_to_uniform_disk(u, out=frozen)
+
+
+def test_large_batches_stream_the_same_bits():
+    # Outputs of 16 MB or more are written with non-temporal stores, in
+    # blocks, on all threads: the bits must equal those of small batches,
+    # also into an output that is not 16-byte aligned.
+    u = mcs.uniform(1_000_003, 2, seed=8)
+    big = warp.square_to_uniform_sphere(u)
+    small = np.concatenate([warp.square_to_uniform_sphere(u[i:i + 4099])
+                            for i in range(0, len(u), 4099)])
+    assert np.array_equal(big, small)
+    backing = np.empty((len(u) + 1, 3))
+    out = backing[1:]  # offset by 24 bytes
+    assert out.ctypes.data % 16 != 0
+    warp.square_to_uniform_sphere(u, out=out)
+    assert np.array_equal(out, small)
+    u32 = u.astype(np.float32)
+    big32 = warp.square_to_uniform_disk(np.concatenate([u32] * 3))
+    assert np.array_equal(big32[:len(u)], warp.square_to_uniform_disk(u32[:len(u)]))

@@ -11,7 +11,7 @@
 use super::parallel::run_batch;
 use crate::error::{Error, shape_str};
 use crate::math::Real;
-use crate::simd::map_rows;
+use crate::simd::{STREAM_MIN_BYTES, map_rows};
 use numpy::{AllowTypeChange, Element, PyArray, PyArrayDescrMethods, PyArrayDyn, PyArrayLikeDyn};
 use numpy::{PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
@@ -313,18 +313,31 @@ where
         })?;
         let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
         let in_rows = x.rows();
+        let stream = size_of_val(&*out_rows) >= STREAM_MIN_BYTES;
         let valid = run_batch(py, x.n, out_rows, |range, chunk: &mut [[T; M]]| {
             let inputs = &in_rows[range];
             // One loop per check, so that the loop body has no dispatch left.
             match check {
-                Check::Unit => map_rows(chunk, inputs, &kernel, |u| {
-                    u.iter()
-                        .fold(true, |ok, &v| ok & (v >= F::zero()) & (v <= F::one()))
-                }),
-                Check::Finite => map_rows(chunk, inputs, &kernel, |u| {
-                    u.iter().fold(true, |ok, &v| ok & v.is_finite())
-                }),
-                Check::Within(_) => map_rows(chunk, inputs, &kernel, |u| check.holds_all(u)),
+                Check::Unit => map_rows(
+                    chunk,
+                    inputs,
+                    &kernel,
+                    |u| {
+                        u.iter()
+                            .fold(true, |ok, &v| ok & (v >= F::zero()) & (v <= F::one()))
+                    },
+                    stream,
+                ),
+                Check::Finite => map_rows(
+                    chunk,
+                    inputs,
+                    &kernel,
+                    |u| u.iter().fold(true, |ok, &v| ok & v.is_finite()),
+                    stream,
+                ),
+                Check::Within(_) => {
+                    map_rows(chunk, inputs, &kernel, |u| check.holds_all(u), stream)
+                }
             }
         })?;
         if !valid {
