@@ -44,10 +44,14 @@ fn rate<const M: usize>(name: &str, u: &[[f32; 2]], kernel: impl Fn([f32; 2]) ->
 
 fn main() {
     let n = 10_000_000;
-    let u: Vec<[f32; 2]> = (0..n)
+    // Uniform random points (a SplitMix64 hash of the index, 24 bits each).
+    let u: Vec<[f32; 2]> = (0..n as u64)
         .map(|i| {
-            let x = (i as f32 * 0.618_034) % 1.0;
-            [x, (i as f32 / n as f32)]
+            let mut z = i.wrapping_add(1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            let bits = |s: u32| ((z >> s) & 0xff_ffff) as f32 / (1u32 << 24) as f32;
+            [bits(0), bits(32)]
         })
         .collect();
     rate("square_to_uniform_disk", &u, warp::square_to_uniform_disk);

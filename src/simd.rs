@@ -79,14 +79,25 @@ where
             let mut ok = true;
             for (out, inputs) in out.chunks_mut(BLOCK).zip(inputs.chunks(BLOCK)) {
                 let n = inputs.len();
+                // Every loop below runs exactly BLOCK times, so that it
+                // vectorises without a scalar remainder: the last, partial
+                // block is padded with copies of its first row.
+                let padded: [[F; K]; BLOCK];
+                let block: &[[F; K]; BLOCK] = match inputs.try_into() {
+                    Ok(full) => full,
+                    Err(_) => {
+                        padded = std::array::from_fn(|i| inputs[if i < n { i } else { 0 }]);
+                        &padded
+                    }
+                };
                 let mut columns = [[F::default(); BLOCK]; K];
-                for (i, u) in inputs.iter().enumerate() {
+                for i in 0..BLOCK {
                     for k in 0..K {
-                        columns[k][i] = u[k];
+                        columns[k][i] = block[i][k];
                     }
                 }
                 let mut results = [[T::default(); BLOCK]; M];
-                for i in 0..n {
+                for i in 0..BLOCK {
                     let x = std::array::from_fn(|k| columns[k][i]);
                     ok &= valid(&x);
                     let r = kernel(x);
@@ -94,13 +105,17 @@ where
                         results[m][i] = r[m];
                     }
                 }
-                // Written as one flat loop, the interleave vectorises.
-                if stream {
-                    let mut rows = [[T::default(); M]; BLOCK];
-                    interleave(&results, &mut rows);
-                    stream_copy(out, &rows[..n]);
-                } else {
-                    interleave(&results, out);
+                match <&mut [[T; M]; BLOCK]>::try_from(&mut *out) {
+                    Ok(full) if !stream => interleave(&results, full),
+                    _ => {
+                        let mut rows = [[T::default(); M]; BLOCK];
+                        interleave(&results, &mut rows);
+                        if stream {
+                            stream_copy(out, &rows[..n]);
+                        } else {
+                            out.copy_from_slice(&rows[..n]);
+                        }
+                    }
                 }
             }
             ok
@@ -112,13 +127,12 @@ where
     ok
 }
 
-/// `rows[i][m] = columns[m][i]` for the rows given (at most `BLOCK`), as
-/// one flat loop, which vectorises where a loop over rows does not.
+/// `rows[i][m] = columns[m][i]`, as one flat loop of constant length,
+/// which vectorises where a loop over rows does not.
 #[inline(always)]
-fn interleave<T: Copy, const M: usize>(columns: &[[T; BLOCK]; M], rows: &mut [[T; M]]) {
+fn interleave<T: Copy, const M: usize>(columns: &[[T; BLOCK]; M], rows: &mut [[T; M]; BLOCK]) {
     let flat = rows.as_flattened_mut();
-    let n = (flat.len() / M).min(BLOCK);
-    for i in 0..n {
+    for i in 0..BLOCK {
         for m in 0..M {
             flat[i * M + m] = columns[m][i];
         }
