@@ -1,4 +1,5 @@
-//! [`AliasTable`]: O(1) sampling of a discrete distribution (Vose's method).
+//! [`AliasTable`]: O(1) sampling of a discrete distribution (Walker's alias
+//! method, built by sweeping).
 
 use super::check_weights;
 use crate::buffer::Buffer;
@@ -21,7 +22,9 @@ use crate::math::Real;
 /// # References
 /// M. D. Vose, "A linear algorithm for generating random numbers with a
 /// given distribution", IEEE Transactions on Software Engineering 17(9),
-/// 1991.
+/// 1991. L. Hübschle-Schneider, P. Sanders, "Parallel Weighted Random
+/// Sampling", ACM Transactions on Mathematical Software 48(3), 2022 (the
+/// sweeping construction used here).
 #[derive(Clone, Debug)]
 pub struct AliasTable {
     /// Cell `c` keeps its own index when the fractional part of `u·n` is
@@ -48,58 +51,62 @@ impl AliasTable {
         for (p, &w) in pmf.iter_mut().zip(weights) {
             *p = w / sum;
         }
+        let share = |i: usize| pmf[i] * n as f64;
 
-        // Vose: cells below their 1/n share ("small") are topped up by cells
-        // above it ("large"). One index array holds both stacks: smalls grow
-        // from the front, larges from the back. A small cell's scaled mass
-        // is final once it is popped, so `scaled` becomes the thresholds.
-        let mut scaled = Buffer::zeroed(n);
-        for (s, &p) in scaled.iter_mut().zip(pmf.iter()) {
-            *s = p * n as f64;
+        // Entries below their 1/n share ("light") in increasing order from
+        // the front of `order`, the others ("heavy") from the back, written
+        // branch-free (the order of the weights is random to the predictor).
+        let mut order = Buffer::<u32>::zeroed(n);
+        let (mut n_light, mut n_heavy) = (0usize, 0usize);
+        for i in 0..n {
+            let light = (share(i) < 1.0) as usize;
+            order[n_light] = i as u32;
+            order[n - 1 - n_heavy] = i as u32;
+            n_light += light;
+            n_heavy += 1 - light;
         }
-        let mut alias = Buffer::zeroed(n);
-        let mut stack = Buffer::<u32>::zeroed(n);
-        let (mut n_small, mut n_large) = (0usize, 0usize);
-        // Branch-free (the weights' order is random to the branch
-        // predictor): write to both free slots, keep the one that counts.
-        for (i, &s) in scaled.iter().enumerate() {
-            let small = (s < 1.0) as usize;
-            stack[n_small] = i as u32;
-            stack[n - 1 - n_large] = i as u32;
-            n_small += small;
-            n_large += 1 - small;
-        }
-        while n_small > 0 && n_large > 0 {
-            n_small -= 1;
-            let small = stack[n_small] as usize;
-            let large = stack[n - n_large] as usize;
-            alias[small] = large as u32;
-            scaled[large] = (scaled[large] + scaled[small]) - 1.0;
-            // A donor that became small moves to the small stack (into
-            // the slot just freed), branch-free as above.
-            let moved = (scaled[large] < 1.0) as usize;
-            stack[n_small] = large as u32;
-            n_small += moved;
-            n_large -= moved;
-        }
-        // What is left holds (up to round-off) exactly one share each; an
-        // entry of weight 0 left over (only by round-off) points at the
-        // most likely entry instead.
-        let donor = pmf
-            .iter()
-            .enumerate()
-            .fold(0, |best, (i, &p)| if p > pmf[best] { i } else { best });
-        for &i in stack[..n_small].iter().chain(&stack[n - n_large..]) {
-            let i = i as usize;
-            if pmf[i] > 0.0 {
-                (scaled[i], alias[i]) = (1.0, i as u32);
+        let light = |k: usize| order[k] as usize;
+        let heavy = |k: usize| order[n - 1 - k] as usize;
+
+        // Sweep (Hübschle-Schneider and Sanders): the current heavy entry
+        // tops up light entries in order while its residual `w` exceeds one
+        // share; once it drops to one share or less it is itself a light
+        // cell, topped up by the next heavy entry. Both cursors only move
+        // forward, and each step is a select, not a branch.
+        let mut cells = Buffer::<[u64; 2]>::zeroed(n);
+        let (mut i, mut j) = (0usize, 0usize);
+        let mut w = if n_heavy > 0 { share(heavy(0)) } else { 0.0 };
+        while n_heavy > 0 && (i < n_light || j + 1 < n_heavy) {
+            let can_light = i < n_light;
+            let can_heavy = j + 1 < n_heavy;
+            let light_step = can_light & ((w > 1.0) | !can_heavy);
+            let l = light(i.min(n_light.saturating_sub(1)));
+            let next = heavy((j + 1).min(n_heavy - 1));
+            let (cell, threshold, alias) = if light_step {
+                (l, share(l), heavy(j))
             } else {
-                (scaled[i], alias[i]) = (0.0, donor as u32);
-            }
+                (heavy(j), w, next)
+            };
+            cells[cell] = [threshold.to_bits(), alias as u64];
+            w = if light_step {
+                w + share(l) - 1.0
+            } else {
+                share(next) + w - 1.0
+            };
+            i += light_step as usize;
+            j += (!light_step) as usize;
         }
-        let mut cells = Buffer::zeroed(n);
-        for (cell, (&t, &a)) in cells.iter_mut().zip(scaled.iter().zip(alias.iter())) {
-            *cell = [f64::to_bits(t), a as u64];
+        // What is left holds (up to round-off) exactly one share each: the
+        // last heavy entry and any light entries. An entry of weight 0 left
+        // over points at the most likely entry instead.
+        let donor = (0..n).fold(0, |best, k| if pmf[k] > pmf[best] { k } else { best });
+        let rest = (i..n_light).map(light).chain((j..n_heavy).map(heavy));
+        for k in rest {
+            cells[k] = if pmf[k] > 0.0 {
+                [1.0f64.to_bits(), k as u64]
+            } else {
+                [0.0f64.to_bits(), donor as u64]
+            };
         }
         Ok(AliasTable { cells, pmf, sum })
     }

@@ -54,11 +54,14 @@ impl Discrete1D {
     /// A distribution from weights already checked to be finite and
     /// `>= 0`; `None` when they are empty or sum to 0.
     pub(crate) fn from_checked(weights: &[f64]) -> Option<Self> {
+        // One pass: the copy of the weights and their running sums.
+        let mut copy = Buffer::zeroed(weights.len());
         let mut cdf = Buffer::zeroed(weights.len());
         let mut acc = 0.0;
-        for (c, &w) in cdf.iter_mut().zip(weights) {
+        for ((c, w_copy), &w) in cdf.iter_mut().zip(copy.iter_mut()).zip(weights) {
             acc += w;
             *c = acc;
+            *w_copy = w;
         }
         let first = weights.iter().position(|&w| w > 0.0)?;
         let last = weights.iter().rposition(|&w| w > 0.0)?;
@@ -66,7 +69,7 @@ impl Discrete1D {
             return None;
         }
         let mut table = Discrete1D {
-            weights: Buffer::from_slice(weights),
+            weights: copy,
             cdf,
             sum: acc,
             first,
@@ -84,15 +87,21 @@ impl Discrete1D {
         }
         // One guide cell per 4 entries: a short search, a small table.
         let cells = n / 4;
-        let scale = self.sum / cells as f64;
-        let mut guide = Buffer::zeroed(cells + 1);
-        let mut i = self.first;
-        for (k, g) in guide.iter_mut().enumerate() {
-            let threshold = k as f64 * scale;
-            while i < self.last && self.cdf[i] < threshold {
-                i += 1;
-            }
-            *g = i as u32;
+        // guide[k] is the first i with C_i ≥ k·Σw/G. Branch-free: entry i
+        // writes its index into cell ⌊C_i·G/Σw⌋, last entries first, so each
+        // hit cell keeps its smallest index; a cell no entry hits takes the
+        // answer of the next cell up (a suffix minimum). Round-off here only
+        // costs a fallback search (see `bracket`).
+        let scale = cells as f64 / self.sum;
+        let mut guide = Buffer::<u32>::zeroed(cells + 1);
+        guide.fill(u32::MAX);
+        for (i, &c) in self.cdf.iter().enumerate().rev() {
+            guide[((c * scale) as usize).min(cells)] = i as u32;
+        }
+        let (first, mut next) = (self.first as u32, self.last as u32);
+        for g in guide.iter_mut().rev() {
+            next = next.min(*g);
+            *g = next.max(first);
         }
         guide
     }

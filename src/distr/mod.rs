@@ -42,14 +42,13 @@ fn check_weights(
             max: MAX_ENTRIES,
         });
     }
-    // One branch-free pass for the common case; find the index only on failure.
-    let valid = weights
-        .iter()
-        .fold(true, |ok, &w| ok & (w >= 0.0 && w.is_finite()));
-    if valid {
+    // One branch-free pass for the common case (NaN and ±∞ fail both
+    // comparisons); find the index only on failure.
+    let ok = |w: f64| (w >= 0.0) & (w <= f64::MAX);
+    if weights.iter().fold(true, |all, &w| all & ok(w)) {
         return Ok(());
     }
-    match weights.iter().position(|&w| !(w >= 0.0 && w.is_finite())) {
+    match weights.iter().position(|&w| !ok(w)) {
         Some(i) => Err(Error::InvalidWeight {
             arg,
             index: index(i),
