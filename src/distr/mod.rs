@@ -44,7 +44,7 @@ fn check_weights(
     }
     // One branch-free pass for the common case (NaN and ±∞ fail both
     // comparisons); find the index only on failure.
-    let ok = |w: f64| (w >= 0.0) & (w <= f64::MAX);
+    let ok = |w: f64| (0.0..=f64::MAX).contains(&w);
     if weights.iter().fold(true, |all, &w| all & ok(w)) {
         return Ok(());
     }
