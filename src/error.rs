@@ -77,6 +77,14 @@ pub enum Error {
         /// The table's length along that axis.
         len: usize,
     },
+    /// A Phong material that reflects more than it receives.
+    #[error("diffuse[{channel}] + specular[{channel}] = {sum}: must be <= 1 (energy conservation)")]
+    NotEnergyConserving {
+        /// The RGB channel (0, 1, 2).
+        channel: usize,
+        /// ρd + ρs in that channel.
+        sum: f64,
+    },
     /// A table too large for 32-bit indices.
     #[error("{arg} has {len} entries: at most {max} are supported")]
     TooLarge {

@@ -11,6 +11,8 @@
 //! - [`buffer`]: large flat arrays on huge pages.
 //! - [`distr`]: discrete tables (CDF inversion, alias), 2D tables and
 //!   piecewise-constant densities.
+//! - [`phong`]: the energy-normalised Phong BRDF and its sampling.
+//! - [`mis`]: multiple importance sampling heuristics.
 //! - [`frame`]: orthonormal frames around a normal.
 //! - [`io`]: EXR, Radiance HDR and PNG files.
 //! - [`simd`]: runtime dispatch of batch loops to AVX2 + FMA.
@@ -34,7 +36,9 @@ pub mod error;
 pub mod frame;
 pub mod io;
 pub mod math;
+pub mod mis;
 pub mod parallel;
+pub mod phong;
 pub mod rng;
 pub mod simd;
 pub mod warp;

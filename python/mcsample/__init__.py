@@ -6,8 +6,17 @@ Conventions (sample-major batches, float32 in / float32 out, densities per
 steradian on directions, +z normal) are in the README.
 """
 
-from . import distr, io, stats, warp
-from ._core import Frame, Rng, __version__, get_num_threads, set_num_threads, uniform
+from . import distr, io, mis, stats, warp
+from ._core import (
+    Frame,
+    Phong,
+    PhongSample,
+    Rng,
+    __version__,
+    get_num_threads,
+    set_num_threads,
+    uniform,
+)
 from .distr import (
     AliasTable,
     Discrete1D,
@@ -23,12 +32,15 @@ __all__ = [
     "Discrete2D",
     "Frame",
     "PiecewiseConstant1D",
+    "Phong",
+    "PhongSample",
     "PiecewiseConstant2D",
     "Rng",
     "distr",
     "__version__",
     "get_num_threads",
     "io",
+    "mis",
     "rejection_sample",
     "set_num_threads",
     "stats",

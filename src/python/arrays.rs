@@ -83,6 +83,8 @@ pub enum Check {
     /// Component `k` in the closed interval `bounds[k]` (points of a
     /// rectangle or, for one component, an interval).
     Within([[f64; 2]; 2]),
+    /// A density: `>= 0`, possibly infinite (a delta), not NaN.
+    Density,
 }
 
 impl Check {
@@ -96,12 +98,13 @@ impl Check {
                 let [lo, hi] = bounds[k.min(1)];
                 x.f64() >= lo && x.f64() <= hi
             }
+            Check::Density => x >= F::zero(),
         }
     }
 
     /// Whether every component of `point` passes.
     #[inline(always)]
-    fn holds_all<F: Real, const K: usize>(self, point: &[F; K]) -> bool {
+    pub fn holds_all<F: Real, const K: usize>(self, point: &[F; K]) -> bool {
         point
             .iter()
             .enumerate()
@@ -116,6 +119,7 @@ impl Check {
                 let [lo, hi] = bounds[k.min(1)];
                 format!("must lie in [{lo}, {hi}]")
             }
+            Check::Density => "a density must be >= 0 (inf allowed, NaN not)".into(),
         }
     }
 }
@@ -335,7 +339,7 @@ where
                     |u| u.iter().fold(true, |ok, &v| ok & v.is_finite()),
                     stream,
                 ),
-                Check::Within(_) => {
+                Check::Within(_) | Check::Density => {
                     map_rows(chunk, inputs, &kernel, |u| check.holds_all(u), stream)
                 }
             }
@@ -345,6 +349,97 @@ where
         }
     }
     finish(out)
+}
+
+/// Maps pairs `(a[i], b[i])` through `kernel`; either input may be a single
+/// point, used for every row (the result is unbatched only when both are).
+/// Each input value is checked in the same pass; the GIL is released.
+pub fn map_pair<'py, F, T, const KA: usize, const KB: usize, const M: usize>(
+    py: Python<'py>,
+    a: (&Points<'py, F, KA>, Check),
+    b: (&Points<'py, F, KB>, Check),
+    kernel: impl Fn([F; KA], [F; KB]) -> [T; M] + Sync + Send,
+) -> PyResult<Bound<'py, PyAny>>
+where
+    F: PyFloat,
+    T: Element + Copy + Default + Send,
+{
+    let ((a, check_a), (b, check_b)) = (a, b);
+    let n = pair_len(a, b)?;
+    let shape = match (a.batched || b.batched, M) {
+        (true, 1) => vec![n],
+        (true, _) => vec![n, M],
+        (false, 1) => vec![],
+        (false, _) => vec![M],
+    };
+    let out = zeros::<T>(py, &shape);
+    {
+        let mut guard = out.readwrite();
+        let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
+        let (rows_a, rows_b) = (a.rows(), b.rows());
+        let (step_a, step_b) = (usize::from(a.batched), usize::from(b.batched));
+        let (valid_a, valid_b) = run_batch_pair(py, n, out_rows, |range, chunk: &mut [[T; M]]| {
+            let (mut ok_a, mut ok_b) = (true, true);
+            for (o, i) in chunk.iter_mut().zip(range) {
+                let (x, y) = (rows_a[i * step_a], rows_b[i * step_b]);
+                ok_a &= check_a.holds_all(&x);
+                ok_b &= check_b.holds_all(&y);
+                *o = kernel(x, y);
+            }
+            (ok_a, ok_b)
+        })?;
+        if !valid_a {
+            return Err(a.invalid(check_a));
+        }
+        if !valid_b {
+            return Err(b.invalid(check_b));
+        }
+    }
+    finish(out)
+}
+
+/// The row count of a pair of inputs that broadcast against each other.
+pub fn pair_len<F: Element, const KA: usize, const KB: usize>(
+    a: &Points<'_, F, KA>,
+    b: &Points<'_, F, KB>,
+) -> PyResult<usize> {
+    match (a.batched, b.batched) {
+        (true, true) if a.n != b.n => Err(Error::Shape {
+            arg: b.arg,
+            expected: format!("{} rows, as {} has (or a single point)", a.n, a.arg),
+            got: format!("{} rows", b.n),
+        }
+        .into()),
+        (_, true) => Ok(b.n),
+        _ => Ok(a.n),
+    }
+}
+
+/// [`run_batch`] for kernels that check two inputs: returns whether each
+/// was valid throughout.
+pub fn run_batch_pair<O, K>(
+    py: Python<'_>,
+    n: usize,
+    outputs: O,
+    kernel: K,
+) -> PyResult<(bool, bool)>
+where
+    O: crate::parallel::Outputs,
+    K: Fn(std::ops::Range<usize>, O) -> (bool, bool) + Sync + Send,
+{
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let (bad_a, bad_b) = (AtomicBool::new(false), AtomicBool::new(false));
+    run_batch(py, n, outputs, |range, out| {
+        let (ok_a, ok_b) = kernel(range, out);
+        if !ok_a {
+            bad_a.store(true, Ordering::Relaxed);
+        }
+        if !ok_b {
+            bad_b.store(true, Ordering::Relaxed);
+        }
+        ok_a && ok_b
+    })?;
+    Ok((!bad_a.into_inner(), !bad_b.into_inner()))
 }
 
 /// As [`map`] for kernels with two results (`M` and `L` values per point),

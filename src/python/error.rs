@@ -18,7 +18,8 @@ impl From<Error> for PyErr {
             | Error::Element { .. }
             | Error::Integer { .. }
             | Error::TooLarge { .. }
-            | Error::Index { .. } => PyValueError::new_err(e.to_string()),
+            | Error::Index { .. }
+            | Error::NotEnergyConserving { .. } => PyValueError::new_err(e.to_string()),
         }
     }
 }

@@ -7,7 +7,9 @@ mod distr;
 mod error;
 mod frame;
 mod io;
+mod mis;
 mod parallel;
+mod phong;
 mod rng;
 mod warp;
 
@@ -42,7 +44,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parallel::_trigger_panic, m)?)?;
     distr::register(m)?;
     m.add_class::<frame::PyFrame>()?;
+    m.add_class::<phong::PyPhong>()?;
+    m.add_class::<phong::PyPhongSample>()?;
     submodule(m, "warp", warp::register)?;
     submodule(m, "io", io::register)?;
+    submodule(m, "mis", mis::register)?;
     Ok(())
 }

@@ -6,6 +6,7 @@ import numpy as np
 from numpy.typing import ArrayLike, DTypeLike, NDArray
 
 from . import io as io
+from . import mis as mis
 from . import warp as warp
 
 __version__: str
@@ -133,3 +134,36 @@ class Frame:
     @property
     def n(self) -> Any: ...
     def __len__(self) -> int: ...
+
+@final
+class PhongSample:
+    """Samples of Phong.sample."""
+
+    @property
+    def wo(self) -> Any: ...
+    @property
+    def pdf(self) -> Any: ...
+    @property
+    def weight(self) -> Any: ...
+    @property
+    def component(self) -> Any: ...
+
+@final
+class Phong:
+    """Energy-normalised modified Phong BRDF (local frame, normal +z)."""
+
+    def __new__(cls, diffuse: float | Sequence[float], specular: float | Sequence[float],
+                exponent: float, selection: str = "max") -> Phong: ...
+    def eval(self, wi: ArrayLike, wo: ArrayLike) -> Any:
+        """f_r(wi, wo) per RGB channel, (N, 3)."""
+    def pdf(self, wi: ArrayLike, wo: ArrayLike) -> Any:
+        """Density of sample per steradian, (N,)."""
+    def sample(self, wi: ArrayLike, u: ArrayLike) -> PhongSample: ...
+    @property
+    def diffuse_probability(self) -> float: ...
+    @property
+    def diffuse(self) -> list[float]: ...
+    @property
+    def specular(self) -> list[float]: ...
+    @property
+    def exponent(self) -> float: ...

@@ -1,0 +1,286 @@
+//! The energy-normalised ("physically plausible") modified Phong BRDF with
+//! importance sampling of its diffuse and glossy parts.
+//!
+//! Directions are in the local shading frame (normal = +z); `wi` points
+//! toward the viewer, `wo` is the sampled direction; both unit length.
+
+use crate::error::{Error, Result};
+use crate::frame::Frame;
+use crate::math::{Real, luminance};
+use crate::warp::{self, V3};
+
+/// How [`Phong::sample`] picks the diffuse or the glossy part.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Selection {
+    /// `p_d = max(ρd) / (max(ρd) + max(ρs))` over the RGB channels (the
+    /// default).
+    Max,
+    /// `p_d = Y(ρd) / (Y(ρd) + Y(ρs))` with Rec. 709 luminance Y (Mitsuba
+    /// 0.6's rule).
+    Luminance,
+}
+
+/// The modified Phong BRDF of Lafortune and Willems, normalised so that it
+/// conserves energy when `ρd + ρs ≤ 1`.
+///
+/// # BRDF
+/// `f_r(wi, wo) = ρd/π + ρs·(n + 2)/(2π)·max(0, cos α)ⁿ`, where α is the
+/// angle between `wo` and the mirror direction `r = 2(wi·n)n − wi`; 0 when
+/// `wi` or `wo` is below the surface. No cosine factor.
+///
+/// # Sampling and density
+/// The diffuse part (probability `p_d`, see [`Selection`]) draws a
+/// cosine-weighted direction; the glossy part (`p_s = 1 − p_d`) a cosⁿ lobe
+/// around `r`, in a frame built on `r`. Whichever part drew `wo`, its
+/// density per steradian is the mixture
+/// `p(wo) = p_d·max(cos θo, 0)/π + p_s·(n + 1)/(2π)·max(0, cos α)ⁿ`,
+/// which is positive below the surface where the lobe reaches there (such
+/// samples carry weight 0).
+///
+/// # References
+/// E. Lafortune, Y. Willems, "Using the Modified Phong Reflectance Model for
+/// Physically Based Rendering", KU Leuven report CW197, 1994.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Phong {
+    diffuse: [f64; 3],
+    specular: [f64; 3],
+    exponent: f64,
+    diffuse_probability: f64,
+}
+
+/// One sample of [`Phong::sample`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhongSample<F> {
+    /// The sampled direction (local frame, unit length).
+    pub wo: V3<F>,
+    /// Its density per steradian (the mixture, see [`Phong`]).
+    pub pdf: F,
+    /// `f_r(wi, wo)·cos θo / pdf` per RGB channel; 0 below the surface.
+    pub weight: V3<F>,
+    /// 0 for the diffuse part, 1 for the glossy part.
+    pub component: u8,
+}
+
+impl Phong {
+    /// A Phong BRDF with RGB reflectances `diffuse` (ρd) and `specular` (ρs)
+    /// and the lobe exponent `n`.
+    ///
+    /// # Errors
+    /// [`Error::Element`] for a reflectance that is negative or not finite,
+    /// [`Error::NotEnergyConserving`] if `ρd + ρs > 1` in a channel, and
+    /// [`Error::Parameter`] for an exponent below 0 or not finite.
+    pub fn new(
+        diffuse: [f64; 3],
+        specular: [f64; 3],
+        exponent: f64,
+        selection: Selection,
+    ) -> Result<Self> {
+        for (arg, rho) in [("diffuse", diffuse), ("specular", specular)] {
+            if let Some(k) = rho.iter().position(|&v| !(v >= 0.0 && v.is_finite())) {
+                return Err(Error::Element {
+                    arg,
+                    index: format!("[{k}]"),
+                    value: rho[k],
+                    requirement: "reflectances must be finite and >= 0".into(),
+                });
+            }
+        }
+        if let Some(k) = (0..3).find(|&k| diffuse[k] + specular[k] > 1.0) {
+            return Err(Error::NotEnergyConserving {
+                channel: k,
+                sum: diffuse[k] + specular[k],
+            });
+        }
+        if !(exponent >= 0.0 && exponent.is_finite()) {
+            return Err(Error::Parameter {
+                arg: "exponent",
+                value: exponent,
+                requirement: "must be finite and >= 0",
+            });
+        }
+        let (d, s) = match selection {
+            Selection::Max => (max3(diffuse), max3(specular)),
+            Selection::Luminance => (luminance(diffuse), luminance(specular)),
+        };
+        // A black material samples the diffuse part (its weight is 0).
+        let diffuse_probability = if d + s > 0.0 { d / (d + s) } else { 1.0 };
+        Ok(Phong {
+            diffuse,
+            specular,
+            exponent,
+            diffuse_probability,
+        })
+    }
+
+    /// ρd.
+    pub fn diffuse(&self) -> [f64; 3] {
+        self.diffuse
+    }
+
+    /// ρs.
+    pub fn specular(&self) -> [f64; 3] {
+        self.specular
+    }
+
+    /// The lobe exponent n.
+    pub fn exponent(&self) -> f64 {
+        self.exponent
+    }
+
+    /// The probability `p_d` of sampling the diffuse part.
+    pub fn diffuse_probability(&self) -> f64 {
+        self.diffuse_probability
+    }
+
+    /// `max(0, cos α)ⁿ`, with α between `wo` and the mirror of `wi`.
+    #[inline(always)]
+    fn lobe<F: Real>(&self, wi: V3<F>, wo: V3<F>) -> F {
+        let r = reflect(wi);
+        let cos_alpha = dot(r, wo);
+        if cos_alpha > F::zero() {
+            cos_alpha.powf(F::c(self.exponent))
+        } else {
+            F::zero()
+        }
+    }
+
+    /// The BRDF value `f_r(wi, wo)` per RGB channel (no cosine).
+    #[inline]
+    pub fn eval<F: Real>(&self, wi: V3<F>, wo: V3<F>) -> V3<F> {
+        if !(wi[2] > F::zero() && wo[2] > F::zero()) {
+            return [F::zero(); 3];
+        }
+        let glossy =
+            F::c((self.exponent + 2.0) * 0.5 * std::f64::consts::FRAC_1_PI) * self.lobe(wi, wo);
+        std::array::from_fn(|k| {
+            F::c(self.diffuse[k] * std::f64::consts::FRAC_1_PI) + F::c(self.specular[k]) * glossy
+        })
+    }
+
+    /// The density of [`Phong::sample`] at `wo`, per steradian.
+    #[inline]
+    pub fn pdf<F: Real>(&self, wi: V3<F>, wo: V3<F>) -> F {
+        let pd = F::c(self.diffuse_probability);
+        let diffuse = warp::square_to_cosine_hemisphere_pdf(wo);
+        let glossy =
+            F::c((self.exponent + 1.0) * 0.5 * std::f64::consts::FRAC_1_PI) * self.lobe(wi, wo);
+        pd * diffuse + (F::one() - pd) * glossy
+    }
+
+    /// A direction drawn from the mixture for `wi`: `u[2]` picks the part,
+    /// `u[0..2]` place the direction. `u` in `[0, 1]³`.
+    #[inline]
+    pub fn sample<F: Real>(&self, wi: V3<F>, u: [F; 3]) -> PhongSample<F> {
+        let diffuse = u[2] < F::c(self.diffuse_probability);
+        let wo = if diffuse {
+            warp::square_to_cosine_hemisphere([u[0], u[1]])
+        } else {
+            let lobe = warp::square_to_cosine_power_hemisphere([u[0], u[1]], F::c(self.exponent));
+            Frame::from_normal(reflect(wi)).to_world(lobe)
+        };
+        let pdf = self.pdf(wi, wo);
+        let f = self.eval(wi, wo);
+        let cos_o = wo[2].max(F::zero());
+        let weight = if pdf > F::zero() {
+            f.map(|v| v * cos_o / pdf)
+        } else {
+            [F::zero(); 3]
+        };
+        PhongSample {
+            wo,
+            pdf,
+            weight,
+            component: u8::from(!diffuse),
+        }
+    }
+}
+
+#[inline(always)]
+fn max3(v: [f64; 3]) -> f64 {
+    v[0].max(v[1]).max(v[2])
+}
+
+#[inline(always)]
+fn dot<F: Real>(a: V3<F>, b: V3<F>) -> F {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The mirror direction of `wi` about the normal +z: `(−x, −y, z)`.
+#[inline(always)]
+fn reflect<F: Real>(wi: V3<F>) -> V3<F> {
+    [-wi[0], -wi[1], wi[2]]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn phong(n: f64) -> Phong {
+        Phong::new([0.3, 0.2, 0.1], [0.5, 0.6, 0.7], n, Selection::Max).unwrap()
+    }
+
+    #[test]
+    fn selection_uses_the_original_maxima() {
+        let p = phong(10.0);
+        assert!((p.diffuse_probability() - 0.3 / (0.3 + 0.7)).abs() < 1e-15);
+        let q = Phong::new([0.3, 0.2, 0.1], [0.5, 0.6, 0.7], 10.0, Selection::Luminance).unwrap();
+        let (d, s) = (luminance([0.3, 0.2, 0.1]), luminance([0.5, 0.6, 0.7]));
+        assert!((q.diffuse_probability() - d / (d + s)).abs() < 1e-15);
+        let black = Phong::new([0.0; 3], [0.0; 3], 1.0, Selection::Max).unwrap();
+        let s = black.sample([0.0, 0.0, 1.0], [0.3, 0.4, 0.5]);
+        assert_eq!(s.weight, [0.0; 3]);
+    }
+
+    #[test]
+    fn errors() {
+        assert!(matches!(
+            Phong::new([0.6; 3], [0.5; 3], 1.0, Selection::Max),
+            Err(Error::NotEnergyConserving { .. })
+        ));
+        assert!(Phong::new([-0.1, 0.0, 0.0], [0.5; 3], 1.0, Selection::Max).is_err());
+        assert!(Phong::new([0.1; 3], [0.5; 3], -1.0, Selection::Max).is_err());
+        assert!(Phong::new([0.1; 3], [0.5; 3], f64::NAN, Selection::Max).is_err());
+    }
+
+    #[test]
+    fn below_the_surface_is_black_and_weights_are_finite() {
+        let p = phong(5.0);
+        let wi = [0.0, (80f64.to_radians()).sin(), (80f64.to_radians()).cos()];
+        assert_eq!(p.eval(wi, [0.0, 0.0, -1.0]), [0.0; 3]);
+        assert_eq!(p.eval([0.0, 0.0, -1.0], [0.0, 0.0, 1.0]), [0.0; 3]);
+        for k in 0..1000 {
+            let u = [
+                k as f64 / 999.0,
+                (k * 7 % 1000) as f64 / 999.0,
+                (k * 13 % 1000) as f64 / 999.0,
+            ];
+            let s = p.sample(wi, u);
+            assert!(s.weight.iter().all(|w| w.is_finite() && *w >= 0.0));
+            assert!((dot(s.wo, s.wo) - 1.0).abs() < 1e-12);
+            if s.wo[2] <= 0.0 {
+                assert_eq!(s.weight, [0.0; 3]);
+            }
+        }
+    }
+
+    #[test]
+    fn pdf_integrates_to_one_over_the_sphere() {
+        // Midpoint rule in (φ, cos θ) on the sphere.
+        for n in [0.0, 1.0, 30.0] {
+            let p = phong(n);
+            let wi = [0.5f64, 0.0, 0.75f64.sqrt()];
+            let (nphi, nz) = (400, 4000);
+            let mut total = 0.0;
+            for i in 0..nphi {
+                let phi = (i as f64 + 0.5) / nphi as f64 * std::f64::consts::TAU;
+                for j in 0..nz {
+                    let z = -1.0 + (j as f64 + 0.5) / nz as f64 * 2.0;
+                    let r = (1.0 - z * z).sqrt();
+                    total += p.pdf(wi, [r * phi.cos(), r * phi.sin(), z]);
+                }
+            }
+            total *= std::f64::consts::TAU / nphi as f64 * 2.0 / nz as f64;
+            assert!((total - 1.0).abs() < 2e-3, "n = {n}: {total}");
+        }
+    }
+}

@@ -1,0 +1,273 @@
+//! `mcsample.Phong`: the energy-normalised Phong BRDF of [`crate::phong`],
+//! batched over directions.
+
+use super::arrays::{
+    Check, Points, PyFloat, finish, map_pair, pair_len, run_batch_pair, with_precision, zeros,
+};
+use crate::error::Error;
+use crate::phong::{Phong, Selection};
+use numpy::PyArrayMethods;
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+
+/// An RGB reflectance: a number (grey) or three numbers.
+fn rgb(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<[f64; 3]> {
+    if let Ok(v) = ob.extract::<f64>() {
+        return Ok([v; 3]);
+    }
+    let values: Vec<f64> = ob.extract().map_err(|_| {
+        PyTypeError::new_err(format!("{arg} must be a number or three numbers (RGB)"))
+    })?;
+    values.try_into().map_err(|v: Vec<f64>| {
+        Error::Shape {
+            arg,
+            expected: "(3,) or a number".into(),
+            got: format!("({},)", v.len()),
+        }
+        .into()
+    })
+}
+
+/// Samples of ``Phong.sample``.
+#[pyclass(module = "mcsample._core", name = "PhongSample", frozen)]
+pub struct PyPhongSample {
+    /// Sampled directions, (N, 3) or (3,), local frame (normal +z).
+    #[pyo3(get)]
+    wo: Py<PyAny>,
+    /// Their densities per steradian (the mixture of both parts), (N,).
+    #[pyo3(get)]
+    pdf: Py<PyAny>,
+    /// f_r(wi, wo) cos(theta_o) / pdf per RGB channel, (N, 3); 0 below the
+    /// surface.
+    #[pyo3(get)]
+    weight: Py<PyAny>,
+    /// 0 where the diffuse part drew the sample, 1 for the glossy part,
+    /// (N,) int64.
+    #[pyo3(get)]
+    component: Py<PyAny>,
+}
+
+#[pymethods]
+impl PyPhongSample {
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let shape = self.pdf.bind(py).getattr("shape")?;
+        Ok(format!("PhongSample(shape={shape})"))
+    }
+}
+
+/// The energy-normalised modified Phong BRDF (Lafortune and Willems):
+/// f_r(wi, wo) = rho_d / pi + rho_s (n + 2) / (2 pi) max(0, cos alpha)^n,
+/// alpha the angle between wo and the mirror direction of wi; 0 when wi or
+/// wo is below the surface. Directions are in the local frame (normal +z),
+/// ``wi`` toward the viewer, unit length.
+///
+/// Sampling picks the diffuse part (a cosine-weighted direction) with
+/// probability ``diffuse_probability`` and otherwise the glossy part (a
+/// cos^n lobe around the mirror direction); the pdf of every sample is the
+/// mixture of both densities.
+///
+/// Parameters
+/// ----------
+/// diffuse, specular : float or (3,) RGB
+///     rho_d and rho_s, >= 0, with rho_d + rho_s <= 1 in every channel.
+/// exponent : float >= 0
+/// selection : "max" (default) or "luminance"
+///     How the diffuse probability is chosen: max(rho_d) / (max(rho_d) +
+///     max(rho_s)) over channels, or the same with Rec. 709 luminance
+///     (Mitsuba 0.6's rule).
+#[pyclass(module = "mcsample._core", name = "Phong", frozen)]
+pub struct PyPhong(Phong);
+
+impl PyPhong {
+    fn pair<'py, F: PyFloat, const M: usize>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        kernel: impl Fn(&Phong, [F; 3], [F; 3]) -> [F; M] + Sync + Send,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let wi = Points::<F, 3>::extract(wi, "wi")?;
+        let wo = Points::<F, 3>::extract(wo, "wo")?;
+        let phong = &self.0;
+        map_pair(py, (&wi, Check::Finite), (&wo, Check::Finite), |a, b| {
+            kernel(phong, a, b)
+        })
+    }
+}
+
+#[pymethods]
+impl PyPhong {
+    #[new]
+    #[pyo3(signature = (diffuse, specular, exponent, selection = "max"))]
+    fn new(
+        diffuse: &Bound<'_, PyAny>,
+        specular: &Bound<'_, PyAny>,
+        exponent: f64,
+        selection: &str,
+    ) -> PyResult<Self> {
+        let selection = match selection {
+            "max" => Selection::Max,
+            "luminance" => Selection::Luminance,
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "selection = {selection:?}: must be \"max\" or \"luminance\""
+                )));
+            }
+        };
+        let (d, s) = (rgb(diffuse, "diffuse")?, rgb(specular, "specular")?);
+        Ok(Self(Phong::new(d, s, exponent, selection)?))
+    }
+
+    /// BRDF values f_r(wi, wo) per RGB channel, without the cosine.
+    ///
+    /// Parameters
+    /// ----------
+    /// wi, wo : array_like, shape (N, 3) or (3,), unit vectors (a single
+    ///     direction broadcasts)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 3) or (3,), per steradian.
+    fn eval<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(wo, F => self.pair::<F, 3>(py, wi, wo, |p, a, b| p.eval(a, b)))
+    }
+
+    /// The density of ``sample`` at wo for wi, per steradian.
+    ///
+    /// Parameters
+    /// ----------
+    /// wi, wo : array_like, shape (N, 3) or (3,), unit vectors
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for single directions).
+    fn pdf<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(wo, F => self.pair::<F, 1>(py, wi, wo, |p, a, b| [p.pdf(a, b)]))
+    }
+
+    /// Directions drawn for wi.
+    ///
+    /// Parameters
+    /// ----------
+    /// wi : array_like, shape (N, 3) or (3,), unit vectors (one broadcasts)
+    /// u : array_like, shape (N, 3) or (3,), values in [0, 1]: u[:, 2] picks
+    ///     the part, u[:, :2] place the direction
+    ///
+    /// Returns
+    /// -------
+    /// PhongSample
+    ///     ``.wo`` (N, 3), ``.pdf`` (N,), ``.weight`` (N, 3), ``.component``
+    ///     (N,) int64, in u's precision.
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<PyPhongSample> {
+        with_precision!(u, F => self.sample_as::<F>(py, wi, u))
+    }
+
+    /// The probability of sampling the diffuse part.
+    #[getter]
+    fn diffuse_probability(&self) -> f64 {
+        self.0.diffuse_probability()
+    }
+
+    /// rho_d (RGB).
+    #[getter]
+    fn diffuse(&self) -> [f64; 3] {
+        self.0.diffuse()
+    }
+
+    /// rho_s (RGB).
+    #[getter]
+    fn specular(&self) -> [f64; 3] {
+        self.0.specular()
+    }
+
+    /// The lobe exponent n.
+    #[getter]
+    fn exponent(&self) -> f64 {
+        self.0.exponent()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Phong(diffuse={:?}, specular={:?}, exponent={})",
+            self.0.diffuse(),
+            self.0.specular(),
+            self.0.exponent()
+        )
+    }
+}
+
+impl PyPhong {
+    fn sample_as<'py, F: PyFloat>(
+        &self,
+        py: Python<'py>,
+        wi: &Bound<'py, PyAny>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<PyPhongSample> {
+        let wi = Points::<F, 3>::extract(wi, "wi")?;
+        let u = Points::<F, 3>::extract(u, "u")?;
+        let n = pair_len(&wi, &u)?;
+        let batched = wi.batched || u.batched;
+        let (vec_shape, scalar_shape): (Vec<usize>, Vec<usize>) = if batched {
+            (vec![n, 3], vec![n])
+        } else {
+            (vec![3], vec![])
+        };
+        let wo = zeros::<F>(py, &vec_shape);
+        let pdf = zeros::<F>(py, &scalar_shape);
+        let weight = zeros::<F>(py, &vec_shape);
+        let component = zeros::<i64>(py, &scalar_shape);
+        {
+            let (mut g_wo, mut g_pdf) = (wo.readwrite(), pdf.readwrite());
+            let (mut g_w, mut g_c) = (weight.readwrite(), component.readwrite());
+            let outputs = (
+                g_wo.as_slice_mut()?.as_chunks_mut::<3>().0,
+                g_pdf.as_slice_mut()?,
+                g_w.as_slice_mut()?.as_chunks_mut::<3>().0,
+                g_c.as_slice_mut()?,
+            );
+            let (rows_wi, rows_u) = (wi.rows(), u.rows());
+            let (step_wi, step_u) = (usize::from(wi.batched), usize::from(u.batched));
+            let phong = &self.0;
+            let (ok_wi, ok_u) =
+                run_batch_pair(py, n, outputs, |range, (o_wo, o_pdf, o_w, o_c)| {
+                    let (mut ok_wi, mut ok_u) = (true, true);
+                    for (k, i) in range.enumerate() {
+                        let (w, x) = (rows_wi[i * step_wi], rows_u[i * step_u]);
+                        ok_wi &= Check::Finite.holds_all(&w);
+                        ok_u &= Check::Unit.holds_all(&x);
+                        let s = phong.sample(w, x);
+                        (o_wo[k], o_pdf[k], o_w[k], o_c[k]) =
+                            (s.wo, s.pdf, s.weight, i64::from(s.component));
+                    }
+                    (ok_wi, ok_u)
+                })?;
+            if !ok_wi {
+                return Err(wi.invalid(Check::Finite));
+            }
+            if !ok_u {
+                return Err(u.invalid(Check::Unit));
+            }
+        }
+        Ok(PyPhongSample {
+            wo: finish(wo)?.unbind(),
+            pdf: finish(pdf)?.unbind(),
+            weight: finish(weight)?.unbind(),
+            component: finish(component)?.unbind(),
+        })
+    }
+}
