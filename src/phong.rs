@@ -138,58 +138,66 @@ impl Phong {
         let r = reflect(wi);
         let cos_alpha = dot(r, wo);
         if cos_alpha > F::zero() {
-            cos_alpha.powf(F::c(self.exponent))
+            F::pow_positive(cos_alpha.min(F::one()), F::c(self.exponent))
         } else {
             F::zero()
         }
     }
 
     /// The BRDF value `f_r(wi, wo)` per RGB channel (no cosine).
-    #[inline]
+    #[inline(always)]
     pub fn eval<F: Real>(&self, wi: V3<F>, wo: V3<F>) -> V3<F> {
-        if !(wi[2] > F::zero() && wo[2] > F::zero()) {
-            return [F::zero(); 3];
-        }
-        let glossy =
-            F::c((self.exponent + 2.0) * 0.5 * std::f64::consts::FRAC_1_PI) * self.lobe(wi, wo);
-        std::array::from_fn(|k| {
-            F::c(self.diffuse[k] * std::f64::consts::FRAC_1_PI) + F::c(self.specular[k]) * glossy
-        })
+        self.eval_with_lobe(wi, wo, self.lobe(wi, wo))
     }
 
     /// The density of [`Phong::sample`] at `wo`, per steradian.
-    #[inline]
+    #[inline(always)]
     pub fn pdf<F: Real>(&self, wi: V3<F>, wo: V3<F>) -> F {
+        self.pdf_with_lobe(wo, self.lobe(wi, wo))
+    }
+
+    #[inline(always)]
+    fn eval_with_lobe<F: Real>(&self, wi: V3<F>, wo: V3<F>, lobe: F) -> V3<F> {
+        let norm = F::c((self.exponent + 2.0) * 0.5 * std::f64::consts::FRAC_1_PI);
+        let above = wi[2] > F::zero() && wo[2] > F::zero();
+        std::array::from_fn(|k| {
+            let f = F::c(self.diffuse[k] * std::f64::consts::FRAC_1_PI)
+                + F::c(self.specular[k]) * norm * lobe;
+            if above { f } else { F::zero() }
+        })
+    }
+
+    #[inline(always)]
+    fn pdf_with_lobe<F: Real>(&self, wo: V3<F>, lobe: F) -> F {
         let pd = F::c(self.diffuse_probability);
         let diffuse = warp::square_to_cosine_hemisphere_pdf(wo);
-        let glossy =
-            F::c((self.exponent + 1.0) * 0.5 * std::f64::consts::FRAC_1_PI) * self.lobe(wi, wo);
+        let glossy = F::c((self.exponent + 1.0) * 0.5 * std::f64::consts::FRAC_1_PI) * lobe;
         pd * diffuse + (F::one() - pd) * glossy
     }
 
     /// A direction drawn from the mixture for `wi`: `u[2]` picks the part,
     /// `u[0..2]` place the direction. `u` in `[0, 1]³`.
-    #[inline]
+    #[inline(always)]
     pub fn sample<F: Real>(&self, wi: V3<F>, u: [F; 3]) -> PhongSample<F> {
         let diffuse = u[2] < F::c(self.diffuse_probability);
-        let wo = if diffuse {
-            warp::square_to_cosine_hemisphere([u[0], u[1]])
+        // Both candidates, then a select: the loop over samples stays
+        // branch-free.
+        let d = warp::square_to_cosine_hemisphere([u[0], u[1]]);
+        let local = warp::square_to_cosine_power_hemisphere([u[0], u[1]], F::c(self.exponent));
+        let g = Frame::from_normal(reflect(wi)).to_world(local);
+        let wo = if diffuse { d } else { g };
+        let lobe = self.lobe(wi, wo);
+        let pdf = self.pdf_with_lobe(wo, lobe);
+        let f = self.eval_with_lobe(wi, wo, lobe);
+        let scale = if pdf > F::zero() {
+            wo[2].max(F::zero()) / pdf
         } else {
-            let lobe = warp::square_to_cosine_power_hemisphere([u[0], u[1]], F::c(self.exponent));
-            Frame::from_normal(reflect(wi)).to_world(lobe)
-        };
-        let pdf = self.pdf(wi, wo);
-        let f = self.eval(wi, wo);
-        let cos_o = wo[2].max(F::zero());
-        let weight = if pdf > F::zero() {
-            f.map(|v| v * cos_o / pdf)
-        } else {
-            [F::zero(); 3]
+            F::zero()
         };
         PhongSample {
             wo,
             pdf,
-            weight,
+            weight: f.map(|v| v * scale),
             component: u8::from(!diffuse),
         }
     }

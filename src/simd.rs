@@ -65,7 +65,7 @@ pub const STREAM_MIN_BYTES: usize = 16 << 20;
 pub fn map_rows<F, T, const K: usize, const M: usize>(
     out: &mut [[T; M]],
     inputs: &[[F; K]],
-    kernel: &impl Fn([F; K]) -> [T; M],
+    kernel: impl Fn([F; K]) -> [T; M],
     valid: impl Fn(&[F; K]) -> bool,
     stream: bool,
 ) -> bool

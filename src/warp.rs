@@ -274,7 +274,7 @@ pub fn cosine_hemisphere_to_square_polar<F: Real>(d: V3<F>) -> P2<F> {
 /// [`cosine_power_hemisphere_to_square`]: `(φ/2π, cos^{n+1} θ)`.
 #[inline(always)]
 pub fn square_to_cosine_power_hemisphere<F: Real>(u: P2<F>, exponent: F) -> V3<F> {
-    let cos_theta = u[1].powf(F::one() / (exponent + F::one()));
+    let cos_theta = F::pow_positive(u[1], F::one() / (exponent + F::one()));
     let sin_theta = safe_sqrt(F::one() - cos_theta * cos_theta);
     let (s, c) = sin_cos_turn(u[0]);
     [c * sin_theta, s * sin_theta, cos_theta]
@@ -284,7 +284,7 @@ pub fn square_to_cosine_power_hemisphere<F: Real>(u: P2<F>, exponent: F) -> V3<F
 #[inline(always)]
 pub fn square_to_cosine_power_hemisphere_pdf<F: Real>(d: V3<F>, exponent: F) -> F {
     if d[2] > F::zero() {
-        (exponent + F::one()) / two_pi::<F>() * d[2].powf(exponent)
+        (exponent + F::one()) / two_pi::<F>() * F::pow_positive(d[2], exponent)
     } else {
         F::zero()
     }
@@ -294,7 +294,10 @@ pub fn square_to_cosine_power_hemisphere_pdf<F: Real>(d: V3<F>, exponent: F) -> 
 #[inline(always)]
 pub fn cosine_power_hemisphere_to_square<F: Real>(d: V3<F>, exponent: F) -> P2<F> {
     let z = d[2].max(F::zero()).min(F::one());
-    [turn_fraction(d[0], d[1]), z.powf(exponent + F::one())]
+    [
+        turn_fraction(d[0], d[1]),
+        F::pow_positive(z, exponent + F::one()),
+    ]
 }
 
 /// Uniform direction in the cone `cos θ ≥ cos_cutoff` around +z, from a
@@ -379,14 +382,14 @@ pub fn uniform_triangle_to_square<F: Real>(p: P2<F>) -> P2<F> {
 /// [`power_to_interval`]: `u = x^{n+1}`.
 #[inline(always)]
 pub fn interval_to_power<F: Real>(u: F, exponent: F) -> F {
-    u.powf(F::one() / (exponent + F::one()))
+    F::pow_positive(u, F::one() / (exponent + F::one()))
 }
 
 /// Density of [`interval_to_power`].
 #[inline(always)]
 pub fn interval_to_power_pdf<F: Real>(x: F, exponent: F) -> F {
     if x >= F::zero() && x <= F::one() {
-        (exponent + F::one()) * x.powf(exponent)
+        (exponent + F::one()) * F::pow_positive(x, exponent)
     } else {
         F::zero()
     }
@@ -395,7 +398,7 @@ pub fn interval_to_power_pdf<F: Real>(x: F, exponent: F) -> F {
 /// Inverse of [`interval_to_power`].
 #[inline(always)]
 pub fn power_to_interval<F: Real>(x: F, exponent: F) -> F {
-    clamp01(x).powf(exponent + F::one())
+    F::pow_positive(clamp01(x), exponent + F::one())
 }
 
 #[cfg(test)]

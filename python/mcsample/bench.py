@@ -206,10 +206,57 @@ def suite_distr(n: int, repeat: int, mi) -> list[Timing]:
     return out
 
 
+def _numpy_phong_sample(wi, u, kd, ks, n, pd):
+    """Phong.sample vectorised with numpy (float64): mixture selection,
+    cosine or cos^n lobe around the mirror direction, pdf and weight."""
+    r = np.array([-wi[0], -wi[1], wi[2]])
+    diffuse = u[:, 2] < pd
+    d = _numpy_cosine_hemisphere(u[:, :2])
+    phi = 2 * np.pi * u[:, 0]
+    cos_t = u[:, 1] ** (1 / (n + 1))
+    sin_t = np.sqrt(np.maximum(0, 1 - cos_t ** 2))
+    local = np.stack([np.cos(phi) * sin_t, np.sin(phi) * sin_t, cos_t], 1)
+    sign = np.copysign(1.0, r[2])
+    a = -1 / (sign + r[2])
+    b = r[0] * r[1] * a
+    s_ax = np.array([1 + sign * r[0] ** 2 * a, sign * b, -sign * r[0]])
+    t_ax = np.array([b, sign + r[1] ** 2 * a, -r[1]])
+    lobe_dir = local[:, :1] * s_ax + local[:, 1:2] * t_ax + local[:, 2:] * r
+    wo = np.where(diffuse[:, None], d, lobe_dir)
+    cos_a = np.maximum(wo @ r, 0)
+    lobe = cos_a ** n
+    cos_o = np.maximum(wo[:, 2], 0)
+    pdf = pd * cos_o / np.pi + (1 - pd) * (n + 1) / (2 * np.pi) * lobe
+    f = kd / np.pi + ks * ((n + 2) / (2 * np.pi) * lobe)[:, None]
+    f = np.where((cos_o > 0)[:, None], f, 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        weight = np.where((pdf > 0)[:, None], f * cos_o[:, None] / pdf[:, None], 0)
+    return wo, pdf, weight
+
+
+def suite_phong(n: int, repeat: int, mi) -> list[Timing]:
+    """Phong.sample (10^7 directions for one wi, exponent 50) against numpy."""
+    kd, ks, exponent = np.array([0.2, 0.3, 0.1]), np.array([0.7, 0.5, 0.6]), 50.0
+    phong = mcs.Phong(kd, ks, exponent)
+    wi = np.array([np.sin(0.5), 0.0, np.cos(0.5)])
+    u64 = mcs.uniform(n, 3, seed=3)
+    u32 = u64.astype(np.float32)
+    pd = phong.diffuse_probability
+    return [
+        Timing("Phong.sample (exponent 50)", "mcsample", "float64", n,
+               measure(lambda: phong.sample(wi, u64), repeat)),
+        Timing("Phong.sample (exponent 50)", "mcsample", "float32", n,
+               measure(lambda: phong.sample(wi, u32), repeat)),
+        Timing("Phong.sample (exponent 50)", "numpy", "float64", n,
+               measure(lambda: _numpy_phong_sample(wi, u64, kd, ks, exponent, pd), max(repeat // 2, 1), 1)),
+    ]
+
+
 SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
     "rng": suite_rng,
     "warps": suite_warps,
     "distr": suite_distr,
+    "phong": suite_phong,
 }
 
 

@@ -6,6 +6,7 @@ use super::arrays::{
 };
 use crate::error::Error;
 use crate::phong::{Phong, Selection};
+use crate::simd::map_rows;
 use numpy::PyArrayMethods;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -245,9 +246,42 @@ impl PyPhong {
             let phong = &self.0;
             let (ok_wi, ok_u) =
                 run_batch_pair(py, n, outputs, |range, (o_wo, o_pdf, o_w, o_c)| {
+                    if step_wi == 0 {
+                        // One wi for all rows: the vectorised block loop, into
+                        // rows of (wo, pdf, weight, component), then split.
+                        let w = rows_wi[0];
+                        let ok_wi = Check::Finite.holds_all(&w);
+                        let mut rows = vec![[F::zero(); 8]; range.len()];
+                        // A single u (then n = 1) or one per row.
+                        let inputs = if step_u == 0 {
+                            &rows_u[..1]
+                        } else {
+                            &rows_u[range]
+                        };
+                        let ok_u = map_rows(
+                            &mut rows,
+                            inputs,
+                            #[inline(always)]
+                            |x: [F; 3]| {
+                                let s = phong.sample(w, x);
+                                let [a, b, c] = s.wo;
+                                let [d, e, f] = s.weight;
+                                [a, b, c, s.pdf, d, e, f, F::c(f64::from(s.component))]
+                            },
+                            |x| Check::Unit.holds_all(x),
+                            false,
+                        );
+                        for (k, r) in rows.iter().enumerate() {
+                            o_wo[k] = [r[0], r[1], r[2]];
+                            o_pdf[k] = r[3];
+                            o_w[k] = [r[4], r[5], r[6]];
+                            o_c[k] = r[7].f64() as i64;
+                        }
+                        return (ok_wi, ok_u);
+                    }
                     let (mut ok_wi, mut ok_u) = (true, true);
                     for (k, i) in range.enumerate() {
-                        let (w, x) = (rows_wi[i * step_wi], rows_u[i * step_u]);
+                        let (w, x) = (rows_wi[i], rows_u[i * step_u]);
                         ok_wi &= Check::Finite.holds_all(&w);
                         ok_u &= Check::Unit.holds_all(&x);
                         let s = phong.sample(w, x);
