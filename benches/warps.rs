@@ -83,7 +83,10 @@ fn main() {
         &u,
         warp::square_to_uniform_triangle,
     );
-    rate("square_to_cosine_power_hemisphere", &u, |u| {
-        warp::square_to_cosine_power_hemisphere(u, 10.0)
-    });
+    rate(
+        "square_to_cosine_power_hemisphere",
+        &u,
+        #[inline(always)]
+        |u| warp::square_to_cosine_power_hemisphere(u, 10.0),
+    );
 }

@@ -53,7 +53,11 @@ pub const STREAM_MIN_BYTES: usize = 16 << 20;
 
 /// `out[i] = kernel(inputs[i])` for every row, compiled for the widest
 /// vector unit (see [`dispatch`]); returns whether `valid` holds for every
-/// input row. Both closures must be branch-free for the loop to vectorise.
+/// input row. Both closures must be branch-free for the loop to vectorise,
+/// and `kernel` must be inlined into it: a function marked
+/// `#[inline(always)]`, or a closure so marked (the dispatch calls it from
+/// one function per instruction set, which LLVM's own heuristics would
+/// decline for a large body).
 ///
 /// Rows are interleaved (`[x, y]`, `[x, y, z]`), which the vectoriser
 /// handles only at half width inside a kernel loop; each block of [`BLOCK`]
@@ -65,7 +69,7 @@ pub const STREAM_MIN_BYTES: usize = 16 << 20;
 pub fn map_rows<F, T, const K: usize, const M: usize>(
     out: &mut [[T; M]],
     inputs: &[[F; K]],
-    kernel: impl Fn([F; K]) -> [T; M],
+    kernel: &impl Fn([F; K]) -> [T; M],
     valid: impl Fn(&[F; K]) -> bool,
     stream: bool,
 ) -> bool

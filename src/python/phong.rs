@@ -258,16 +258,19 @@ impl PyPhong {
                         } else {
                             &rows_u[range]
                         };
-                        let ok_u = map_rows(
-                            &mut rows,
-                            inputs,
+                        let sample = {
                             #[inline(always)]
                             |x: [F; 3]| {
                                 let s = phong.sample(w, x);
                                 let [a, b, c] = s.wo;
                                 let [d, e, f] = s.weight;
                                 [a, b, c, s.pdf, d, e, f, F::c(f64::from(s.component))]
-                            },
+                            }
+                        };
+                        let ok_u = map_rows(
+                            &mut rows,
+                            inputs,
+                            &sample,
                             |x| Check::Unit.holds_all(x),
                             false,
                         );

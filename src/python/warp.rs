@@ -316,6 +316,7 @@ batch_fn! {
     /// (n + 1)/(2 pi) cos^n theta per sr.
     fn square_to_cosine_power_hemisphere(u: [2; Unit], exponent: f64) = |F| {
         let n = exponent_arg::<F>(exponent)?;
+        #[inline(always)]
         move |u| warp::square_to_cosine_power_hemisphere(u, n)
     }
 }
@@ -333,6 +334,7 @@ batch_fn! {
     /// ndarray, shape (N,) (a scalar for one direction).
     fn square_to_cosine_power_hemisphere_pdf(x: [3; Finite], exponent: f64) = |F| {
         let n = exponent_arg::<F>(exponent)?;
+        #[inline(always)]
         move |d| [warp::square_to_cosine_power_hemisphere_pdf(d, n)]
     }
 }
@@ -350,6 +352,7 @@ batch_fn! {
     /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
     fn cosine_power_hemisphere_to_square(x: [3; Finite], exponent: f64) = |F| {
         let n = exponent_arg::<F>(exponent)?;
+        #[inline(always)]
         move |d| warp::cosine_power_hemisphere_to_square(d, n)
     }
 }
@@ -367,6 +370,7 @@ batch_fn! {
     /// 1 / (2 pi (1 - cos_cutoff)) per sr.
     fn square_to_uniform_cone(u: [2; Unit], cos_cutoff: f64) = |F| {
         let c = cos_cutoff_arg::<F>(cos_cutoff)?;
+        #[inline(always)]
         move |u| warp::square_to_uniform_cone(u, c)
     }
 }
@@ -384,6 +388,7 @@ batch_fn! {
     /// ndarray, shape (N,) (a scalar for one direction).
     fn square_to_uniform_cone_pdf(x: [3; Finite], cos_cutoff: f64) = |F| {
         let c = cos_cutoff_arg::<F>(cos_cutoff)?;
+        #[inline(always)]
         move |d| [warp::square_to_uniform_cone_pdf(d, c)]
     }
 }
@@ -400,6 +405,7 @@ batch_fn! {
     /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
     fn uniform_cone_to_square(x: [3; Finite], cos_cutoff: f64) = |F| {
         let c = cos_cutoff_arg::<F>(cos_cutoff)?;
+        #[inline(always)]
         move |d| warp::uniform_cone_to_square(d, c)
     }
 }
@@ -456,6 +462,7 @@ batch_fn! {
     /// ndarray, shape (N,) (a scalar for a scalar u).
     fn interval_to_power(u: [1; Unit], exponent: f64) = |F| {
         let n = exponent_arg::<F>(exponent)?;
+        #[inline(always)]
         move |u: [F; 1]| [warp::interval_to_power(u[0], n)]
     }
 }
@@ -473,6 +480,7 @@ batch_fn! {
     /// ndarray, shape (N,) (a scalar for a scalar x).
     fn interval_to_power_pdf(x: [1; Finite], exponent: f64) = |F| {
         let n = exponent_arg::<F>(exponent)?;
+        #[inline(always)]
         move |x: [F; 1]| [warp::interval_to_power_pdf(x[0], n)]
     }
 }
@@ -489,6 +497,7 @@ batch_fn! {
     /// ndarray, shape (N,) (a scalar for a scalar x).
     fn power_to_interval(x: [1; Finite], exponent: f64) = |F| {
         let n = exponent_arg::<F>(exponent)?;
+        #[inline(always)]
         move |x: [F; 1]| [warp::power_to_interval(x[0], n)]
     }
 }
