@@ -16,7 +16,7 @@ import subprocess
 import sys
 from types import ModuleType
 
-__all__ = ["available", "choose_variant", "find_libllvm", "llvm_usable", "load"]
+__all__ = ["available", "choose_variant", "find_libllvm", "llvm_usable", "load", "register_phong"]
 
 #: Oldest libLLVM major version Dr.Jit's LLVM backend accepts.
 MIN_LLVM = 16
@@ -114,3 +114,27 @@ def load(variant: str | None = None) -> ModuleType:
 
     mi.set_variant(variant)
     return mi
+
+
+_REGISTERED: set[str] = set()
+
+
+def register_phong() -> str:
+    """Registers mcsample's Phong BSDF for the current Mitsuba variant (set
+    one first, e.g. with :func:`load`) and returns its type name,
+    ``"mcsample_phong"``. Its keys are ``diffuse_reflectance`` and
+    ``specular_reflectance`` (a float, an RGB triple or a constant
+    texture) and ``exponent``; it is written in Dr.Jit, independently of
+    the Rust :class:`mcsample.Phong`, with the same formula and sampling."""
+    import mitsuba as mi
+
+    from .mitsuba_phong import TYPE_NAME, make_class
+
+    variant = mi.variant()
+    if variant is None:
+        raise RuntimeError("set a Mitsuba variant first (mcsample.mitsuba.load())")
+    if variant not in _REGISTERED:
+        cls = make_class(mi)
+        mi.register_bsdf(TYPE_NAME, lambda props: cls(props))
+        _REGISTERED.add(variant)
+    return TYPE_NAME
