@@ -80,46 +80,25 @@ where
     let ok = dispatch(
         #[inline(always)]
         || {
+            // Full blocks straight from the slices; the last, partial block
+            // padded with copies of its first row, in its own code path (a
+            // shared one would copy every block through the padding).
+            let (in_blocks, in_tail) = inputs.as_chunks::<BLOCK>();
+            let (out_blocks, out_tail) = out.as_chunks_mut::<BLOCK>();
             let mut ok = true;
-            for (out, inputs) in out.chunks_mut(BLOCK).zip(inputs.chunks(BLOCK)) {
-                let n = inputs.len();
-                // Every loop below runs exactly BLOCK times, so that it
-                // vectorises without a scalar remainder: the last, partial
-                // block is padded with copies of its first row.
-                let padded: [[F; K]; BLOCK];
-                let block: &[[F; K]; BLOCK] = match inputs.try_into() {
-                    Ok(full) => full,
-                    Err(_) => {
-                        padded = std::array::from_fn(|i| inputs[if i < n { i } else { 0 }]);
-                        &padded
-                    }
-                };
-                let mut columns = [[F::default(); BLOCK]; K];
-                for i in 0..BLOCK {
-                    for k in 0..K {
-                        columns[k][i] = block[i][k];
-                    }
-                }
-                let mut results = [[T::default(); BLOCK]; M];
-                for i in 0..BLOCK {
-                    let x = std::array::from_fn(|k| columns[k][i]);
-                    ok &= valid(&x);
-                    let r = kernel(x);
-                    for m in 0..M {
-                        results[m][i] = r[m];
-                    }
-                }
-                match <&mut [[T; M]; BLOCK]>::try_from(&mut *out) {
-                    Ok(full) if !stream => interleave(&results, full),
-                    _ => {
-                        let mut rows = [[T::default(); M]; BLOCK];
-                        interleave(&results, &mut rows);
-                        if stream {
-                            stream_copy(out, &rows[..n]);
-                        } else {
-                            out.copy_from_slice(&rows[..n]);
-                        }
-                    }
+            for (o, i) in out_blocks.iter_mut().zip(in_blocks) {
+                ok &= map_block(o, i, kernel, &valid, stream);
+            }
+            if let Some(&first) = in_tail.first() {
+                let n = in_tail.len();
+                let padded: [[F; K]; BLOCK] =
+                    std::array::from_fn(|i| if i < n { in_tail[i] } else { first });
+                let mut rows = [[T::default(); M]; BLOCK];
+                ok &= map_block(&mut rows, &padded, kernel, &valid, false);
+                if stream {
+                    stream_copy(out_tail, &rows[..n]);
+                } else {
+                    out_tail.copy_from_slice(&rows[..n]);
                 }
             }
             ok
@@ -127,6 +106,47 @@ where
     );
     if stream {
         store_fence();
+    }
+    ok
+}
+
+/// One block of [`map_rows`]: transpose to columns, map, transpose back
+/// (into `out`, or with `stream` through a buffer and non-temporal stores).
+/// Every loop runs exactly [`BLOCK`] times.
+#[inline(always)]
+fn map_block<F, T, const K: usize, const M: usize>(
+    out: &mut [[T; M]; BLOCK],
+    inputs: &[[F; K]; BLOCK],
+    kernel: &impl Fn([F; K]) -> [T; M],
+    valid: &impl Fn(&[F; K]) -> bool,
+    stream: bool,
+) -> bool
+where
+    F: Copy + Default,
+    T: Copy + Default,
+{
+    let mut columns = [[F::default(); BLOCK]; K];
+    for i in 0..BLOCK {
+        for k in 0..K {
+            columns[k][i] = inputs[i][k];
+        }
+    }
+    let mut ok = true;
+    let mut results = [[T::default(); BLOCK]; M];
+    for i in 0..BLOCK {
+        let x = std::array::from_fn(|k| columns[k][i]);
+        ok &= valid(&x);
+        let r = kernel(x);
+        for m in 0..M {
+            results[m][i] = r[m];
+        }
+    }
+    if stream {
+        let mut rows = [[T::default(); M]; BLOCK];
+        interleave(&results, &mut rows);
+        stream_copy(out, &rows);
+    } else {
+        interleave(&results, out);
     }
     ok
 }
