@@ -5,8 +5,10 @@
 //!
 //! This module holds the crate's only `unsafe`: calling a function compiled
 //! for an instruction set, which is sound because the CPU was just checked
-//! to have it. Results do not depend on the path taken: no floating-point
-//! contraction is enabled, so each operation rounds the same way.
+//! to have it, and the non-temporal stores of large outputs (raw-pointer
+//! intrinsics, bounds and alignment argued at each use). Results do not
+//! depend on the path taken: no floating-point contraction is enabled, so
+//! each operation rounds the same way.
 
 /// Runs `f` compiled for the widest vector unit this CPU has: AVX-512
 /// (F, VL, DQ, BW), else AVX2 + FMA (x86-64), else the baseline target.
