@@ -3,7 +3,7 @@ a density given as a Python callable.
 
 - :class:`Discrete1D`: CDF inversion (guide table + binary search);
   ``sample``, ``sample_reuse``, ``pmf``, ``cdf``, ``sum``.
-- :class:`AliasTable`: Vose's alias method, O(1) per sample.
+- :class:`AliasTable`: Walker's alias method (built by sweeping), O(1) per sample.
 - :class:`Discrete2D`: a row from the marginal, then a column.
 - :class:`PiecewiseConstant1D` / :class:`PiecewiseConstant2D`: densities
   constant on equal cells, sampled by inverting their CDFs, with ``pdf`` and

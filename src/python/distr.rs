@@ -172,7 +172,7 @@ impl PyDiscrete1D {
     }
 }
 
-/// An alias table (Vose's method): O(1) sampling of the distribution over
+/// An alias table (Walker's method, built by sweeping): O(1) sampling over
 /// 0..n-1 proportional to ``weights``, with one uniform number per sample.
 /// Same probabilities as ``Discrete1D``, a different map from u to indices;
 /// an entry of weight 0 is never returned.

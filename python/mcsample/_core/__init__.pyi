@@ -63,7 +63,7 @@ class Discrete1D:
 
 @final
 class AliasTable:
-    """Vose's alias table: O(1) sampling of 0..n-1 proportional to weights."""
+    """Walker's alias table: O(1) sampling of 0..n-1 proportional to weights."""
 
     def __new__(cls, weights: ArrayLike) -> AliasTable: ...
     def sample(self, u: ArrayLike) -> Any: ...
