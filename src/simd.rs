@@ -10,25 +10,64 @@
 //! depend on the path taken: no floating-point contraction is enabled, so
 //! each operation rounds the same way.
 
-/// Runs `f` compiled for the widest vector unit this CPU has: AVX-512
-/// (F, VL, DQ, BW), else AVX2 + FMA (x86-64), else the baseline target.
-/// Mark the closure `#[inline(always)]` so that its body is compiled inside
-/// the dispatching function.
-#[inline(always)]
-pub fn dispatch<R>(f: impl FnOnce() -> R) -> R {
+/// Name of the environment variable that caps the instruction set batch
+/// loops use: `avx512`, `avx2` or `baseline` (for tests and debugging;
+/// results are the same bits on every path).
+pub const SIMD_VAR: &str = "MCSAMPLE_SIMD";
+
+/// The instruction sets [`dispatch`] can use, widest last.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Level {
+    /// The target's baseline (SSE2 on x86-64).
+    Baseline,
+    /// AVX2 and FMA.
+    Avx2,
+    /// AVX-512 F, VL, DQ and BW.
+    Avx512,
+}
+
+/// The widest [`Level`] this CPU has, capped by `MCSAMPLE_SIMD` (read once).
+pub fn level() -> Level {
+    static LEVEL: std::sync::OnceLock<Level> = std::sync::OnceLock::new();
+    *LEVEL.get_or_init(|| {
+        let cap = match std::env::var(SIMD_VAR).as_deref() {
+            Ok("baseline") => Level::Baseline,
+            Ok("avx2") => Level::Avx2,
+            _ => Level::Avx512,
+        };
+        detected().min(cap)
+    })
+}
+
+fn detected() -> Level {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::is_x86_feature_detected as has;
         if has!("avx512f") && has!("avx512vl") && has!("avx512dq") && has!("avx512bw") {
-            #[allow(unsafe_code)]
-            // SAFETY: the CPU supports these AVX-512 subsets, checked just above.
-            return unsafe { avx512(f) };
+            return Level::Avx512;
         }
         if has!("avx2") && has!("fma") {
-            #[allow(unsafe_code)]
-            // SAFETY: the CPU supports AVX2 and FMA, checked just above.
-            return unsafe { avx2_fma(f) };
+            return Level::Avx2;
         }
+    }
+    Level::Baseline
+}
+
+/// Runs `f` compiled for the widest vector unit this CPU has ([`level`]):
+/// AVX-512 (F, VL, DQ, BW), else AVX2 + FMA (x86-64), else the baseline
+/// target. Mark the closure `#[inline(always)]` so that its body is
+/// compiled inside the dispatching function.
+#[inline(always)]
+pub fn dispatch<R>(f: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    match level() {
+        #[allow(unsafe_code)]
+        // SAFETY: `level` reports AVX-512 only when the CPU has these subsets.
+        Level::Avx512 => return unsafe { avx512(f) },
+        #[allow(unsafe_code)]
+        // SAFETY: `level` reports AVX2 only when the CPU has AVX2 and FMA.
+        Level::Avx2 => return unsafe { avx2_fma(f) },
+        Level::Baseline => {}
     }
     f()
 }

@@ -206,3 +206,33 @@ def test_large_batches_stream_the_same_bits():
     u32 = u.astype(np.float32)
     big32 = warp.square_to_uniform_disk(np.concatenate([u32] * 3))
     assert np.array_equal(big32[:len(u)], warp.square_to_uniform_disk(u32[:len(u)]))
+
+
+def test_every_instruction_set_gives_the_same_bits(tmp_path):
+    # Batch loops dispatch to AVX-512, AVX2 + FMA or the baseline target;
+    # MCSAMPLE_SIMD caps the choice. Each path must round the same way.
+    code = (
+        "import sys, numpy as np, mcsample as mcs\n"
+        "from mcsample import warp\n"
+        "u = mcs.uniform(100_003, 3, seed=4)\n"
+        "out = {}\n"
+        "for dt in (np.float64, np.float32):\n"
+        "    v = u.astype(dt)\n"
+        "    out[f'sphere{dt.__name__}'] = warp.square_to_uniform_sphere(v[:, :2])\n"
+        "    out[f'cosine{dt.__name__}'] = warp.square_to_cosine_hemisphere(v[:, :2])\n"
+        "    out[f'cone{dt.__name__}'] = warp.square_to_uniform_cone(v[:, :2], 0.3)\n"
+        "    out[f'power{dt.__name__}'] = warp.square_to_cosine_power_hemisphere(v[:, :2], 37.0)\n"
+        "    out[f'phong{dt.__name__}'] = mcs.Phong(0.3, 0.6, 20.0).sample([0.6, 0, 0.8], v).weight\n"
+        "np.savez(sys.argv[1], **out)\n"
+    )
+    results = {}
+    for level in ("avx512", "avx2", "baseline"):
+        path = tmp_path / f"{level}.npz"
+        env = dict(os.environ, MCSAMPLE_SIMD=level)
+        done = subprocess.run([sys.executable, "-c", code, str(path)], env=env,
+                              capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr[-2000:]
+        results[level] = np.load(path)
+    for key in results["avx512"].files:
+        for level in ("avx2", "baseline"):
+            assert np.array_equal(results["avx512"][key], results[level][key]), (key, level)
