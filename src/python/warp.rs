@@ -3,7 +3,7 @@
 //! float32, checks `u ∈ [0, 1]` (or finiteness of points) in the kernel's
 //! own pass, and runs on all cores with the GIL released.
 
-use super::arrays::{Check, Points, map_into, with_precision};
+use super::arrays::{Check, Points, PyFloat, map_into, with_precision};
 use crate::error::Error;
 use crate::math::Real;
 use crate::warp;
@@ -248,17 +248,40 @@ pub fn square_to_cosine_hemisphere<'py>(
     method: &str,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    // The method is chosen outside the batch loop, which must stay
-    // branch-free to vectorise.
-    let polar = polar_arg(method)?;
-    with_precision!(u, F => {
-        let points = Points::<F, 2>::extract(u, "u")?;
-        if polar {
-            map_into(py, &points, Check::Unit, out, warp::square_to_cosine_hemisphere_polar::<F>)
-        } else {
-            map_into(py, &points, Check::Unit, out, warp::square_to_cosine_hemisphere::<F>)
-        }
-    })
+    with_precision!(u, F => by_method(
+        py, u, "u", Check::Unit, method, out,
+        warp::square_to_cosine_hemisphere_polar::<F>,
+        warp::square_to_cosine_hemisphere::<F>,
+    ))
+}
+
+/// Maps `x` (argument `arg`) through `polar` or `concentric` as `method`
+/// asks: the choice is made outside the batch loop, which must stay
+/// branch-free to vectorise.
+#[allow(clippy::too_many_arguments)]
+fn by_method<'py, F: PyFloat, const K: usize, const M: usize, P, C>(
+    py: Python<'py>,
+    x: &Bound<'py, PyAny>,
+    arg: &'static str,
+    check: Check,
+    method: &str,
+    out: Option<&Bound<'py, PyAny>>,
+    polar: P,
+    concentric: C,
+) -> PyResult<Bound<'py, PyAny>>
+where
+    // Generic (not fn pointers), so that the kernels stay inlined into the
+    // vectorised loop.
+    P: Fn([F; K]) -> [F; M] + Sync + Send,
+    C: Fn([F; K]) -> [F; M] + Sync + Send,
+{
+    let use_polar = polar_arg(method)?;
+    let points = Points::<F, K>::extract(x, arg)?;
+    if use_polar {
+        map_into(py, &points, check, out, polar)
+    } else {
+        map_into(py, &points, check, out, concentric)
+    }
 }
 batch_fn! {
     /// Density of ``square_to_cosine_hemisphere`` (either method):
@@ -291,15 +314,11 @@ pub fn cosine_hemisphere_to_square<'py>(
     method: &str,
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let polar = polar_arg(method)?;
-    with_precision!(x, F => {
-        let points = Points::<F, 3>::extract(x, "x")?;
-        if polar {
-            map_into(py, &points, Check::Finite, out, warp::cosine_hemisphere_to_square_polar::<F>)
-        } else {
-            map_into(py, &points, Check::Finite, out, warp::cosine_hemisphere_to_square::<F>)
-        }
-    })
+    with_precision!(x, F => by_method(
+        py, x, "x", Check::Finite, method, out,
+        warp::cosine_hemisphere_to_square_polar::<F>,
+        warp::cosine_hemisphere_to_square::<F>,
+    ))
 }
 batch_fn! {
     /// Directions of the cos^n lobe around +z (the Phong lobe):
