@@ -43,6 +43,17 @@ pub enum Error {
         /// What the value must satisfy, e.g. `must be >= 0`.
         requirement: &'static str,
     },
+    /// A choice among named options that is unknown or does not fit the
+    /// other arguments.
+    #[error("{arg} = {value:?}: {requirement}")]
+    Choice {
+        /// Name of the argument.
+        arg: &'static str,
+        /// The value given.
+        value: String,
+        /// What it must be.
+        requirement: String,
+    },
     /// An entry of a batch outside its valid range (e.g. `u` outside `[0, 1]`).
     #[error("{arg}{index} = {value}: {requirement}")]
     Element {

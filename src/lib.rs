@@ -11,6 +11,8 @@
 //! - [`buffer`]: large flat arrays on huge pages.
 //! - [`distr`]: discrete tables (CDF inversion, alias), 2D tables and
 //!   piecewise-constant densities.
+//! - [`envmap`]: environment maps (lat-long, angular, cube) and their
+//!   importance sampling.
 //! - [`phong`]: the energy-normalised Phong BRDF and its sampling.
 //! - [`mis`]: multiple importance sampling heuristics.
 //! - [`frame`]: orthonormal frames around a normal.
@@ -32,6 +34,7 @@
 
 pub mod buffer;
 pub mod distr;
+pub mod envmap;
 pub mod error;
 pub mod frame;
 pub mod io;

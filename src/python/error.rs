@@ -16,6 +16,7 @@ impl From<Error> for PyErr {
             | Error::Shape { .. }
             | Error::Parameter { .. }
             | Error::Element { .. }
+            | Error::Choice { .. }
             | Error::Integer { .. }
             | Error::TooLarge { .. }
             | Error::Index { .. }

@@ -1,0 +1,242 @@
+//! The texels of an environment map and their bilinear interpolation, per
+//! [`Mapping`].
+//!
+//! - Lat-long (as Mitsuba 3): texel column `x` is centred at
+//!   `s = (x + ½)/W` and the columns are periodic in `s`; row `y` lies at
+//!   `t = y/(H − 1)`, so row 0 is exactly the +Y pole and row `H − 1` the −Y
+//!   pole.
+//! - Angular and cube faces: texel `(x, y)` is centred at
+//!   `((x + ½)/W, (y + ½)/H)` of its square, clamped to the edge texels
+//!   beyond the outermost centres; an angular map is black outside its unit
+//!   circle.
+
+use super::mapping::Mapping;
+use crate::error::{Error, Result};
+use crate::math::luminance;
+
+/// RGB texels, row-major, row 0 at the top; a cube map stores its six
+/// `R × R` faces one below the other (`height = 6R`).
+#[derive(Clone, Debug)]
+pub struct Image {
+    width: usize,
+    height: usize,
+    texels: Vec<[f32; 3]>,
+}
+
+/// The four texels around a point and their bilinear weights (all 0
+/// where the map has no light).
+pub type Corners = ([usize; 4], [f64; 4]);
+
+impl Image {
+    /// An image of `width × height` RGB texels (`data` row-major, 3 floats
+    /// a texel) for `mapping`, checked to be finite and `>= 0`. Lat-long
+    /// maps narrower than 2 columns or shorter than 3 rows are padded by
+    /// repeating the last column / row (the smallest Mitsuba accepts).
+    ///
+    /// # Errors
+    /// [`Error::Shape`] for an empty image, a non-square angular map or
+    /// cube face; [`Error::InvalidWeight`] for a NaN, infinite or negative
+    /// value, named `image[y, x, c]` (`image[face, y, x, c]` for cube maps).
+    pub fn new(mapping: Mapping, width: usize, height: usize, data: &[f32]) -> Result<Self> {
+        let shape_error = |expected: &str| Error::Shape {
+            arg: "image",
+            expected: expected.into(),
+            got: format!("({height}, {width}, 3)"),
+        };
+        if width == 0 || height == 0 || data.len() != width * height * 3 {
+            return Err(shape_error("(H, W, 3) with H, W >= 1"));
+        }
+        match mapping {
+            Mapping::Angular if width != height => return Err(shape_error("(R, R, 3): square")),
+            Mapping::Cube if height != 6 * width => {
+                return Err(Error::Shape {
+                    arg: "image",
+                    expected: "(6, R, R, 3)".into(),
+                    got: format!("({}, {width}, {width}, 3)", height as f64 / width as f64),
+                });
+            }
+            _ => {}
+        }
+        if let Some(i) = data.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+            let (pixel, c) = (i / 3, i % 3);
+            let (y, x) = (pixel / width, pixel % width);
+            let index = match mapping {
+                Mapping::Cube => format!("[{}, {}, {x}, {c}]", y / width, y % width),
+                _ => format!("[{y}, {x}, {c}]"),
+            };
+            return Err(Error::InvalidWeight {
+                arg: "image",
+                index,
+                value: f64::from(data[i]),
+            });
+        }
+        let mut texels: Vec<[f32; 3]> = data.as_chunks::<3>().0.to_vec();
+        let (mut width, mut height) = (width, height);
+        if mapping == Mapping::LatLong && width < 2 {
+            texels = texels.iter().flat_map(|&t| [t, t]).collect();
+            width = 2;
+        }
+        if mapping == Mapping::LatLong && height < 3 {
+            let last = texels[(height - 1) * width..].to_vec();
+            for _ in height..3 {
+                texels.extend_from_slice(&last);
+            }
+            height = 3;
+        }
+        Ok(Image {
+            width,
+            height,
+            texels,
+        })
+    }
+
+    /// Columns.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Rows (`6R` for a cube map).
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// All texels, row-major.
+    pub fn texels(&self) -> &[[f32; 3]] {
+        &self.texels
+    }
+
+    /// Texel `i` (row-major index) as `f64`.
+    #[inline(always)]
+    pub fn texel(&self, i: usize) -> [f64; 3] {
+        self.texels[i].map(f64::from)
+    }
+
+    /// Luminance of texel `i`.
+    #[inline(always)]
+    pub fn texel_luminance(&self, i: usize) -> f64 {
+        luminance(self.texel(i))
+    }
+
+    /// The texels around `p` and their weights (see the module docs).
+    #[inline]
+    pub fn corners(&self, mapping: Mapping, p: [f64; 2]) -> Corners {
+        let (w, h) = (self.width, self.height);
+        match mapping {
+            Mapping::LatLong => {
+                let x = p[0] - 0.5 / w as f64;
+                let x = (x - x.floor()) * w as f64;
+                let y = p[1].clamp(0.0, 1.0) * (h - 1) as f64;
+                let (x0, y0) = ((x as usize).min(w - 1), (y as usize).min(h - 2));
+                let (fx, fy) = ((x - x0 as f64).clamp(0.0, 1.0), y - y0 as f64);
+                let x1 = if x0 + 1 == w { 0 } else { x0 + 1 };
+                quad([x0, x1], [y0, y0 + 1], w, fx, fy)
+            }
+            Mapping::Angular | Mapping::Cube => {
+                let face_rows = w;
+                let (face, t) = match mapping {
+                    Mapping::Cube => {
+                        let face = (p[1].max(0.0) as usize).min(5);
+                        (face, p[1] - face as f64)
+                    }
+                    _ => (0, p[1]),
+                };
+                let (xs, fx) = clamped_axis(p[0], w);
+                let (ys, fy) = clamped_axis(t, face_rows);
+                let mut c = quad(xs, ys.map(|y| y + face * face_rows), w, fx, fy);
+                if mapping == Mapping::Angular {
+                    let (a, b) = (2.0 * p[0] - 1.0, 1.0 - 2.0 * p[1]);
+                    if a * a + b * b > 1.0 {
+                        c.1 = [0.0; 4];
+                    }
+                }
+                c
+            }
+        }
+    }
+
+    /// The bilinearly interpolated RGB value at `p`.
+    #[inline]
+    pub fn lookup(&self, mapping: Mapping, p: [f64; 2]) -> [f64; 3] {
+        let (idx, wt) = self.corners(mapping, p);
+        let mut rgb = [0.0; 3];
+        for (i, w) in idx.into_iter().zip(wt) {
+            let t = self.texel(i);
+            for k in 0..3 {
+                rgb[k] += w * t[k];
+            }
+        }
+        rgb
+    }
+}
+
+/// Texel indices `[x0, x1]` and the fraction toward `x1` along an axis of
+/// `n` texels centred at `(x + ½)/n`, clamped at both ends.
+#[inline(always)]
+fn clamped_axis(s: f64, n: usize) -> ([usize; 2], f64) {
+    let x = (s * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
+    let x0 = (x as usize).min(n.saturating_sub(2));
+    let x1 = (x0 + 1).min(n - 1);
+    ([x0, x1], x - x0 as f64)
+}
+
+#[inline(always)]
+fn quad(xs: [usize; 2], ys: [usize; 2], width: usize, fx: f64, fy: f64) -> Corners {
+    (
+        [
+            ys[0] * width + xs[0],
+            ys[0] * width + xs[1],
+            ys[1] * width + xs[0],
+            ys[1] * width + xs[1],
+        ],
+        [
+            (1.0 - fx) * (1.0 - fy),
+            fx * (1.0 - fy),
+            (1.0 - fx) * fy,
+            fx * fy,
+        ],
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp(w: usize, h: usize) -> Vec<f32> {
+        (0..w * h).flat_map(|i| [i as f32, 0.0, 0.0]).collect()
+    }
+
+    #[test]
+    fn latlong_texel_centres_and_pole_rows() {
+        let img = Image::new(Mapping::LatLong, 4, 3, &ramp(4, 3)).unwrap();
+        assert_eq!(img.lookup(Mapping::LatLong, [0.125, 0.0])[0], 0.0);
+        assert_eq!(img.lookup(Mapping::LatLong, [0.375, 0.5])[0], 5.0);
+        assert_eq!(img.lookup(Mapping::LatLong, [0.875, 1.0])[0], 11.0);
+        // Periodic in s: half way between the last column and the first.
+        assert_eq!(img.lookup(Mapping::LatLong, [0.0, 0.0])[0], 1.5);
+    }
+
+    #[test]
+    fn clamped_edges_and_the_angular_circle() {
+        let img = Image::new(Mapping::Angular, 2, 2, &ramp(2, 2)).unwrap();
+        assert_eq!(img.lookup(Mapping::Angular, [0.25, 0.25])[0], 0.0);
+        assert_eq!(img.lookup(Mapping::Angular, [0.5, 0.5])[0], 1.5);
+        assert_eq!(img.lookup(Mapping::Angular, [0.0, 0.0])[0], 0.0);
+        assert_eq!(img.lookup(Mapping::Angular, [0.99, 0.99])[0], 0.0);
+        assert_eq!(img.lookup(Mapping::Angular, [0.8, 0.5])[0], 2.0);
+    }
+
+    #[test]
+    fn tiny_latlong_maps_are_padded_and_bad_texels_named() {
+        let img = Image::new(Mapping::LatLong, 1, 1, &[1.0, 2.0, 3.0]).unwrap();
+        assert_eq!((img.width(), img.height()), (2, 3));
+        assert_eq!(img.lookup(Mapping::LatLong, [0.7, 0.9]), [1.0, 2.0, 3.0]);
+        let mut data = ramp(2, 12);
+        data[3 * 9 + 1] = f32::NAN;
+        let e = Image::new(Mapping::Cube, 2, 12, &data).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "image[2, 0, 1, 1] = NaN: image must be finite and >= 0"
+        );
+        assert!(Image::new(Mapping::Angular, 3, 2, &ramp(3, 2)).is_err());
+    }
+}

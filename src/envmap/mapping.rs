@@ -1,0 +1,289 @@
+//! The three parameterisations of the sphere of directions an environment
+//! map can use, each between a direction (local frame of the map) and a
+//! point `p = (s, t)` of its parameter domain.
+//!
+//! | mapping | domain of `(s, t)` | `s` | `t` |
+//! |---|---|---|---|
+//! | [`Mapping::LatLong`] | `[0, 1] × [0, 1]` | Mitsuba's `u` (azimuth, periodic) | Mitsuba's `v` (θ/π, 0 at +Y) |
+//! | [`Mapping::Angular`] | `[0, 1] × [0, 1]` | column fraction (left → right) | row fraction (top → bottom) |
+//! | [`Mapping::Cube`] | `[0, 1] × [0, 6]` | column fraction of the face | `face + row fraction` |
+//!
+//! `jacobian(p)` is `dω/dp`, the solid angle per unit area of the domain, so
+//! that a density `p_p` on the domain is `p_p / jacobian` per steradian.
+
+use crate::warp::V3;
+use std::f64::consts::PI;
+
+/// How an image covers the sphere of directions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mapping {
+    /// Latitude-longitude, exactly as Mitsuba 3's `envmap` emitter: Y up,
+    /// `s = atan2(d.x, −d.z)/(2π)` wrapped into `[0, 1)` (so `s = 0` is −Z
+    /// and `s = ¼` is +X), `t = acos(d.y)/π`.
+    ///
+    /// `d = (sin 2πs · sin πt, cos πt, −cos 2πs · sin πt)`;
+    /// `dω/dp = 2π² sin θ`.
+    LatLong,
+    /// Debevec's angular light probe: `(a, b) = (d.x, d.y)·r/√(d.x² + d.y²)`
+    /// with `r = acos(d.z)/π`, image centre +Z, the edge of the unit circle
+    /// −Z, +Y toward the top row; `a = 2s − 1`, `b = 1 − 2t`.
+    ///
+    /// `dω/dp = 4·π sin(πr)/r` inside the unit circle (`π²·4` at its
+    /// centre), 0 outside.
+    Angular,
+    /// Six square faces +X, −X, +Y, −Y, +Z, −Z, each oriented as in OpenGL's
+    /// cube maps, row 0 at the top: a face's `(sc, tc)` in `[−1, 1]²` are
+    /// `(2s − 1, 2t' − 1)` with `t'` the row fraction.
+    ///
+    /// `dω/dp = 4/(1 + sc² + tc²)^{3/2}`.
+    Cube,
+}
+
+/// The faces of a cube map: major axis, and the directions that `sc` and
+/// `tc` run along (OpenGL's table).
+const CUBE_FACES: [(V3<f64>, V3<f64>, V3<f64>); 6] = [
+    ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, -1.0, 0.0]),
+    ([-1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]),
+    ([0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+    ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]),
+    ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]),
+    ([0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]),
+];
+
+impl Mapping {
+    /// The name used in the Python API: `"latlong"`, `"angular"`, `"cube"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mapping::LatLong => "latlong",
+            Mapping::Angular => "angular",
+            Mapping::Cube => "cube",
+        }
+    }
+
+    /// The mapping called `name` (see [`Mapping::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "latlong" => Some(Mapping::LatLong),
+            "angular" => Some(Mapping::Angular),
+            "cube" => Some(Mapping::Cube),
+            _ => None,
+        }
+    }
+
+    /// Upper bound of `t` (1, or 6 for the six faces of a cube map).
+    pub fn t_max(self) -> f64 {
+        match self {
+            Mapping::Cube => 6.0,
+            _ => 1.0,
+        }
+    }
+
+    /// The unit direction at `p`. Points outside an angular map's circle
+    /// give the direction at the same angle on its edge (−Z).
+    #[inline]
+    pub fn to_dir(self, p: [f64; 2]) -> V3<f64> {
+        let [s, t] = p;
+        match self {
+            Mapping::LatLong => {
+                let (sin_theta, cos_theta) = (PI * t).sin_cos();
+                let (sin_phi, cos_phi) = (2.0 * PI * s).sin_cos();
+                [sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta]
+            }
+            Mapping::Angular => {
+                let (a, b) = (2.0 * s - 1.0, 1.0 - 2.0 * t);
+                let r = (a * a + b * b).sqrt();
+                if r == 0.0 {
+                    return [0.0, 0.0, 1.0];
+                }
+                let (sin_theta, cos_theta) = (PI * r.min(1.0)).sin_cos();
+                [a / r * sin_theta, b / r * sin_theta, cos_theta]
+            }
+            Mapping::Cube => {
+                let face = (t.max(0.0) as usize).min(5);
+                let (major, s_axis, t_axis) = CUBE_FACES[face];
+                let (sc, tc) = (2.0 * s - 1.0, 2.0 * (t - face as f64) - 1.0);
+                let v: V3<f64> =
+                    std::array::from_fn(|k| major[k] + sc * s_axis[k] + tc * t_axis[k]);
+                let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                v.map(|x| x / norm)
+            }
+        }
+    }
+
+    /// The point of the domain that looks along `d` (a unit vector; other
+    /// lengths are accepted and normalised, the zero vector gives a valid
+    /// point).
+    #[inline]
+    pub fn from_dir(self, d: V3<f64>) -> [f64; 2] {
+        let d = normalized(d);
+        match self {
+            Mapping::LatLong => {
+                let s = d[0].atan2(-d[2]) * (0.5 / PI);
+                let s = if s < 0.0 { s + 1.0 } else { s };
+                // -0.0 and s + 1 rounding up to 1 both mean the start of the turn.
+                let s = if s >= 1.0 { 0.0 } else { s.abs() };
+                [s, polar_angle(d[1], d[0], d[2]) / PI]
+            }
+            Mapping::Angular => {
+                let rho = (d[0] * d[0] + d[1] * d[1]).sqrt();
+                let r = polar_angle(d[2], d[0], d[1]) / PI;
+                let (a, b) = if rho > 0.0 {
+                    (d[0] * r / rho, d[1] * r / rho)
+                } else {
+                    // +Z at the centre; −Z anywhere on the edge (take +X's side).
+                    (r, 0.0)
+                };
+                [(a + 1.0) * 0.5, (1.0 - b) * 0.5]
+            }
+            Mapping::Cube => {
+                let abs = d.map(f64::abs);
+                let axis = if abs[0] >= abs[1] && abs[0] >= abs[2] {
+                    0
+                } else if abs[1] >= abs[2] {
+                    1
+                } else {
+                    2
+                };
+                let face = 2 * axis + usize::from(d[axis] < 0.0);
+                let (_, s_axis, t_axis) = CUBE_FACES[face];
+                let ma = abs[axis].max(f64::MIN_POSITIVE);
+                let dot = |e: V3<f64>| (e[0] * d[0] + e[1] * d[1] + e[2] * d[2]) / ma;
+                let s = ((dot(s_axis) + 1.0) * 0.5).clamp(0.0, 1.0);
+                let t = ((dot(t_axis) + 1.0) * 0.5).clamp(0.0, 1.0);
+                [s, face as f64 + t.min(1.0 - f64::EPSILON / 2.0)]
+            }
+        }
+    }
+
+    /// `dω/dp` at `p`: solid angle per unit area of the domain (0 at the
+    /// poles of a lat-long map and on or outside an angular map's circle).
+    #[inline]
+    pub fn jacobian(self, p: [f64; 2]) -> f64 {
+        let [s, t] = p;
+        match self {
+            Mapping::LatLong => 2.0 * PI * PI * (PI * t).sin().max(0.0),
+            Mapping::Angular => {
+                let (a, b) = (2.0 * s - 1.0, 1.0 - 2.0 * t);
+                let r = (a * a + b * b).sqrt();
+                if r >= 1.0 {
+                    0.0
+                } else if r < 1e-8 {
+                    4.0 * PI * PI
+                } else {
+                    4.0 * PI * (PI * r).sin() / r
+                }
+            }
+            Mapping::Cube => {
+                let face = (t.max(0.0) as usize).min(5);
+                let (sc, tc) = (2.0 * s - 1.0, 2.0 * (t - face as f64) - 1.0);
+                4.0 / (1.0 + sc * sc + tc * tc).powf(1.5)
+            }
+        }
+    }
+}
+
+/// The angle between a unit vector and an axis, from its component `c`
+/// along the axis and the two others: `atan2(√(a² + b²), c)`, which unlike
+/// `acos(c)` keeps its precision near the poles.
+#[inline(always)]
+pub fn polar_angle(c: f64, a: f64, b: f64) -> f64 {
+    (a * a + b * b).sqrt().atan2(c)
+}
+
+/// `d/|d|`, or `d` itself when it has length 0.
+#[inline]
+pub fn normalized(d: V3<f64>) -> V3<f64> {
+    let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    if norm > 0.0 { d.map(|x| x / norm) } else { d }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ALL: [Mapping; 3] = [Mapping::LatLong, Mapping::Angular, Mapping::Cube];
+
+    fn close(a: V3<f64>, b: V3<f64>, tol: f64) -> bool {
+        (0..3).all(|k| (a[k] - b[k]).abs() < tol)
+    }
+
+    #[test]
+    fn latlong_axes_follow_mitsuba() {
+        let m = Mapping::LatLong;
+        assert!(close(m.to_dir([0.0, 0.5]), [0.0, 0.0, -1.0], 1e-15));
+        assert!(close(m.to_dir([0.25, 0.5]), [1.0, 0.0, 0.0], 1e-15));
+        assert!(close(m.to_dir([0.5, 0.5]), [0.0, 0.0, 1.0], 1e-15));
+        assert!(close(m.to_dir([0.3, 0.0]), [0.0, 1.0, 0.0], 1e-15));
+        assert_eq!(m.from_dir([1.0, 0.0, 0.0]), [0.25, 0.5]);
+    }
+
+    #[test]
+    fn angular_centre_is_plus_z_and_top_is_plus_y() {
+        let m = Mapping::Angular;
+        assert!(close(m.to_dir([0.5, 0.5]), [0.0, 0.0, 1.0], 1e-15));
+        // Half way up from the centre: θ = π/2 toward +Y.
+        assert!(close(m.to_dir([0.5, 0.25]), [0.0, 1.0, 0.0], 1e-15));
+        assert!(close(m.to_dir([0.75, 0.5]), [1.0, 0.0, 0.0], 1e-15));
+        assert!(close(m.to_dir([1.0, 0.5]), [0.0, 0.0, -1.0], 1e-15));
+    }
+
+    #[test]
+    fn cube_faces_follow_opengl() {
+        let m = Mapping::Cube;
+        let centres = [
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        for (face, c) in centres.iter().enumerate() {
+            assert!(close(m.to_dir([0.5, face as f64 + 0.5]), *c, 1e-15));
+        }
+        // +Z face: row 0 (top) looks up (+Y), column 0 (left) toward −X.
+        let top = m.to_dir([0.5, 4.0]);
+        assert!(top[1] > 0.0 && top[0].abs() < 1e-15);
+        let left = m.to_dir([0.0, 4.5]);
+        assert!(left[0] < 0.0);
+    }
+
+    #[test]
+    fn round_trips() {
+        for m in ALL {
+            for i in 0..=40 {
+                for j in 0..=40 {
+                    let s = (i as f64 + 0.37) / 41.0;
+                    let t = (j as f64 + 0.61) / 41.0 * m.t_max();
+                    let p = [s, t];
+                    if m == Mapping::Angular && m.jacobian(p) == 0.0 {
+                        continue;
+                    }
+                    let d = m.to_dir(p);
+                    let back = m.from_dir(d);
+                    let dd = m.to_dir(back);
+                    assert!(close(d, dd, 1e-12), "{m:?}: {p:?} -> {d:?} -> {back:?}");
+                    assert!((back[0] - s).abs() < 1e-12 && (back[1] - t).abs() < 1e-12);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn jacobians_integrate_to_the_sphere() {
+        // Midpoint rule over the domain: ∫ dω/dp dp = 4π.
+        for m in ALL {
+            let n = 1000;
+            let rows = (n as f64 * m.t_max()) as usize;
+            let mut total = 0.0;
+            for i in 0..n {
+                for j in 0..rows {
+                    let p = [(i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64];
+                    total += m.jacobian(p);
+                }
+            }
+            total /= (n * n) as f64;
+            assert!((total / (4.0 * PI) - 1.0).abs() < 2e-3, "{m:?}: {total}");
+        }
+    }
+}

@@ -1,0 +1,580 @@
+//! Environment maps (image-based lighting): radiance from every direction,
+//! and importance sampling of directions in proportion to it.
+//!
+//! An [`EnvMap`] is an [`Image`] on the sphere through a [`Mapping`]
+//! (lat-long exactly as Mitsuba 3's `envmap` emitter, Debevec's angular
+//! probes, OpenGL cube maps), turned by `to_world` and scaled by `scale`.
+//! Every method takes and returns world directions.
+//!
+//! # Sampling
+//! [`Sampling::Piecewise`] (the default) samples a [`PiecewiseConstant2D`]
+//! over the cells of the map's domain in which the bilinear radiance is one
+//! polynomial (lat-long: the patches between texel centres, `W × (H − 1)`;
+//! angular and cube: half-texel cells), each weighted by the luminance of
+//! its mean radiance times the Jacobian `dω/dp` at its centre. A cell where
+//! the radiance is not 0 has weight > 0, so wherever `eval(d) > 0`,
+//! `pdf(d) > 0`: environment-only sampling is unbiased (also for one bright
+//! texel, also at the poles). Within a cell the density per steradian is
+//! `p_cell / (dω/dp)`.
+//!
+//! [`Sampling::Mitsuba`] (lat-long only) reproduces Mitsuba's density: the
+//! bilinear interpolant of luminance × sin θ on the `(W + 1) × H` vertex
+//! grid (the periodic column repeated), shifted by half a texel,
+//! `pdf = bilerp / (2π² sin θ)`. It is 0 near a pole whose neighbouring row
+//! is black, even where the map is not, as Mitsuba's is.
+//!
+//! `compensate` subtracts the mean texel luminance before the distribution
+//! is built and clamps at 0 (MIS compensation, Karlík et al. 2019, as
+//! Mitsuba's `mis_compensation`); it is switched off for maps whose minimum
+//! is within 1% of the mean. A compensated map is only unbiased in an MIS
+//! combination with a strategy that covers its dark parts.
+//!
+//! An all-black map (or `scale = 0`) is valid: it samples nothing (pdf 0,
+//! weight 0, a valid unit direction) and its pdf is 0 everywhere.
+
+mod bilinear;
+mod image;
+mod mapping;
+
+pub use bilinear::BilinearGrid;
+pub use image::Image;
+pub use mapping::{Mapping, normalized, polar_angle};
+
+use crate::distr::PiecewiseConstant2D;
+use crate::error::{Error, Result};
+use crate::warp::{self, V3};
+use std::f64::consts::PI;
+
+/// A 3×3 matrix, row-major.
+pub type Matrix3 = [[f64; 3]; 3];
+
+const IDENTITY: Matrix3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// Mitsuba's `Epsilon<float>` (2⁻²⁴): the floor of sin θ in the density of
+/// the polar tables, as in Mitsuba's envmap pdf.
+const SIN_FLOOR: f64 = 1.0 / 16_777_216.0;
+
+/// The luminance weights of Mitsuba 3's `luminance()`, used in
+/// [`Sampling::Mitsuba`] mode so that its density is Mitsuba's.
+const MITSUBA_LUMINANCE: [f64; 3] = [0.212671, 0.715160, 0.072169];
+
+/// How an [`EnvMap`] samples directions (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sampling {
+    /// Piecewise-constant over the cells of the bilinear radiance (default).
+    Piecewise,
+    /// Mitsuba 3's bilinear density on the vertex grid (lat-long only).
+    Mitsuba,
+}
+
+impl Sampling {
+    /// The name used in the Python API: `"piecewise"` or `"mitsuba"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Sampling::Piecewise => "piecewise",
+            Sampling::Mitsuba => "mitsuba",
+        }
+    }
+
+    /// The mode called `name` (see [`Sampling::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "piecewise" => Some(Sampling::Piecewise),
+            "mitsuba" => Some(Sampling::Mitsuba),
+            _ => None,
+        }
+    }
+}
+
+/// The options of an [`EnvMap`] beyond its image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    /// How the image covers the sphere.
+    pub mapping: Mapping,
+    /// Local-to-world rotation (row-major).
+    pub to_world: Matrix3,
+    /// Radiance scale, finite and `>= 0`.
+    pub scale: f64,
+    /// The sampling density.
+    pub sampling: Sampling,
+    /// MIS compensation.
+    pub compensate: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            mapping: Mapping::LatLong,
+            to_world: IDENTITY,
+            scale: 1.0,
+            sampling: Sampling::Piecewise,
+            compensate: false,
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+enum Distribution {
+    Piecewise(PiecewiseConstant2D),
+    Bilinear(BilinearGrid),
+    Black,
+}
+
+/// An environment map: radiance `L(d)` for every world direction and a
+/// sampler of directions with a density close to `L`.
+#[derive(Clone, Debug)]
+pub struct EnvMap {
+    image: Image,
+    options: Options,
+    distribution: Distribution,
+}
+
+/// One sample of [`EnvMap::sample`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvSample {
+    /// World direction toward the environment (unit length).
+    pub direction: V3<f64>,
+    /// Its density per steradian.
+    pub pdf: f64,
+    /// `L(direction)/pdf` per RGB channel; 0 when `pdf = 0`.
+    pub weight: V3<f64>,
+}
+
+impl EnvMap {
+    /// An environment map of the row-major RGB `image` (`width × height`
+    /// texels; cube maps: the six faces one below the other).
+    ///
+    /// # Errors
+    /// As [`Image::new`]; [`Error::Parameter`] for a `scale` that is
+    /// negative or not finite, or a `to_world` that is not a rotation (an
+    /// orthonormal matrix, to 1e-4); [`Error::Choice`] for
+    /// [`Sampling::Mitsuba`] on a map that is not lat-long.
+    pub fn new(width: usize, height: usize, data: &[f32], options: Options) -> Result<Self> {
+        let image = Image::new(options.mapping, width, height, data)?;
+        Self::from_image(image, options)
+    }
+
+    fn from_image(image: Image, options: Options) -> Result<Self> {
+        if !(options.scale >= 0.0 && options.scale.is_finite()) {
+            return Err(Error::Parameter {
+                arg: "scale",
+                value: options.scale,
+                requirement: "must be finite and >= 0",
+            });
+        }
+        check_rotation(&options.to_world)?;
+        if options.sampling == Sampling::Mitsuba && options.mapping != Mapping::LatLong {
+            return Err(Error::Choice {
+                arg: "sampling",
+                value: "mitsuba".into(),
+                requirement: format!(
+                    "Mitsuba's envmap is lat-long only; mapping is {:?}",
+                    options.mapping.name()
+                ),
+            });
+        }
+        let distribution = if options.scale == 0.0 {
+            Distribution::Black
+        } else {
+            match options.sampling {
+                Sampling::Piecewise => piecewise_table(&image, &options),
+                Sampling::Mitsuba => mitsuba_grid(&image, options.compensate),
+            }
+        };
+        Ok(EnvMap {
+            image,
+            options,
+            distribution,
+        })
+    }
+
+    /// The texels (after the padding of tiny lat-long maps).
+    pub fn image(&self) -> &Image {
+        &self.image
+    }
+
+    /// The options it was built with.
+    pub fn options(&self) -> &Options {
+        &self.options
+    }
+
+    /// The local direction of the world direction `d`: `to_worldᵀ·d`.
+    #[inline(always)]
+    fn to_local(&self, d: V3<f64>) -> V3<f64> {
+        let m = &self.options.to_world;
+        std::array::from_fn(|k| m[0][k] * d[0] + m[1][k] * d[1] + m[2][k] * d[2])
+    }
+
+    #[inline(always)]
+    fn to_world(&self, d: V3<f64>) -> V3<f64> {
+        let m = &self.options.to_world;
+        std::array::from_fn(|k| m[k][0] * d[0] + m[k][1] * d[1] + m[k][2] * d[2])
+    }
+
+    /// The domain point `(s, t)` that looks along the world direction `d`.
+    #[inline]
+    pub fn dir_to_uv(&self, d: V3<f64>) -> [f64; 2] {
+        self.options.mapping.from_dir(self.to_local(d))
+    }
+
+    /// The world direction of the domain point `p`.
+    #[inline]
+    pub fn uv_to_dir(&self, p: [f64; 2]) -> V3<f64> {
+        self.to_world(self.options.mapping.to_dir(p))
+    }
+
+    /// Radiance at domain point `p`: the bilinear image value times scale.
+    #[inline(always)]
+    fn radiance_at(&self, p: [f64; 2]) -> V3<f64> {
+        let scale = self.options.scale;
+        self.image
+            .lookup(self.options.mapping, p)
+            .map(|v| v * scale)
+    }
+
+    /// Radiance arriving from the world direction `d`, per RGB channel.
+    #[inline]
+    pub fn eval(&self, d: V3<f64>) -> V3<f64> {
+        self.radiance_at(self.dir_to_uv(d))
+    }
+
+    /// The density of [`EnvMap::sample`] at the world direction `d`, per
+    /// steradian.
+    #[inline]
+    pub fn pdf(&self, d: V3<f64>) -> f64 {
+        let local = self.to_local(d);
+        let pdf_q = match &self.distribution {
+            Distribution::Piecewise(table) => table.pdf(self.table_point(local)),
+            Distribution::Bilinear(grid) => grid.pdf(self.table_point(local)),
+            Distribution::Black => return 0.0,
+        };
+        pdf_q / self.table_jacobian(local)
+    }
+
+    /// A direction drawn with density [`EnvMap::pdf`], for `u` in `[0, 1]²`.
+    #[inline]
+    pub fn sample(&self, u: [f64; 2]) -> EnvSample {
+        let (q, pdf_q) = match &self.distribution {
+            Distribution::Piecewise(table) => table.sample(u),
+            Distribution::Bilinear(grid) => grid.sample(u),
+            Distribution::Black => {
+                let d = warp::square_to_uniform_sphere(u);
+                return EnvSample {
+                    direction: self.to_world(d),
+                    pdf: 0.0,
+                    weight: [0.0; 3],
+                };
+            }
+        };
+        let p = self.table_to_uv(q);
+        let local = self.options.mapping.to_dir(p);
+        let pdf = pdf_q / self.table_jacobian(local);
+        let radiance = self.radiance_at(p);
+        EnvSample {
+            direction: self.to_world(local),
+            pdf,
+            weight: if pdf > 0.0 {
+                radiance.map(|l| l / pdf)
+            } else {
+                [0.0; 3]
+            },
+        }
+    }
+
+    /// The point of the sampling table that looks along the local
+    /// direction `d`: lat-long `(s − ½/W, t)` wrapped into the table (which
+    /// starts half a texel into the turn, at the first texel centre);
+    /// angular, polar coordinates around +Z `(ψ, ρ) = (atan2(d.y, d.x)/2π,
+    /// acos(d.z)/π)`; cube maps, the domain point itself.
+    #[inline(always)]
+    fn table_point(&self, d: V3<f64>) -> [f64; 2] {
+        let mapping = self.options.mapping;
+        match mapping {
+            Mapping::LatLong => {
+                let p = mapping.from_dir(d);
+                let s = p[0] - 0.5 / self.image.width() as f64;
+                [s - s.floor(), p[1]]
+            }
+            Mapping::Angular => {
+                let d = normalized(d);
+                let psi = d[1].atan2(d[0]) * (0.5 / PI);
+                [psi - psi.floor(), polar_angle(d[2], d[0], d[1]) / PI]
+            }
+            Mapping::Cube => mapping.from_dir(d),
+        }
+    }
+
+    /// The domain point (`dir_to_uv`'s coordinates) of the table point `q`.
+    #[inline(always)]
+    fn table_to_uv(&self, q: [f64; 2]) -> [f64; 2] {
+        match self.options.mapping {
+            Mapping::LatLong => {
+                let s = q[0] + 0.5 / self.image.width() as f64;
+                [if s >= 1.0 { s - 1.0 } else { s }, q[1]]
+            }
+            Mapping::Angular => {
+                let (sin_psi, cos_psi) = (2.0 * PI * q[0]).sin_cos();
+                let (a, b) = (q[1] * cos_psi, q[1] * sin_psi);
+                [(a + 1.0) * 0.5, (1.0 - b) * 0.5]
+            }
+            Mapping::Cube => q,
+        }
+    }
+
+    /// `dω/dq` of the sampling table at the local direction `d`: for the
+    /// polar tables (lat-long around Y, angular around Z)
+    /// `2π² max(sin θ, 2⁻²⁴)` with sin θ from `d` (Mitsuba's floor, so a
+    /// pole has a finite density); for cube maps [`Mapping::jacobian`].
+    #[inline(always)]
+    fn table_jacobian(&self, d: V3<f64>) -> f64 {
+        let d = normalized(d);
+        let polar = |x: f64, y: f64| 2.0 * PI * PI * (x * x + y * y).sqrt().max(SIN_FLOOR);
+        match self.options.mapping {
+            Mapping::LatLong => polar(d[0], d[2]),
+            Mapping::Angular => polar(d[0], d[1]),
+            Mapping::Cube => Mapping::Cube.jacobian(Mapping::Cube.from_dir(d)),
+        }
+    }
+
+    /// The same light resampled into `mapping` at `width × height` texels
+    /// (cube maps: `height = 6·width`): every new texel takes the bilinear
+    /// value of this map in its direction. `to_world`, `scale` and
+    /// `compensate` are kept; the sampling mode too where the new mapping
+    /// has it (else [`Sampling::Piecewise`]).
+    ///
+    /// # Errors
+    /// As [`EnvMap::new`] for the new shape.
+    pub fn convert(&self, mapping: Mapping, width: usize, height: usize) -> Result<EnvMap> {
+        let mut data = Vec::with_capacity(width * height * 3);
+        for y in 0..height {
+            for x in 0..width {
+                let p = texel_centre(mapping, width, height, x, y);
+                let lit = mapping.jacobian(p) > 0.0 || mapping != Mapping::Angular;
+                let rgb = if lit {
+                    let d = mapping.to_dir(p);
+                    self.image
+                        .lookup(self.options.mapping, self.options.mapping.from_dir(d))
+                } else {
+                    [0.0; 3]
+                };
+                data.extend(rgb.map(|v| v as f32));
+            }
+        }
+        let sampling = if mapping == Mapping::LatLong {
+            self.options.sampling
+        } else {
+            Sampling::Piecewise
+        };
+        EnvMap::new(
+            width,
+            height,
+            &data,
+            Options {
+                mapping,
+                sampling,
+                ..self.options
+            },
+        )
+    }
+}
+
+/// Where texel `(x, y)` of a `width × height` image of `mapping` sits in
+/// the domain (lat-long rows on the poles and between; others centred).
+pub fn texel_centre(mapping: Mapping, width: usize, height: usize, x: usize, y: usize) -> [f64; 2] {
+    let s = (x as f64 + 0.5) / width as f64;
+    match mapping {
+        Mapping::LatLong => [s, y as f64 / (height.max(2) - 1) as f64],
+        Mapping::Angular => [s, (y as f64 + 0.5) / height as f64],
+        Mapping::Cube => [s, (y as f64 + 0.5) / width as f64],
+    }
+}
+
+/// Checks that `m` is orthonormal (to 1e-4) and finite.
+fn check_rotation(m: &Matrix3) -> Result<()> {
+    let mut worst = 0.0f64;
+    for i in 0..3 {
+        for j in 0..3 {
+            let dot: f64 = (0..3).map(|k| m[k][i] * m[k][j]).sum();
+            let expected = if i == j { 1.0 } else { 0.0 };
+            let err = (dot - expected).abs();
+            worst = if err.is_nan() {
+                f64::NAN
+            } else {
+                worst.max(err)
+            };
+        }
+    }
+    if worst <= 1e-4 {
+        Ok(())
+    } else {
+        Err(Error::Parameter {
+            arg: "to_world",
+            value: worst,
+            requirement: "must be a rotation: the deviation of to_world^T to_world from the identity (shown) must be <= 1e-4",
+        })
+    }
+}
+
+/// Texel luminances, with the mean subtracted and clamped at 0 when
+/// `compensate` is set (and the map is not nearly constant). `weights` are
+/// the luminance coefficients; for angular maps only texels inside the
+/// circle count toward the mean.
+fn sampling_luminance(
+    image: &Image,
+    mapping: Mapping,
+    weights: [f64; 3],
+    compensate: bool,
+) -> Vec<f64> {
+    let lum: Vec<f64> = image
+        .texels()
+        .iter()
+        .map(|t| (0..3).map(|k| weights[k] * f64::from(t[k])).sum())
+        .collect();
+    if !compensate {
+        return lum;
+    }
+    let (w, h) = (image.width(), image.height());
+    let (mut sum, mut count, mut min) = (0.0, 0usize, f64::INFINITY);
+    for (i, &l) in lum.iter().enumerate() {
+        let inside = mapping != Mapping::Angular
+            || mapping.jacobian(texel_centre(mapping, w, h, i % w, i / w)) > 0.0;
+        if inside {
+            sum += l;
+            count += 1;
+            min = min.min(l);
+        }
+    }
+    let mean = sum / count.max(1) as f64;
+    if mean - min <= 0.01 * mean {
+        return lum;
+    }
+    lum.into_iter().map(|l| (l - mean).max(0.0)).collect()
+}
+
+/// The piecewise-constant table of [`Sampling::Piecewise`], or
+/// [`Distribution::Black`] when nothing is lit.
+///
+/// Cells and weights (luminance `Y` bilinear between texels, `J` the
+/// table's Jacobian without the floor):
+/// - lat-long: the `W × (H − 1)` patches between texel centres, weight
+///   `Y(centre)·J(centre)`, the exact mean of `Y` times `J` at the centre;
+/// - cube: half-texel cells of every face, the same weight;
+/// - angular: a polar table of `2W` sectors × `W` rings around +Z, weight
+///   the mean of `Y·J` over 4 × 4 points; a sector whose points all miss the
+///   light but whose footprint touches a lit texel gets that texel's `Y`
+///   times `J` at its centre / 16, so that lit sectors are never 0.
+fn piecewise_table(image: &Image, options: &Options) -> Distribution {
+    let mapping = options.mapping;
+    let lum = sampling_luminance(image, mapping, [0.2126, 0.7152, 0.0722], options.compensate);
+    let (w, h) = (image.width(), image.height());
+    let (cols, rows, domain) = match mapping {
+        Mapping::LatLong => (w, h - 1, [[0.0, 1.0], [0.0, 1.0]]),
+        Mapping::Angular => ((2 * w).max(4), w.max(2), [[0.0, 1.0], [0.0, 1.0]]),
+        Mapping::Cube => (2 * w, 2 * h, [[0.0, 1.0], [0.0, 6.0]]),
+    };
+    let size = [
+        (domain[0][1] - domain[0][0]) / cols as f64,
+        (domain[1][1] - domain[1][0]) / rows as f64,
+    ];
+    let bilinear_lum = |p: [f64; 2]| {
+        let (idx, wt) = image.corners(mapping, p);
+        (0..4).map(|k| wt[k] * lum[idx[k]]).sum::<f64>()
+    };
+    let polar = |rho: f64| 2.0 * PI * PI * (PI * rho).sin().max(0.0);
+    let mut values = Vec::with_capacity(rows * cols);
+    for j in 0..rows {
+        for i in 0..cols {
+            let q = [
+                (i as f64 + 0.5) * size[0],
+                domain[1][0] + (j as f64 + 0.5) * size[1],
+            ];
+            values.push(match mapping {
+                Mapping::LatLong => bilinear_lum([q[0] + 0.5 / w as f64, q[1]]) * polar(q[1]),
+                Mapping::Cube => bilinear_lum(q) * mapping.jacobian(q),
+                Mapping::Angular => angular_sector(q, size, image, &lum, &bilinear_lum),
+            });
+        }
+    }
+    PiecewiseConstant2D::new(&values, rows, cols, domain)
+        .map_or(Distribution::Black, Distribution::Piecewise)
+}
+
+/// The domain point of polar coordinates `(ψ, ρ)` around +Z of an angular
+/// map.
+fn angular_uv(psi: f64, rho: f64) -> [f64; 2] {
+    let (sin_psi, cos_psi) = (2.0 * PI * psi).sin_cos();
+    [(rho * cos_psi + 1.0) * 0.5, (1.0 - rho * sin_psi) * 0.5]
+}
+
+/// The weight of the angular-map sector centred at `q = (ψ, ρ)` of size
+/// `size` (see [`piecewise_table`]).
+fn angular_sector(
+    q: [f64; 2],
+    size: [f64; 2],
+    image: &Image,
+    lum: &[f64],
+    bilinear_lum: &impl Fn([f64; 2]) -> f64,
+) -> f64 {
+    let k = 4;
+    let polar = |rho: f64| 2.0 * PI * PI * (PI * rho).sin().max(0.0);
+    let mut total = 0.0;
+    for a in 0..k {
+        for b in 0..k {
+            let psi = q[0] + ((a as f64 + 0.5) / k as f64 - 0.5) * size[0];
+            let rho = q[1] + ((b as f64 + 0.5) / k as f64 - 0.5) * size[1];
+            total += bilinear_lum(angular_uv(psi, rho)) * polar(rho);
+        }
+    }
+    if total > 0.0 {
+        return total / (k * k) as f64;
+    }
+    // The sector's bounding box in the image: its corners, and its outer
+    // arc where it crosses an axis.
+    let (psi0, psi1) = (q[0] - 0.5 * size[0], q[0] + 0.5 * size[0]);
+    let (rho0, rho1) = (q[1] - 0.5 * size[1], q[1] + 0.5 * size[1]);
+    let mut points = vec![
+        angular_uv(psi0, rho0),
+        angular_uv(psi0, rho1),
+        angular_uv(psi1, rho0),
+        angular_uv(psi1, rho1),
+    ];
+    points.extend(
+        [0.0, 0.25, 0.5, 0.75, 1.0]
+            .into_iter()
+            .filter(|&axis| axis > psi0 && axis < psi1)
+            .map(|axis| angular_uv(axis, rho1)),
+    );
+    let n = image.width();
+    let texel_range = |c: usize| {
+        let lo = points.iter().map(|p| p[c]).fold(f64::INFINITY, f64::min);
+        let hi = points
+            .iter()
+            .map(|p| p[c])
+            .fold(f64::NEG_INFINITY, f64::max);
+        let first = (lo * n as f64 - 0.5).floor().clamp(0.0, (n - 1) as f64) as usize;
+        let last = ((hi * n as f64 - 0.5).floor() + 1.0).clamp(0.0, (n - 1) as f64) as usize;
+        first..=last
+    };
+    let brightest = texel_range(1)
+        .flat_map(|y| texel_range(0).map(move |x| y * n + x))
+        .map(|i| lum[i])
+        .fold(0.0, f64::max);
+    brightest * polar(q[1]) / (k * k) as f64
+}
+
+/// The vertex grid of [`Sampling::Mitsuba`]: luminance (Mitsuba's weights)
+/// × sin θ of the row, the first column repeated after the last.
+fn mitsuba_grid(image: &Image, compensate: bool) -> Distribution {
+    let lum = sampling_luminance(image, Mapping::LatLong, MITSUBA_LUMINANCE, compensate);
+    let (w, h) = (image.width(), image.height());
+    let mut values = Vec::with_capacity((w + 1) * h);
+    for y in 0..h {
+        let sin_theta = (y as f64 * PI / (h - 1) as f64).sin().max(0.0);
+        let row = &lum[y * w..(y + 1) * w];
+        values.extend(row.iter().chain(&row[..1]).map(|l| l * sin_theta));
+    }
+    BilinearGrid::new(values, w + 1, h).map_or(Distribution::Black, Distribution::Bilinear)
+}
+
+#[cfg(test)]
+mod tests;

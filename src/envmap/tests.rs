@@ -1,0 +1,275 @@
+//! Unit tests of the environment maps: sample / pdf agreement, densities
+//! that integrate to 1, support, modes and conversions.
+
+use super::*;
+
+/// A smooth map with a bright spot, `w × h` (cube: faces of `w`).
+fn test_image(mapping: Mapping, w: usize, h: usize) -> Vec<f32> {
+    let mut data = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let p = texel_centre(mapping, w, h, x, y);
+            let d = mapping.to_dir(p);
+            let spot = if d[0] * 0.6 + d[1] * 0.8 > 0.97 {
+                40.0
+            } else {
+                0.0
+            };
+            let sky = 0.2 + 0.5 * d[1].max(0.0);
+            data.extend([sky + spot, sky * 0.8 + spot, 0.3 * sky].map(|v| v as f32));
+        }
+    }
+    data
+}
+
+fn map(mapping: Mapping, sampling: Sampling, rotated: bool) -> EnvMap {
+    let (w, h) = match mapping {
+        Mapping::LatLong => (32, 17),
+        Mapping::Angular => (24, 24),
+        Mapping::Cube => (8, 48),
+    };
+    let c = 0.8f64;
+    let s = 0.6f64;
+    let to_world = if rotated {
+        [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]
+    } else {
+        IDENTITY
+    };
+    let options = Options {
+        mapping,
+        to_world,
+        scale: 2.0,
+        sampling,
+        compensate: false,
+    };
+    EnvMap::new(w, h, &test_image(mapping, w, h), options).unwrap()
+}
+
+fn all_maps() -> Vec<EnvMap> {
+    vec![
+        map(Mapping::LatLong, Sampling::Piecewise, false),
+        map(Mapping::LatLong, Sampling::Piecewise, true),
+        map(Mapping::LatLong, Sampling::Mitsuba, true),
+        map(Mapping::Angular, Sampling::Piecewise, true),
+        map(Mapping::Cube, Sampling::Piecewise, false),
+    ]
+}
+
+/// ∫ f dω over the sphere by the midpoint rule in (φ, cos θ).
+fn integrate(f: impl Fn(V3<f64>) -> f64) -> f64 {
+    let (nphi, nz) = (800, 800);
+    let mut total = 0.0;
+    for i in 0..nphi {
+        let phi = (i as f64 + 0.5) / nphi as f64 * 2.0 * PI;
+        for j in 0..nz {
+            let z = -1.0 + (j as f64 + 0.5) / nz as f64 * 2.0;
+            let r = (1.0 - z * z).sqrt();
+            total += f([r * phi.cos(), z, r * phi.sin()]);
+        }
+    }
+    total * 4.0 * PI / (nphi * nz) as f64
+}
+
+#[test]
+fn pdfs_integrate_to_one() {
+    for m in all_maps() {
+        let total = integrate(|d| m.pdf(d));
+        assert!((total - 1.0).abs() < 5e-3, "{:?}: {total}", m.options());
+    }
+}
+
+#[test]
+fn samples_carry_their_own_pdf_and_weight() {
+    for m in all_maps() {
+        let mut mismatches = 0;
+        for i in 0..=60 {
+            for j in 0..=60 {
+                let u = [i as f64 / 60.0, j as f64 / 60.0];
+                let s = m.sample(u);
+                let norm = s.direction.iter().map(|x| x * x).sum::<f64>();
+                assert!((norm - 1.0).abs() < 1e-12);
+                // Mitsuba's density is 0 exactly on a pole (u[1] = 0 or 1).
+                let pole =
+                    m.options().sampling == Sampling::Mitsuba && (u[1] == 0.0 || u[1] == 1.0);
+                assert!(s.pdf > 0.0 || pole, "{:?}: u = {u:?}", m.options());
+                // On the edges of u, samples lie on cell boundaries, the seam
+                // of a polar table, the rim of an angular map (one direction,
+                // −Z, whose radiance depends on where on the rim it is looked
+                // up) or a seam between cube faces: there a direction may find
+                // the neighbouring cell or face.
+                let seam = u.iter().any(|&x| x == 0.0 || x == 1.0);
+                let pdf = m.pdf(s.direction);
+                if (pdf - s.pdf).abs() > 1e-6 * s.pdf && !seam {
+                    mismatches += 1;
+                }
+                let l = m.eval(s.direction);
+                for k in (0..3).filter(|_| s.pdf > 0.0 && !seam) {
+                    let diff = (s.weight[k] * s.pdf - l[k]).abs();
+                    assert!(diff <= 1e-6 * l[k].max(1e-3), "{:?} {u:?}", m.options());
+                }
+            }
+        }
+        // Only samples on a cell boundary may find the neighbouring cell.
+        assert!(mismatches <= 4, "{:?}: {mismatches}", m.options());
+    }
+}
+
+#[test]
+fn uv_round_trips_through_to_world() {
+    for m in all_maps() {
+        for i in 0..50 {
+            let p = [(i as f64 + 0.3) / 50.0, ((i * 7 % 50) as f64 + 0.6) / 50.0];
+            if m.options().mapping == Mapping::Angular && Mapping::Angular.jacobian(p) == 0.0 {
+                continue;
+            }
+            let d = m.uv_to_dir(p);
+            let back = m.dir_to_uv(d);
+            assert!((back[0] - p[0]).abs() < 1e-12 && (back[1] - p[1]).abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn one_bright_texel_is_covered_by_the_pdf() {
+    for (mapping, w, h) in [
+        (Mapping::LatLong, 16, 9),
+        (Mapping::Angular, 16, 16),
+        (Mapping::Cube, 4, 24),
+    ] {
+        // A texel near a pole / the rim too.
+        for (x, y) in [(5, 3), (0, 0), (w - 1, h - 1), (w / 2, 0)] {
+            let mut data = vec![0.0f32; w * h * 3];
+            data[(y * w + x) * 3 + 1] = 100.0;
+            let options = Options {
+                mapping,
+                ..Options::default()
+            };
+            let m = EnvMap::new(w, h, &data, options).unwrap();
+            let lit = integrate(|d| f64::from(m.eval(d)[1] > 0.0 && m.pdf(d) == 0.0));
+            assert_eq!(lit, 0.0, "{mapping:?} texel ({x}, {y})");
+            // The estimator of ∫L by envmap sampling equals the quadrature.
+            let truth = integrate(|d| m.eval(d)[1]);
+            let n = 200;
+            let mut est = 0.0;
+            for i in 0..n {
+                for j in 0..n {
+                    est += m
+                        .sample([(i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64])
+                        .weight[1];
+                }
+            }
+            est /= (n * n) as f64;
+            if truth > 1e-3 {
+                assert!(
+                    (est / truth - 1.0).abs() < 0.02,
+                    "{mapping:?} ({x}, {y}): {est} vs {truth}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn black_maps_sample_nothing() {
+    let m = EnvMap::new(4, 3, &[0.0; 36], Options::default()).unwrap();
+    let s = m.sample([0.3, 0.7]);
+    assert_eq!((s.pdf, s.weight), (0.0, [0.0; 3]));
+    assert!((s.direction.iter().map(|x| x * x).sum::<f64>() - 1.0).abs() < 1e-12);
+    assert_eq!(m.pdf([0.0, 1.0, 0.0]), 0.0);
+}
+
+#[test]
+fn compensation_removes_the_mean() {
+    // A floor of 1 with a 3 × 3 block of 50: compensated, the floor gets no
+    // samples.
+    let (w, h) = (16, 9);
+    let mut data = vec![1.0f32; w * h * 3];
+    for y in 3..6 {
+        for x in 6..9 {
+            data[(y * w + x) * 3..(y * w + x) * 3 + 3].fill(50.0);
+        }
+    }
+    for sampling in [Sampling::Piecewise, Sampling::Mitsuba] {
+        let options = Options {
+            sampling,
+            ..Options::default()
+        };
+        let compensated = Options {
+            compensate: true,
+            ..options
+        };
+        let m = EnvMap::new(w, h, &data, compensated).unwrap();
+        let plain = EnvMap::new(w, h, &data, options).unwrap();
+        let floor = m.uv_to_dir([0.1, 0.5]);
+        assert_eq!(m.pdf(floor), 0.0);
+        assert!(plain.pdf(floor) > 0.0);
+        assert!((integrate(|d| m.pdf(d)) - 1.0).abs() < 5e-3);
+    }
+    // A constant map is left as it is.
+    let flat = EnvMap::new(
+        w,
+        h,
+        &vec![2.0f32; w * h * 3],
+        Options {
+            compensate: true,
+            ..Options::default()
+        },
+    );
+    assert!(flat.unwrap().pdf([0.0, 0.0, 1.0]) > 0.0);
+}
+
+#[test]
+fn convert_round_trip_keeps_the_light() {
+    let m = map(Mapping::LatLong, Sampling::Piecewise, true);
+    for target in [Mapping::Cube, Mapping::Angular] {
+        let (w, h) = if target == Mapping::Cube {
+            (64, 384)
+        } else {
+            (128, 128)
+        };
+        let c = m.convert(target, w, h).unwrap();
+        let back = c.convert(Mapping::LatLong, 32, 17).unwrap();
+        let total = integrate(|d| m.eval(d)[0]);
+        let err = integrate(|d| (back.eval(d)[0] - m.eval(d)[0]).abs());
+        let bound = if target == Mapping::Cube { 0.05 } else { 0.1 };
+        assert!(err / total < bound, "{target:?}: {}", err / total);
+    }
+}
+
+#[test]
+fn bad_options_are_errors() {
+    let data = [1.0f32; 36];
+    let bad = |options: Options| EnvMap::new(4, 3, &data, options).unwrap_err().to_string();
+    assert!(
+        bad(Options {
+            scale: -1.0,
+            ..Options::default()
+        })
+        .starts_with("scale = -1")
+    );
+    let skew = [[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    assert!(
+        bad(Options {
+            to_world: skew,
+            ..Options::default()
+        })
+        .starts_with("to_world")
+    );
+    let e = bad(Options {
+        mapping: Mapping::Cube,
+        ..Options::default()
+    });
+    assert!(e.contains("(6, R, R, 3)"), "{e}");
+    let e = EnvMap::new(
+        2,
+        2,
+        &data[..12],
+        Options {
+            mapping: Mapping::Angular,
+            sampling: Sampling::Mitsuba,
+            ..Options::default()
+        },
+    )
+    .unwrap_err();
+    assert!(e.to_string().starts_with("sampling = \"mitsuba\""), "{e}");
+}
