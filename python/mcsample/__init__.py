@@ -6,8 +6,10 @@ Conventions (sample-major batches, float32 in / float32 out, densities per
 steradian on directions, +z normal) are in the README.
 """
 
-from . import distr, io, mis, stats, warp
+from . import data, distr, io, mis, stats, warp
 from ._core import (
+    EnvMap,
+    EnvSample,
     Frame,
     Phong,
     PhongSample,
@@ -27,6 +29,9 @@ from .distr import (
 )
 
 __all__ = [
+    "EnvMap",
+    "EnvSample",
+    "data",
     "AliasTable",
     "Discrete1D",
     "Discrete2D",

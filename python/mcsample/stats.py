@@ -29,6 +29,7 @@ __all__ = [
     "Chi2Result",
     "DiskDomain",
     "Domain",
+    "EnvMapDomain",
     "HemisphereDomain",
     "ImageZTestResult",
     "IntervalDomain",
@@ -207,6 +208,69 @@ class HemisphereDomain(SphericalDomain):
 
     bounds = ((-np.pi, np.pi), (0.0, 1.0))
     aspect = 1.0
+
+
+class EnvMapDomain(Domain):
+    """The sphere in the coordinates of an environment map's sampling table,
+    where its piecewise density is constant on cells: lat-long, Mitsuba's
+    (u, v); angular, polar coordinates around the probe's +Z, (psi, rho) =
+    (atan2(y, x) / 2 pi, acos(z) / pi); cube, (u, face + v). Densities per
+    steradian.
+
+    ``cells`` is a histogram resolution whose cells each lie in one cell of
+    the table (lat-long: half-texel columns, rows between texel rows;
+    angular: 2W sectors x W rings; cube: half-texel cells), so that the
+    expected counts of a ``sampling="piecewise"`` map are integrated exactly:
+    ``chi2_test(..., EnvMapDomain(env), res=EnvMapDomain(env).cells)``.
+    """
+
+    point_dim = 3
+
+    def __init__(self, env: Any):
+        self.env = env
+        self.mapping = env.mapping
+        self.rotation = np.asarray(env.to_world, dtype=np.float64)
+        shape = np.shape(env.image)
+        if self.mapping == "cube":
+            r = shape[1]
+            self.bounds = ((0.0, 1.0), (0.0, 6.0))
+            self.cells: tuple[int, int] = (2 * r, 12 * r)
+        elif self.mapping == "angular":
+            self.bounds = ((0.0, 1.0), (0.0, 1.0))
+            self.cells = (max(2 * shape[1], 4), max(shape[1], 2))
+        else:
+            h, w = shape[:2]
+            self.bounds = ((0.0, 1.0), (0.0, 1.0))
+            self.cells = (2 * w, h - 1)
+        (x0, x1), (y0, y1) = self.bounds
+        self.aspect = (x1 - x0) / (y1 - y0)
+
+    def to_param(self, points: np.ndarray) -> np.ndarray:
+        if self.mapping != "angular":
+            return np.asarray(self.env.dir_to_uv(points), dtype=np.float64)
+        d = points @ self.rotation  # local = R^T d
+        psi = np.arctan2(d[:, 1], d[:, 0]) / (2 * np.pi) % 1.0
+        rho = np.arctan2(np.hypot(d[:, 0], d[:, 1]), d[:, 2]) / np.pi
+        return np.stack([psi, rho], axis=1)
+
+    def from_param(self, xy: np.ndarray) -> np.ndarray:
+        if self.mapping != "angular":
+            return np.asarray(self.env.uv_to_dir(xy), dtype=np.float64)
+        psi, rho = 2 * np.pi * xy[:, 0], np.pi * xy[:, 1]
+        local = np.stack([np.cos(psi) * np.sin(rho), np.sin(psi) * np.sin(rho), np.cos(rho)], 1)
+        return local @ self.rotation.T
+
+    def jacobian(self, xy: np.ndarray) -> np.ndarray:
+        if self.mapping == "cube":
+            sc, tc = 2 * xy[:, 0] - 1, 2 * (xy[:, 1] % 1.0) - 1
+            return 4 / (1 + sc**2 + tc**2) ** 1.5
+        return 2 * np.pi**2 * np.sin(np.pi * xy[:, 1])
+
+    def check_points(self, points: np.ndarray) -> str | None:
+        return SphericalDomain.check_points(self, points)  # type: ignore[arg-type]
+
+    def __repr__(self) -> str:
+        return f"EnvMapDomain({self.mapping!r}, cells={self.cells})"
 
 
 DomainLike = Union[str, Domain, Sequence[Any]]

@@ -4,6 +4,7 @@
 
 mod arrays;
 mod distr;
+mod envmap;
 mod error;
 mod frame;
 mod io;
@@ -46,6 +47,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<frame::PyFrame>()?;
     m.add_class::<phong::PyPhong>()?;
     m.add_class::<phong::PyPhongSample>()?;
+    m.add_class::<envmap::PyEnvMap>()?;
+    m.add_class::<envmap::PyEnvSample>()?;
     submodule(m, "warp", warp::register)?;
     submodule(m, "io", io::register)?;
     submodule(m, "mis", mis::register)?;

@@ -1,0 +1,526 @@
+//! `mcsample.EnvMap`: environment maps (see [`crate::envmap`]), batched
+//! over directions and uniform samples.
+
+use super::arrays::{Check, Points, PyFloat, finish, map, with_precision, zeros};
+use super::parallel::{detached, run_batch};
+use crate::envmap::{EnvMap, Mapping, Matrix3, Options, Sampling};
+use crate::error::{Error, shape_str};
+use crate::io;
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+
+fn mapping_arg(name: &str) -> PyResult<Mapping> {
+    Mapping::from_name(name).ok_or_else(|| {
+        Error::Choice {
+            arg: "mapping",
+            value: name.into(),
+            requirement: "must be \"latlong\", \"angular\" or \"cube\"".into(),
+        }
+        .into()
+    })
+}
+
+fn sampling_arg(name: &str) -> PyResult<Sampling> {
+    Sampling::from_name(name).ok_or_else(|| {
+        Error::Choice {
+            arg: "sampling",
+            value: name.into(),
+            requirement: "must be \"piecewise\" or \"mitsuba\"".into(),
+        }
+        .into()
+    })
+}
+
+/// `to_world` as a 3×3 rotation: None (identity), a 3×3 or 4×4 array-like
+/// (translation ignored) or an object with a ``matrix`` (a Mitsuba
+/// transform).
+fn to_world_arg(ob: Option<&Bound<'_, PyAny>>) -> PyResult<Matrix3> {
+    let Some(ob) = ob.filter(|o| !o.is_none()) else {
+        return Ok(Options::default().to_world);
+    };
+    let py = ob.py();
+    let source = match ob.getattr(pyo3::intern!(py, "matrix")) {
+        Ok(m) if !ob.hasattr("shape")? => m,
+        _ => ob.clone(),
+    };
+    let array = py
+        .import(pyo3::intern!(py, "numpy"))?
+        .call_method1(pyo3::intern!(py, "asarray"), (source,))
+        .and_then(|a| a.call_method1("astype", ("float64",)))
+        .map_err(|e| {
+            PyTypeError::new_err(format!(
+                "to_world must be a 3x3 or 4x4 matrix or a Mitsuba transform: {e}"
+            ))
+        })?;
+    let array: PyArrayLikeDyn<'_, f64, AllowTypeChange> = array.extract()?;
+    let shape = array.shape().to_vec();
+    let flat: Vec<f64> = array.as_array().iter().copied().collect();
+    // A Mitsuba JIT transform's matrix has a trailing axis of width 1.
+    let n = match (flat.len(), shape.as_slice()) {
+        (9, [3, 3] | [3, 3, 1]) => 3,
+        (16, [4, 4] | [4, 4, 1]) => 4,
+        _ => {
+            return Err(Error::Shape {
+                arg: "to_world",
+                expected: "(3, 3) or (4, 4)".into(),
+                got: shape_str(&shape),
+            }
+            .into());
+        }
+    };
+    if let Some(i) = flat.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Element {
+            arg: "to_world",
+            index: format!("[{}, {}]", i / n, i % n),
+            value: flat[i],
+            requirement: "must be finite".into(),
+        }
+        .into());
+    }
+    Ok(std::array::from_fn(|r| std::array::from_fn(|c| flat[r * n + c])))
+}
+
+/// The texels of `image` for `mapping` as `(width, height, data)`: shape
+/// `(H, W, 3)`, or `(6, R, R, 3)` for cube maps (faces stacked).
+fn image_arg(image: &Bound<'_, PyAny>, mapping: Mapping) -> PyResult<(usize, usize, Vec<f32>)> {
+    let array: PyArrayLikeDyn<'_, f32, AllowTypeChange> = image
+        .extract()
+        .map_err(|e| PyTypeError::new_err(format!("image must be an array of numbers: {e}")))?;
+    let shape = array.shape().to_vec();
+    let (width, height) = match (mapping, shape.as_slice()) {
+        (Mapping::Cube, [6, r, r2, 3]) if r == r2 => (*r, 6 * r),
+        (Mapping::LatLong | Mapping::Angular, [h, w, 3]) => (*w, *h),
+        _ => {
+            return Err(Error::Shape {
+                arg: "image",
+                expected: match mapping {
+                    Mapping::Cube => "(6, R, R, 3)".into(),
+                    _ => "(H, W, 3)".into(),
+                },
+                got: shape_str(&shape),
+            }
+            .into());
+        }
+    };
+    Ok((width, height, array.as_array().iter().copied().collect()))
+}
+
+/// A file's image for `mapping`: RGB(A) (alpha dropped); cube maps as a
+/// vertical strip of six faces (6R × R) or a horizontal one (R × 6R), in
+/// the order +x, -x, +y, -y, +z, -z.
+fn read_image(path: &PathBuf, mapping: Mapping) -> crate::Result<(usize, usize, Vec<f32>)> {
+    let is_hdr = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("hdr") || e.eq_ignore_ascii_case("rgbe"));
+    let raster = if is_hdr {
+        io::read_hdr(path)?
+    } else {
+        io::read_exr(path)?
+    };
+    let rgb: Vec<f32> = raster
+        .data
+        .chunks(raster.channels)
+        .flat_map(|px| [px[0], px[1], px[2]])
+        .collect();
+    let (w, h) = (raster.width, raster.height);
+    if mapping != Mapping::Cube || h == 6 * w {
+        return Ok((w, h, rgb));
+    }
+    if w != 6 * h {
+        return Err(Error::Io {
+            path: path.clone(),
+            message: format!(
+                "a cube map file must be a strip of six square faces, 6R x R or R x 6R; got {w} x {h}"
+            ),
+        });
+    }
+    // Horizontal strip: face f is columns [f·R, (f + 1)·R).
+    let mut stacked = Vec::with_capacity(rgb.len());
+    for face in 0..6 {
+        for y in 0..h {
+            let start = (y * w + face * h) * 3;
+            stacked.extend_from_slice(&rgb[start..start + 3 * h]);
+        }
+    }
+    Ok((h, 6 * h, stacked))
+}
+
+/// Samples of ``EnvMap.sample``.
+#[pyclass(module = "mcsample._core", name = "EnvSample", frozen)]
+pub struct PyEnvSample {
+    /// World directions toward the environment, (N, 3) or (3,), unit.
+    #[pyo3(get)]
+    direction: Py<PyAny>,
+    /// Their densities per steradian, (N,).
+    #[pyo3(get)]
+    pdf: Py<PyAny>,
+    /// Radiance / pdf per RGB channel, (N, 3); 0 where pdf = 0.
+    #[pyo3(get)]
+    weight: Py<PyAny>,
+}
+
+#[pymethods]
+impl PyEnvSample {
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        let shape = self.pdf.bind(py).getattr("shape")?;
+        Ok(format!("EnvSample(shape={shape})"))
+    }
+}
+
+/// An environment map: radiance arriving from every direction (an
+/// infinitely distant light), and importance sampling of directions in
+/// proportion to its luminance. Every method takes and returns world
+/// directions.
+///
+/// Parameters
+/// ----------
+/// image : array_like or None
+///     Linear RGB radiance, float32 after conversion: (H, W, 3) for
+///     "latlong" and "angular" (square), (6, R, R, 3) for "cube"; finite
+///     and >= 0. None: the packaged sky (``mcsample.data.sky_path()``).
+/// mapping : "latlong" (default), "angular" or "cube"
+///     "latlong" is Mitsuba 3's envmap convention (Y up, u = 0 at -Z, u =
+///     1/4 at +X, v = theta / pi; texel columns centred at (x + 1/2) / W,
+///     rows at v = y / (H - 1)); "angular" is Debevec's light probe (centre
+///     +Z, rim -Z, +Y up); "cube" holds the faces +x, -x, +y, -y, +z, -z
+///     oriented as OpenGL's.
+/// to_world : None, (3, 3) or (4, 4) array_like, or a Mitsuba transform
+///     Rotation from the map's frame to the world (translation ignored).
+/// scale : float
+///     Radiance scale, finite and >= 0.
+/// sampling : "piecewise" (default) or "mitsuba"
+///     "piecewise": piecewise-constant over the cells of the bilinear
+///     radiance, so that pdf > 0 wherever eval > 0. "mitsuba" (lat-long
+///     only): Mitsuba's bilinear density, equal to its envmap emitter's
+///     ``pdf_direction``.
+/// compensate : bool
+///     MIS compensation: the mean luminance is subtracted before the
+///     sampling density is built (Karlik et al. 2019), as Mitsuba's
+///     ``mis_compensation``. Only for use in MIS.
+#[pyclass(module = "mcsample._core", name = "EnvMap", frozen)]
+pub struct PyEnvMap(EnvMap);
+
+struct Settings {
+    mapping: Mapping,
+    options: Options,
+}
+
+fn settings(
+    mapping: &str,
+    to_world: Option<&Bound<'_, PyAny>>,
+    scale: f64,
+    sampling: &str,
+    compensate: bool,
+) -> PyResult<Settings> {
+    let mapping = mapping_arg(mapping)?;
+    Ok(Settings {
+        mapping,
+        options: Options {
+            mapping,
+            to_world: to_world_arg(to_world)?,
+            scale,
+            sampling: sampling_arg(sampling)?,
+            compensate,
+        },
+    })
+}
+
+impl PyEnvMap {
+    fn build(py: Python<'_>, (w, h, data): (usize, usize, Vec<f32>), options: Options) -> PyResult<Self> {
+        Ok(Self(detached(py, || EnvMap::new(w, h, &data, options))?))
+    }
+
+    fn directions<'py, F: PyFloat, const M: usize>(
+        &self,
+        py: Python<'py>,
+        d: &Bound<'py, PyAny>,
+        kernel: impl Fn(&EnvMap, [f64; 3]) -> [f64; M] + Sync + Send,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let d = Points::<F, 3>::extract(d, "d")?;
+        let env = &self.0;
+        map(py, &d, Check::Finite, |x: [F; 3]| {
+            kernel(env, x.map(F::f64)).map(F::c)
+        })
+    }
+
+    fn sample_as<'py, F: PyFloat>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<PyEnvSample> {
+        let u = Points::<F, 2>::extract(u, "u")?;
+        let (vec_shape, scalar_shape) = (u.out_shape(3), u.out_shape(1));
+        let direction = zeros::<F>(py, &vec_shape);
+        let pdf = zeros::<F>(py, &scalar_shape);
+        let weight = zeros::<F>(py, &vec_shape);
+        {
+            let (mut g_d, mut g_p, mut g_w) = (direction.readwrite(), pdf.readwrite(), weight.readwrite());
+            let outputs = (
+                g_d.as_slice_mut()?.as_chunks_mut::<3>().0,
+                g_p.as_slice_mut()?,
+                g_w.as_slice_mut()?.as_chunks_mut::<3>().0,
+            );
+            let rows = u.rows();
+            let env = &self.0;
+            let valid = run_batch(py, u.n, outputs, |range, (o_d, o_p, o_w)| {
+                let mut ok = true;
+                for (k, x) in rows[range].iter().enumerate() {
+                    ok &= Check::Unit.holds_all(x);
+                    let s = env.sample(x.map(|v| v.f64().clamp(0.0, 1.0)));
+                    (o_d[k], o_p[k], o_w[k]) = (s.direction.map(F::c), F::c(s.pdf), s.weight.map(F::c));
+                }
+                ok
+            })?;
+            if !valid {
+                return Err(u.invalid(Check::Unit));
+            }
+        }
+        Ok(PyEnvSample {
+            direction: finish(direction)?.unbind(),
+            pdf: finish(pdf)?.unbind(),
+            weight: finish(weight)?.unbind(),
+        })
+    }
+
+    fn uv_to_dir_as<'py, F: PyFloat>(&self, py: Python<'py>, uv: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let uv = Points::<F, 2>::extract(uv, "uv")?;
+        let env = &self.0;
+        let bounds = [[0.0, 1.0], [0.0, env.options().mapping.t_max()]];
+        map(py, &uv, Check::Within(bounds), |p: [F; 2]| {
+            env.uv_to_dir(p.map(F::f64)).map(F::c)
+        })
+    }
+}
+
+#[pymethods]
+impl PyEnvMap {
+    #[new]
+    #[pyo3(signature = (image = None, mapping = "latlong", to_world = None, scale = 1.0, sampling = "piecewise", compensate = false))]
+    fn new(
+        py: Python<'_>,
+        image: Option<&Bound<'_, PyAny>>,
+        mapping: &str,
+        to_world: Option<&Bound<'_, PyAny>>,
+        scale: f64,
+        sampling: &str,
+        compensate: bool,
+    ) -> PyResult<Self> {
+        let s = settings(mapping, to_world, scale, sampling, compensate)?;
+        let texels = match image.filter(|i| !i.is_none()) {
+            Some(image) => image_arg(image, s.mapping)?,
+            None => {
+                if s.mapping != Mapping::LatLong {
+                    return Err(Error::Choice {
+                        arg: "mapping",
+                        value: s.mapping.name().into(),
+                        requirement: "the packaged sky (image=None) is lat-long; convert() it".into(),
+                    }
+                    .into());
+                }
+                let path: PathBuf = py.import("mcsample.data")?.call_method0("sky_path")?.extract()?;
+                detached(py, || read_image(&path, Mapping::LatLong))?
+            }
+        };
+        Self::build(py, texels, s.options)
+    }
+
+    /// Reads an environment map from an OpenEXR or Radiance .hdr file
+    /// (alpha is dropped). Cube maps are a strip of six square faces,
+    /// vertical (6R x R) or horizontal (R x 6R), in the order +x, -x, +y,
+    /// -y, +z, -z. The other parameters are as for ``EnvMap``.
+    ///
+    /// Raises OSError naming the path for a file that cannot be read.
+    #[staticmethod]
+    #[pyo3(signature = (path, mapping = "latlong", to_world = None, scale = 1.0, sampling = "piecewise", compensate = false))]
+    fn load(
+        py: Python<'_>,
+        path: PathBuf,
+        mapping: &str,
+        to_world: Option<&Bound<'_, PyAny>>,
+        scale: f64,
+        sampling: &str,
+        compensate: bool,
+    ) -> PyResult<Self> {
+        let s = settings(mapping, to_world, scale, sampling, compensate)?;
+        let texels = detached(py, || read_image(&path, s.mapping))?;
+        Self::build(py, texels, s.options)
+    }
+
+    /// Radiance arriving from world directions d, per RGB channel.
+    ///
+    /// Parameters
+    /// ----------
+    /// d : array_like, shape (N, 3) or (3,), directions (normalised here)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 3) or (3,), in d's precision.
+    fn eval<'py>(&self, py: Python<'py>, d: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(d, F => self.directions::<F, 3>(py, d, |e, x| e.eval(x)))
+    }
+
+    /// The density of ``sample`` at world directions d, per steradian.
+    ///
+    /// Parameters
+    /// ----------
+    /// d : array_like, shape (N, 3) or (3,), directions (normalised here)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N,) (a scalar for one direction).
+    fn pdf<'py>(&self, py: Python<'py>, d: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(d, F => self.directions::<F, 1>(py, d, |e, x| [e.pdf(x)]))
+    }
+
+    /// Directions drawn with density ``pdf``.
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    ///
+    /// Returns
+    /// -------
+    /// EnvSample
+    ///     ``.direction`` (N, 3), ``.pdf`` (N,) per steradian, ``.weight``
+    ///     (N, 3) = eval / pdf (0 where pdf = 0), in u's precision.
+    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<PyEnvSample> {
+        with_precision!(u, F => self.sample_as::<F>(py, u))
+    }
+
+    /// The map coordinates (u, v) that look along world directions d:
+    /// lat-long as Mitsuba (u in [0, 1), v = theta / pi); angular, the
+    /// image position (u to the right, v down, both in [0, 1]); cube, u
+    /// across the face and v = face + position down the face, in [0, 6).
+    ///
+    /// Parameters
+    /// ----------
+    /// d : array_like, shape (N, 3) or (3,)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 2) or (2,).
+    fn dir_to_uv<'py>(&self, py: Python<'py>, d: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(d, F => self.directions::<F, 2>(py, d, |e, x| e.dir_to_uv(x)))
+    }
+
+    /// The world directions at map coordinates uv (see ``dir_to_uv``).
+    ///
+    /// Parameters
+    /// ----------
+    /// uv : array_like, shape (N, 2) or (2,); u in [0, 1], v in [0, 1]
+    ///     ([0, 6] for cube maps)
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (N, 3) or (3,), unit vectors.
+    fn uv_to_dir<'py>(&self, py: Python<'py>, uv: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(uv, F => self.uv_to_dir_as::<F>(py, uv))
+    }
+
+    /// The same light in another parameterisation: every new texel takes
+    /// this map's bilinear value in its direction.
+    ///
+    /// Parameters
+    /// ----------
+    /// mapping : "latlong", "angular" or "cube"
+    /// resolution : int or (height, width)
+    ///     Lat-long: width W (height W // 2, at least 3) or (H, W);
+    ///     angular: R (R x R); cube: the face size R.
+    ///
+    /// Returns
+    /// -------
+    /// EnvMap with the same to_world, scale and compensate (and sampling,
+    /// where the new mapping has it).
+    fn convert(&self, py: Python<'_>, mapping: &str, resolution: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let mapping = mapping_arg(mapping)?;
+        let (w, h) = match resolution.extract::<(usize, usize)>() {
+            Ok((h, w)) if mapping == Mapping::LatLong => (w, h),
+            Ok(_) => {
+                return Err(PyTypeError::new_err(
+                    "resolution is a single int R for angular and cube maps",
+                ));
+            }
+            Err(_) => {
+                let r = super::arrays::index_arg(resolution, "resolution", 1, 1 << 15)? as usize;
+                match mapping {
+                    Mapping::LatLong => (r, (r / 2).max(3)),
+                    Mapping::Angular => (r, r),
+                    Mapping::Cube => (r, 6 * r),
+                }
+            }
+        };
+        if w == 0 || h == 0 || w.saturating_mul(h) > 1 << 28 {
+            return Err(Error::Integer {
+                arg: "resolution",
+                value: format!("({h}, {w})"),
+                requirement: "must give between 1 and 2**28 texels".into(),
+            }
+            .into());
+        }
+        let env = &self.0;
+        Ok(Self(detached(py, || env.convert(mapping, w, h))?))
+    }
+
+    /// The texels, float32: (H, W, 3), or (6, R, R, 3) for cube maps (tiny
+    /// lat-long maps as padded).
+    #[getter]
+    fn image<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let img = self.0.image();
+        let flat: Vec<f32> = img.texels().iter().flatten().copied().collect();
+        let array = PyArray1::from_vec(py, flat);
+        let (w, h) = (img.width(), img.height());
+        Ok(match self.0.options().mapping {
+            Mapping::Cube => array.reshape([6, w, w, 3])?.into_any(),
+            _ => array.reshape([h, w, 3])?.into_any(),
+        })
+    }
+
+    /// "latlong", "angular" or "cube".
+    #[getter]
+    fn mapping(&self) -> &'static str {
+        self.0.options().mapping.name()
+    }
+
+    /// "piecewise" or "mitsuba".
+    #[getter]
+    fn sampling(&self) -> &'static str {
+        self.0.options().sampling.name()
+    }
+
+    /// The radiance scale.
+    #[getter]
+    fn scale(&self) -> f64 {
+        self.0.options().scale
+    }
+
+    /// Whether MIS compensation was asked for.
+    #[getter]
+    fn compensate(&self) -> bool {
+        self.0.options().compensate
+    }
+
+    /// The local-to-world rotation, (3, 3) float64.
+    #[getter]
+    fn to_world<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let m = self.0.options().to_world;
+        Ok(PyArray1::from_vec(py, m.concat()).reshape([3, 3])?.into_any())
+    }
+
+    fn __repr__(&self) -> String {
+        let (img, o) = (self.0.image(), self.0.options());
+        format!(
+            "EnvMap(mapping={:?}, resolution={}x{}, scale={}, sampling={:?}, compensate={})",
+            o.mapping.name(),
+            img.width(),
+            img.height(),
+            o.scale,
+            o.sampling.name(),
+            if o.compensate { "True" } else { "False" }
+        )
+    }
+}
+
+impl PyEnvMap {
+    /// The core map (for the estimators' bindings).
+    pub fn inner(&self) -> &EnvMap {
+        &self.0
+    }
+}

@@ -1,0 +1,248 @@
+"""EnvMap on its own: conventions of the three mappings, samples against
+their own pdf (chi-square), pdf(sample) = sample.pdf and weight = eval / pdf,
+densities that integrate to 1, pdf > 0 wherever eval > 0, the all-black map,
+conversion between mappings, files and the packaged sky."""
+
+import numpy as np
+import pytest
+
+import mcsample as mcs
+from mcsample import stats
+
+SKY = mcs.EnvMap()
+
+
+def one_hot(mapping, x, y, size=(9, 16)):
+    """A black map with one bright texel (x, y)."""
+    h, w = size
+    if mapping == "cube":
+        image = np.zeros((6, w, w, 3), np.float32)
+        image[y // w, y % w, x] = [10.0, 20.0, 5.0]
+    else:
+        image = np.zeros((h, w, 3), np.float32)
+        image[y, x] = [10.0, 20.0, 5.0]
+    return mcs.EnvMap(image, mapping=mapping)
+
+
+def integrate(env, f, k=4):
+    """∫ f(d) dω by the midpoint rule on k x k points per cell of the map's
+    table (EnvMapDomain): exact for its piecewise-constant and bilinear
+    densities, and accurate for its radiance."""
+    dom = stats.EnvMapDomain(env)
+    nx, ny = dom.cells[0] * k, dom.cells[1] * k
+    (x0, x1), (y0, y1) = dom.bounds
+    gx, gy = np.meshgrid(x0 + (np.arange(nx) + 0.5) / nx * (x1 - x0),
+                         y0 + (np.arange(ny) + 0.5) / ny * (y1 - y0))
+    xy = np.stack([gx.ravel(), gy.ravel()], 1)
+    values = np.asarray(f(dom.from_param(xy)))
+    jacobian = dom.jacobian(xy)
+    values = values * (jacobian[:, None] if values.ndim == 2 else jacobian)
+    return values.sum(0) * (x1 - x0) * (y1 - y0) / (nx * ny)
+
+
+def sphere_grid(n_phi=720, n_z=720):
+    """Midpoints of an equal-area (phi, z) grid, and the solid angle of a
+    cell."""
+    phi = (np.arange(n_phi) + 0.5) / n_phi * 2 * np.pi
+    z = -1 + (np.arange(n_z) + 0.5) / n_z * 2
+    phi, z = np.meshgrid(phi, z)
+    r = np.sqrt(1 - z**2)
+    d = np.stack([r * np.cos(phi), z, r * np.sin(phi)], -1).reshape(-1, 3)
+    return d, 4 * np.pi / (n_phi * n_z)
+
+
+ROTATION = np.array([[0.8, 0.0, 0.6], [0.0, 1.0, 0.0], [-0.6, 0.0, 0.8]])
+
+MAPS = {
+    "sky": SKY,
+    "sky rotated x3": mcs.EnvMap(SKY.image, to_world=ROTATION, scale=3.0),
+    "sky mitsuba mode": mcs.EnvMap(SKY.image, sampling="mitsuba"),
+    "sky compensated": mcs.EnvMap(SKY.image, compensate=True),
+    "sky angular": SKY.convert("angular", 256),
+    "sky cube": SKY.convert("cube", 64),
+    "one-hot latlong": one_hot("latlong", 5, 3),
+    "one-hot angular": one_hot("angular", 4, 11, (16, 16)),
+    "one-hot cube": one_hot("cube", 2, 13, (24, 4)),
+}
+
+
+def test_latlong_axes_are_mitsubas():
+    d = np.array([[0, 0, -1], [1, 0, 0], [0, 0, 1], [0, 1, 0], [0, -1, 0.0]])
+    uv = SKY.dir_to_uv(d)
+    np.testing.assert_allclose(uv[:3], [[0, 0.5], [0.25, 0.5], [0.5, 0.5]], atol=1e-15)
+    assert uv[3, 1] == 0 and uv[4, 1] == 1
+    np.testing.assert_allclose(SKY.uv_to_dir(uv[:3]), d[:3], atol=1e-15)
+    # Texel columns centred at (x + 1/2) / W, rows on v = y / (H - 1).
+    image = SKY.image
+    h, w, _ = image.shape
+    np.testing.assert_allclose(SKY.eval(SKY.uv_to_dir([(7.5) / w, 5 / (h - 1)])), image[5, 7],
+                               rtol=1e-6)
+
+
+def test_angular_and_cube_conventions():
+    probe = SKY.convert("angular", 64)
+    np.testing.assert_allclose(probe.uv_to_dir([[0.5, 0.5], [0.5, 0.25], [0.75, 0.5]]),
+                               [[0, 0, 1], [0, 1, 0], [1, 0, 0]], atol=1e-15)
+    np.testing.assert_allclose(probe.dir_to_uv([0, 0, 1.0]), [0.5, 0.5])
+    assert probe.image.shape == (64, 64, 3)
+    # Outside the circle there is no light.
+    assert np.all(probe.image[0, 0] == 0)
+    cube = SKY.convert("cube", 16)
+    assert cube.image.shape == (6, 16, 16, 3)
+    centres = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]
+    uv = cube.dir_to_uv(np.array(centres, float))
+    np.testing.assert_allclose(uv, [[0.5, f + 0.5] for f in range(6)], atol=1e-15)
+    # The +Z face looks upright: its top row is toward +Y, its left column
+    # toward -X.
+    top, left = cube.uv_to_dir([[0.5, 4.0], [0.0, 4.5]])
+    assert top[1] > 0.5 and left[0] < -0.5
+
+
+@pytest.mark.parametrize("name", list(MAPS))
+def test_samples_follow_their_own_pdf(name):
+    """In the table's own coordinates, with histogram cells inside the
+    table's cells, the expected counts of a piecewise map are exact; Mitsuba's
+    bilinear density is smooth and checked on the sphere."""
+    env = MAPS[name]
+    if env.sampling == "mitsuba":
+        domain, res, ires = "sphere", 51, 16
+    else:
+        domain = stats.EnvMapDomain(env)
+        res, ires = domain.cells, 4
+    result = stats.chi2_test(lambda u: env.sample(u).direction, env.pdf, domain,
+                             res=res, ires=ires, test_count=2 * len(MAPS))
+    assert result.passed, result.message
+
+
+@pytest.mark.parametrize("name", ["sky", "sky rotated x3"])
+def test_samples_follow_their_own_pdf_on_the_sphere(name):
+    """The same on a sphere histogram whose cells cut across the table's."""
+    env = MAPS[name]
+    result = stats.chi2_test(lambda u: env.sample(u).direction, env.pdf, "sphere",
+                             res=51, ires=16, test_count=2 * len(MAPS))
+    assert result.passed, result.message
+
+
+@pytest.mark.parametrize("name", list(MAPS))
+def test_pdf_of_samples_and_weights(name):
+    env = MAPS[name]
+    s = env.sample(mcs.uniform(200_000, 2, seed=7))
+    assert np.allclose(np.linalg.norm(s.direction, axis=1), 1, atol=1e-12)
+    assert np.all(s.pdf > 0)
+    # Only samples within round-off of a cell boundary may find the next cell.
+    same = np.isclose(env.pdf(s.direction), s.pdf, rtol=1e-6)
+    assert same.mean() > 0.9999
+    np.testing.assert_allclose((s.weight * s.pdf[:, None])[same], env.eval(s.direction)[same],
+                               rtol=1e-6, atol=1e-9)
+
+
+@pytest.mark.parametrize("name", list(MAPS))
+def test_pdf_integrates_to_one(name):
+    env = MAPS[name]
+    assert abs(integrate(env, env.pdf) - 1) < 1e-9
+    # And on a plain (phi, cos theta) grid, where the sun is resolved worse.
+    d, cell = sphere_grid()
+    assert abs(env.pdf(d).sum() * cell - 1) < 0.1
+
+
+@pytest.mark.parametrize("mapping,texels", [
+    ("latlong", [(5, 3), (0, 0), (15, 8), (8, 0)]),
+    ("angular", [(4, 11), (0, 8), (8, 8), (15, 7)]),
+    ("cube", [(2, 13), (0, 0), (3, 23)]),
+])
+def test_one_hot_maps_are_covered_and_unbiased(mapping, texels):
+    """Wherever eval > 0, pdf > 0: envmap sampling alone is unbiased, also for
+    a texel on a pole, the seam, the rim of a probe or a cube edge."""
+    d, cell = sphere_grid(1440, 1440)
+    size = (24, 4) if mapping == "cube" else ((16, 16) if mapping == "angular" else (9, 16))
+    for x, y in texels:
+        env = one_hot(mapping, x, y, size)
+        lit = env.eval(d)[:, 1] > 0
+        assert lit.any()
+        assert np.all(env.pdf(d[lit]) > 0), (mapping, x, y)
+        truth = env.eval(d).sum(0) * cell
+        w = env.sample(mcs.uniform(400_000, 2, seed=x + 7 * y)).weight
+        mean, err = w.mean(0), w.std(0) / np.sqrt(len(w))
+        assert np.all(np.abs(mean - truth) < 4 * err + 2e-3 * truth), (mapping, x, y, mean, truth)
+
+
+def test_black_maps_sample_nothing():
+    for env in [mcs.EnvMap(np.zeros((8, 16, 3))), mcs.EnvMap(SKY.image, scale=0.0),
+                mcs.EnvMap(np.zeros((6, 4, 4, 3)), mapping="cube")]:
+        s = env.sample(mcs.uniform(1000, 2))
+        assert np.all(s.pdf == 0) and np.all(s.weight == 0)
+        np.testing.assert_allclose(np.linalg.norm(s.direction, axis=1), 1)
+        assert np.all(env.pdf(s.direction) == 0)
+
+
+def test_tiny_latlong_maps_are_padded_as_mitsuba_would():
+    env = mcs.EnvMap(np.array([[[1.0, 2.0, 3.0]]]))
+    assert env.image.shape == (3, 2, 3)
+    np.testing.assert_allclose(env.eval([[0.3, -0.4, 0.5], [0, 1, 0]]), [[1, 2, 3]] * 2)
+
+
+def test_compensation_leaves_dark_directions_to_other_strategies():
+    plain, comp = MAPS["sky"], MAPS["sky compensated"]
+    ground = np.array([0.3, -0.8, 0.1])
+    assert plain.pdf(ground) > 0 and comp.pdf(ground) == 0
+    lum = SKY.image @ np.array([0.2126, 0.7152, 0.0722])
+    y, x = np.unravel_index(np.argmax(lum), lum.shape)
+    sun = SKY.uv_to_dir([(x + 0.5) / lum.shape[1], y / (lum.shape[0] - 1)])
+    assert comp.pdf(sun) > plain.pdf(sun) > 0
+
+
+def test_convert_round_trip_keeps_the_map():
+    """latlong -> cube / angular -> latlong within interpolation error: the
+    power within 0.5% (1% through a probe, which stretches -Z); texel by texel within 5% wherever the map is smooth
+    (away from the sun's rim and the horizon, which the resampling blurs)."""
+    from scipy import ndimage
+
+    power = integrate(SKY, SKY.eval)
+    lum = SKY.image.sum(-1)
+    sky = ndimage.maximum_filter(lum, 5, mode="wrap") < 1.5 * ndimage.minimum_filter(lum, 5, mode="wrap")
+    assert sky.mean() > 0.8
+    for target, res, rtol in [("cube", 256, 5e-3), ("angular", 512, 1e-2)]:
+        back = SKY.convert(target, res).convert("latlong", (128, 256))
+        assert back.image.shape == SKY.image.shape
+        np.testing.assert_allclose(integrate(back, back.eval), power, rtol=rtol)
+        np.testing.assert_allclose(back.image[sky], SKY.image[sky], rtol=0.05, atol=2e-3)
+
+
+def test_float32_in_float32_out():
+    u = mcs.uniform(100, 2).astype(np.float32)
+    s = SKY.sample(u)
+    assert s.direction.dtype == s.pdf.dtype == s.weight.dtype == np.float32
+    assert SKY.eval(s.direction).dtype == np.float32
+    np.testing.assert_allclose(s.pdf, SKY.sample(u.astype(np.float64)).pdf, rtol=1e-5)
+
+
+def test_single_direction_is_unbatched():
+    assert SKY.eval([0, 1, 0]).shape == (3,)
+    assert np.ndim(SKY.pdf([0, 1, 0])) == 0
+    s = SKY.sample([0.5, 0.5])
+    assert s.direction.shape == (3,) and np.ndim(s.pdf) == 0
+
+
+def test_files_round_trip(tmp_path):
+    path = tmp_path / "sky.exr"
+    mcs.io.write_exr(path, SKY.image)
+    env = mcs.EnvMap.load(path, scale=2.0)
+    np.testing.assert_array_equal(env.image, SKY.image)
+    assert env.scale == 2.0
+    cube = SKY.convert("cube", 8)
+    faces = cube.image
+    mcs.io.write_exr(tmp_path / "v.exr", faces.reshape(48, 8, 3))
+    mcs.io.write_exr(tmp_path / "h.exr", np.concatenate(list(faces), axis=1))
+    for name in ["v.exr", "h.exr"]:
+        loaded = mcs.EnvMap.load(tmp_path / name, mapping="cube")
+        np.testing.assert_array_equal(loaded.image, faces)
+
+
+def test_packaged_sky():
+    path = mcs.data.sky_path()
+    assert path.stat().st_size < 300_000
+    lum = SKY.image @ np.array([0.2126, 0.7152, 0.0722])
+    assert lum.max() / lum.min() > 1e4
+    # The sun is up: the brightest texel is above the horizon.
+    y, x = np.unravel_index(np.argmax(lum), lum.shape)
+    assert SKY.uv_to_dir([(x + 0.5) / lum.shape[1], y / (lum.shape[0] - 1)])[1] > 0.3
