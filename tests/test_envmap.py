@@ -246,3 +246,11 @@ def test_packaged_sky():
     # The sun is up: the brightest texel is above the horizon.
     y, x = np.unravel_index(np.argmax(lum), lum.shape)
     assert SKY.uv_to_dir([(x + 0.5) / lum.shape[1], y / (lum.shape[0] - 1)])[1] > 0.3
+
+
+def test_truncated_file_is_an_oserror(tmp_path):
+    path = tmp_path / "sky.exr"
+    mcs.io.write_exr(path, SKY.image)
+    path.write_bytes(path.read_bytes()[:2000])
+    with pytest.raises(OSError, match="sky.exr"):
+        mcs.EnvMap.load(path)

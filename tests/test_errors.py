@@ -11,6 +11,17 @@ NAN, INF = float("nan"), float("inf")
 U2 = [[0.1, 0.2], [0.3, 0.4]]
 D3 = [[0.0, 0.0, 1.0]]
 
+def _img(nan=None, value=None):
+    """An (8, 16, 3) lat-long image, with a NaN at ``nan`` or ``value[3]`` at
+    ``value[:3]``."""
+    image = np.ones((8, 16, 3))
+    if nan is not None:
+        image[nan] = NAN
+    if value is not None:
+        image[value[:3]] = value[3]
+    return image
+
+
 CASES = [
     # (call, exception, message fragments)
     # Discrete tables: NaN, inf, negative, all-zero, empty, wrong shapes.
@@ -82,6 +93,37 @@ CASES = [
     (lambda: mcs.Frame([[0, 0, 1], [NAN, 0, 1]]), ValueError, ["normal[1]"]),
     (lambda: mcs.Frame([[0, 0, 1], [0, 1, 0]]).to_local(np.ones((3, 3))), ValueError,
      ["v must have shape (2, 3)"]),
+    # Environment maps: bad texels, shapes, options, files and inputs.
+    (lambda: mcs.EnvMap(_img(nan=(2, 3, 1))), ValueError, ["image[2, 3, 1] = NaN", ">= 0"]),
+    (lambda: mcs.EnvMap(_img(value=(1, 0, 0, INF))), ValueError, ["image[1, 0, 0] = inf"]),
+    (lambda: mcs.EnvMap(_img(value=(0, 5, 2, -1.0))), ValueError, ["image[0, 5, 2] = -1"]),
+    (lambda: mcs.EnvMap(np.ones((6, 4, 4, 3)), mapping="cube").__class__(
+        np.full((6, 4, 4, 3), NAN), mapping="cube"), ValueError, ["image[0, 0, 0, 0] = NaN"]),
+    (lambda: mcs.EnvMap(np.ones((4, 8))), ValueError, ["image must have shape (H, W, 3)", "(4, 8)"]),
+    (lambda: mcs.EnvMap(np.ones((4, 8, 3)), mapping="angular"), ValueError,
+     ["image must have shape (R, R, 3)"]),
+    (lambda: mcs.EnvMap(np.ones((4, 8, 3)), mapping="cube"), ValueError, ["(6, R, R, 3)"]),
+    (lambda: mcs.EnvMap(np.ones((0, 8, 3))), ValueError, ["image must have shape"]),
+    (lambda: mcs.EnvMap(_img(), mapping="polar"), ValueError, ['mapping = "polar"', "latlong"]),
+    (lambda: mcs.EnvMap(_img(), sampling="fast"), ValueError, ['sampling = "fast"']),
+    (lambda: mcs.EnvMap(np.ones((4, 4, 3)), mapping="angular", sampling="mitsuba"), ValueError,
+     ['sampling = "mitsuba"', "lat-long only"]),
+    (lambda: mcs.EnvMap(_img(), scale=-2.0), ValueError, ["scale = -2", ">= 0"]),
+    (lambda: mcs.EnvMap(_img(), scale=NAN), ValueError, ["scale = NaN"]),
+    (lambda: mcs.EnvMap(_img(), to_world=np.diag([2.0, 1, 1])), ValueError,
+     ["to_world", "rotation"]),
+    (lambda: mcs.EnvMap(_img(), to_world=np.ones((2, 2))), ValueError,
+     ["to_world must have shape (3, 3) or (4, 4)"]),
+    (lambda: mcs.EnvMap(_img(), to_world=[[1, 0, 0], [0, NAN, 0], [0, 0, 1]]), ValueError,
+     ["to_world[1, 1] = NaN"]),
+    (lambda: mcs.EnvMap.load("/nonexistent/sky.exr"), OSError, ["/nonexistent/sky.exr"]),
+    (lambda: mcs.EnvMap(_img()).sample([[0.5, NAN]]), ValueError, ["u[0, 1] = NaN"]),
+    (lambda: mcs.EnvMap(_img()).sample([0.5, 1.5, 0.1]), ValueError, ["u must have shape (N, 2)"]),
+    (lambda: mcs.EnvMap(_img()).eval([[0, 1, 0], [INF, 0, 0]]), ValueError, ["d[1, 0] = inf"]),
+    (lambda: mcs.EnvMap(_img()).pdf([[0, 1]]), ValueError, ["d must have shape (N, 3)"]),
+    (lambda: mcs.EnvMap(_img()).uv_to_dir([0.5, 1.5]), ValueError, ["uv[1] = 1.5"]),
+    (lambda: mcs.EnvMap(_img()).convert("cube", 0), ValueError, ["resolution = 0"]),
+    (lambda: mcs.EnvMap(_img()).convert("cube", 2.5), TypeError, ["resolution"]),
     # Rejection sampling: a pdf callable returning negative values, values
     # above the bound, NaN; bad bound, domain or n.
     (lambda: mcs.rejection_sample(lambda x: x - 0.5, 1.0, (0, 1), 10), ValueError,

@@ -79,7 +79,9 @@ fn to_world_arg(ob: Option<&Bound<'_, PyAny>>) -> PyResult<Matrix3> {
         }
         .into());
     }
-    Ok(std::array::from_fn(|r| std::array::from_fn(|c| flat[r * n + c])))
+    Ok(std::array::from_fn(|r| {
+        std::array::from_fn(|c| flat[r * n + c])
+    }))
 }
 
 /// The texels of `image` for `mapping` as `(width, height, data)`: shape
@@ -228,7 +230,11 @@ fn settings(
 }
 
 impl PyEnvMap {
-    fn build(py: Python<'_>, (w, h, data): (usize, usize, Vec<f32>), options: Options) -> PyResult<Self> {
+    fn build(
+        py: Python<'_>,
+        (w, h, data): (usize, usize, Vec<f32>),
+        options: Options,
+    ) -> PyResult<Self> {
         Ok(Self(detached(py, || EnvMap::new(w, h, &data, options))?))
     }
 
@@ -245,14 +251,19 @@ impl PyEnvMap {
         })
     }
 
-    fn sample_as<'py, F: PyFloat>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<PyEnvSample> {
+    fn sample_as<'py, F: PyFloat>(
+        &self,
+        py: Python<'py>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<PyEnvSample> {
         let u = Points::<F, 2>::extract(u, "u")?;
         let (vec_shape, scalar_shape) = (u.out_shape(3), u.out_shape(1));
         let direction = zeros::<F>(py, &vec_shape);
         let pdf = zeros::<F>(py, &scalar_shape);
         let weight = zeros::<F>(py, &vec_shape);
         {
-            let (mut g_d, mut g_p, mut g_w) = (direction.readwrite(), pdf.readwrite(), weight.readwrite());
+            let (mut g_d, mut g_p, mut g_w) =
+                (direction.readwrite(), pdf.readwrite(), weight.readwrite());
             let outputs = (
                 g_d.as_slice_mut()?.as_chunks_mut::<3>().0,
                 g_p.as_slice_mut()?,
@@ -265,7 +276,8 @@ impl PyEnvMap {
                 for (k, x) in rows[range].iter().enumerate() {
                     ok &= Check::Unit.holds_all(x);
                     let s = env.sample(x.map(|v| v.f64().clamp(0.0, 1.0)));
-                    (o_d[k], o_p[k], o_w[k]) = (s.direction.map(F::c), F::c(s.pdf), s.weight.map(F::c));
+                    (o_d[k], o_p[k], o_w[k]) =
+                        (s.direction.map(F::c), F::c(s.pdf), s.weight.map(F::c));
                 }
                 ok
             })?;
@@ -280,7 +292,11 @@ impl PyEnvMap {
         })
     }
 
-    fn uv_to_dir_as<'py, F: PyFloat>(&self, py: Python<'py>, uv: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn uv_to_dir_as<'py, F: PyFloat>(
+        &self,
+        py: Python<'py>,
+        uv: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let uv = Points::<F, 2>::extract(uv, "uv")?;
         let env = &self.0;
         let bounds = [[0.0, 1.0], [0.0, env.options().mapping.t_max()]];
@@ -311,11 +327,15 @@ impl PyEnvMap {
                     return Err(Error::Choice {
                         arg: "mapping",
                         value: s.mapping.name().into(),
-                        requirement: "the packaged sky (image=None) is lat-long; convert() it".into(),
+                        requirement: "the packaged sky (image=None) is lat-long; convert() it"
+                            .into(),
                     }
                     .into());
                 }
-                let path: PathBuf = py.import("mcsample.data")?.call_method0("sky_path")?.extract()?;
+                let path: PathBuf = py
+                    .import("mcsample.data")?
+                    .call_method0("sky_path")?
+                    .extract()?;
                 detached(py, || read_image(&path, Mapping::LatLong))?
             }
         };
@@ -397,7 +417,11 @@ impl PyEnvMap {
     /// Returns
     /// -------
     /// ndarray, shape (N, 2) or (2,).
-    fn dir_to_uv<'py>(&self, py: Python<'py>, d: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn dir_to_uv<'py>(
+        &self,
+        py: Python<'py>,
+        d: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         with_precision!(d, F => self.directions::<F, 2>(py, d, |e, x| e.dir_to_uv(x)))
     }
 
@@ -411,7 +435,11 @@ impl PyEnvMap {
     /// Returns
     /// -------
     /// ndarray, shape (N, 3) or (3,), unit vectors.
-    fn uv_to_dir<'py>(&self, py: Python<'py>, uv: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn uv_to_dir<'py>(
+        &self,
+        py: Python<'py>,
+        uv: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         with_precision!(uv, F => self.uv_to_dir_as::<F>(py, uv))
     }
 
@@ -429,7 +457,12 @@ impl PyEnvMap {
     /// -------
     /// EnvMap with the same to_world, scale and compensate (and sampling,
     /// where the new mapping has it).
-    fn convert(&self, py: Python<'_>, mapping: &str, resolution: &Bound<'_, PyAny>) -> PyResult<Self> {
+    fn convert(
+        &self,
+        py: Python<'_>,
+        mapping: &str,
+        resolution: &Bound<'_, PyAny>,
+    ) -> PyResult<Self> {
         let mapping = mapping_arg(mapping)?;
         let (w, h) = match resolution.extract::<(usize, usize)>() {
             Ok((h, w)) if mapping == Mapping::LatLong => (w, h),
@@ -501,7 +534,9 @@ impl PyEnvMap {
     #[getter]
     fn to_world<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let m = self.0.options().to_world;
-        Ok(PyArray1::from_vec(py, m.concat()).reshape([3, 3])?.into_any())
+        Ok(PyArray1::from_vec(py, m.concat())
+            .reshape([3, 3])?
+            .into_any())
     }
 
     fn __repr__(&self) -> String {

@@ -1,5 +1,6 @@
 """Type stub of mcsample's compiled core (``mcsample._core``)."""
 
+import os
 from typing import Any, Sequence, Union, final
 
 import numpy as np
@@ -167,3 +168,51 @@ class Phong:
     def specular(self) -> list[float]: ...
     @property
     def exponent(self) -> float: ...
+
+@final
+class EnvSample:
+    """Samples of EnvMap.sample."""
+
+    @property
+    def direction(self) -> Any: ...
+    @property
+    def pdf(self) -> Any: ...
+    @property
+    def weight(self) -> Any: ...
+
+@final
+class EnvMap:
+    """Environment map: radiance from every world direction, and importance
+    sampling of directions ("latlong" as Mitsuba 3's envmap, "angular",
+    "cube")."""
+
+    def __new__(cls, image: ArrayLike | None = None, mapping: str = "latlong",
+                to_world: Any = None, scale: float = 1.0, sampling: str = "piecewise",
+                compensate: bool = False) -> EnvMap: ...
+    @staticmethod
+    def load(path: str | os.PathLike[str], mapping: str = "latlong", to_world: Any = None,
+             scale: float = 1.0, sampling: str = "piecewise",
+             compensate: bool = False) -> EnvMap:
+        """Reads an OpenEXR or Radiance .hdr file."""
+    def eval(self, d: ArrayLike) -> Any:
+        """Radiance from world directions d, (N, 3)."""
+    def pdf(self, d: ArrayLike) -> Any:
+        """Density of sample per steradian, (N,)."""
+    def sample(self, u: ArrayLike) -> EnvSample: ...
+    def dir_to_uv(self, d: ArrayLike) -> Any:
+        """Map coordinates of world directions, (N, 2)."""
+    def uv_to_dir(self, uv: ArrayLike) -> Any:
+        """World directions of map coordinates, (N, 3)."""
+    def convert(self, mapping: str, resolution: int | tuple[int, int]) -> EnvMap: ...
+    @property
+    def image(self) -> Any: ...
+    @property
+    def mapping(self) -> str: ...
+    @property
+    def sampling(self) -> str: ...
+    @property
+    def scale(self) -> float: ...
+    @property
+    def compensate(self) -> bool: ...
+    @property
+    def to_world(self) -> Any: ...
