@@ -9,7 +9,7 @@ use crate::io;
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 fn mapping_arg(name: &str) -> PyResult<Mapping> {
     Mapping::from_name(name).ok_or_else(|| {
@@ -112,7 +112,7 @@ fn image_arg(image: &Bound<'_, PyAny>, mapping: Mapping) -> PyResult<(usize, usi
 /// A file's image for `mapping`: RGB(A) (alpha dropped); cube maps as a
 /// vertical strip of six faces (6R × R) or a horizontal one (R × 6R), in
 /// the order +x, -x, +y, -y, +z, -z.
-fn read_image(path: &PathBuf, mapping: Mapping) -> crate::Result<(usize, usize, Vec<f32>)> {
+fn read_image(path: &Path, mapping: Mapping) -> crate::Result<(usize, usize, Vec<f32>)> {
     let is_hdr = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("hdr") || e.eq_ignore_ascii_case("rgbe"));
@@ -132,7 +132,7 @@ fn read_image(path: &PathBuf, mapping: Mapping) -> crate::Result<(usize, usize, 
     }
     if w != 6 * h {
         return Err(Error::Io {
-            path: path.clone(),
+            path: path.to_path_buf(),
             message: format!(
                 "a cube map file must be a strip of six square faces, 6R x R or R x 6R; got {w} x {h}"
             ),
