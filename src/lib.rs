@@ -13,6 +13,8 @@
 //!   piecewise-constant densities.
 //! - [`envmap`]: environment maps (lat-long, angular, cube) and their
 //!   importance sampling.
+//! - [`estimators`]: irradiance and reflected radiance under an envmap,
+//!   by several strategies and MIS.
 //! - [`phong`]: the energy-normalised Phong BRDF and its sampling.
 //! - [`mis`]: multiple importance sampling heuristics.
 //! - [`frame`]: orthonormal frames around a normal.
@@ -36,6 +38,7 @@ pub mod buffer;
 pub mod distr;
 pub mod envmap;
 pub mod error;
+pub mod estimators;
 pub mod frame;
 pub mod io;
 pub mod math;

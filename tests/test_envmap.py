@@ -24,20 +24,8 @@ def one_hot(mapping, x, y, size=(9, 16)):
     return mcs.EnvMap(image, mapping=mapping)
 
 
-def integrate(env, f, k=4):
-    """∫ f(d) dω by the midpoint rule on k x k points per cell of the map's
-    table (EnvMapDomain): exact for its piecewise-constant and bilinear
-    densities, and accurate for its radiance."""
-    dom = stats.EnvMapDomain(env)
-    nx, ny = dom.cells[0] * k, dom.cells[1] * k
-    (x0, x1), (y0, y1) = dom.bounds
-    gx, gy = np.meshgrid(x0 + (np.arange(nx) + 0.5) / nx * (x1 - x0),
-                         y0 + (np.arange(ny) + 0.5) / ny * (y1 - y0))
-    xy = np.stack([gx.ravel(), gy.ravel()], 1)
-    values = np.asarray(f(dom.from_param(xy)))
-    jacobian = dom.jacobian(xy)
-    values = values * (jacobian[:, None] if values.ndim == 2 else jacobian)
-    return values.sum(0) * (x1 - x0) * (y1 - y0) / (nx * ny)
+def integrate(env, f):
+    return mcs.estimators.envmap_integral(env, f)
 
 
 def sphere_grid(n_phi=720, n_z=720):

@@ -6,7 +6,7 @@ Conventions (sample-major batches, float32 in / float32 out, densities per
 steradian on directions, +z normal) are in the README.
 """
 
-from . import data, distr, io, mis, stats, warp
+from . import data, distr, estimators, io, mis, stats, warp
 from ._core import (
     EnvMap,
     EnvSample,
@@ -42,6 +42,7 @@ __all__ = [
     "PiecewiseConstant2D",
     "Rng",
     "distr",
+    "estimators",
     "__version__",
     "get_num_threads",
     "io",

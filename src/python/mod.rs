@@ -6,6 +6,7 @@ mod arrays;
 mod distr;
 mod envmap;
 mod error;
+mod estimators;
 mod frame;
 mod io;
 mod mis;
@@ -52,5 +53,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     submodule(m, "warp", warp::register)?;
     submodule(m, "io", io::register)?;
     submodule(m, "mis", mis::register)?;
+    submodule(m, "estimators", estimators::register)?;
     Ok(())
 }

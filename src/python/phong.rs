@@ -213,6 +213,11 @@ impl PyPhong {
 }
 
 impl PyPhong {
+    /// The core BRDF (for the estimators' bindings).
+    pub fn inner(&self) -> &Phong {
+        &self.0
+    }
+
     fn sample_as<'py, F: PyFloat>(
         &self,
         py: Python<'py>,

@@ -6,6 +6,7 @@ from typing import Any, Sequence, Union, final
 import numpy as np
 from numpy.typing import ArrayLike, DTypeLike, NDArray
 
+from . import estimators as estimators
 from . import io as io
 from . import mis as mis
 from . import warp as warp

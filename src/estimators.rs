@@ -1,0 +1,425 @@
+//! Monte Carlo estimators of the light an environment map delivers to a
+//! point: irradiance on a surface, and radiance reflected by a Phong
+//! surface, each by several sampling strategies and their MIS combination.
+//!
+//! An estimate averages `n` independent evaluations `f_i`; its standard
+//! error is `s/√n` with `s²` the sample variance. Sample `i` draws its
+//! uniform numbers from the PCG32 stream of `seed` advanced to
+//! `i · draws`, so the result is the same bits whatever the thread count.
+//!
+//! # Irradiance `E = ∫ L(ω) max(0, n·ω) dω`
+//! - uniform: `ω` uniform on the hemisphere of `n`, `f = L cos θ · 2π`;
+//! - cosine: `ω` cosine-weighted, `f = L π`;
+//! - envmap: `ω` from the map, `f = (L/p_env) cos⁺ θ`;
+//! - mis: one cosine and one envmap sample, each weighted by the heuristic
+//!   against the other's density (Veach's multi-sample model).
+//!
+//! # Reflected radiance `L_r(ωi) = ∫ L(ω) f_r(ωi, ω) cos⁺ θ dω`
+//! With the Phong BRDF in the frame of `n`: bsdf (its own sampling), envmap,
+//! and mis of the two.
+
+use crate::envmap::EnvMap;
+use crate::error::{Error, Result};
+use crate::frame::Frame;
+use crate::mis;
+use crate::parallel;
+use crate::phong::Phong;
+use crate::rng::Rng;
+use crate::warp::{self, V3};
+use std::f64::consts::PI;
+use std::sync::Mutex;
+
+/// A sampling strategy.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Strategy {
+    /// Uniform directions on the hemisphere (irradiance only).
+    Uniform,
+    /// Cosine-weighted directions (irradiance only).
+    Cosine,
+    /// The BRDF's own sampling (reflected radiance only).
+    Bsdf,
+    /// The environment map's importance sampling.
+    Envmap,
+    /// MIS of the two applicable strategies (cosine or BSDF, and envmap).
+    Mis,
+}
+
+impl Strategy {
+    /// The strategy called `name` (`"uniform"`, `"cosine"`, `"bsdf"`,
+    /// `"envmap"`, `"mis"`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Some(match name {
+            "uniform" => Strategy::Uniform,
+            "cosine" => Strategy::Cosine,
+            "bsdf" => Strategy::Bsdf,
+            "envmap" => Strategy::Envmap,
+            "mis" => Strategy::Mis,
+            _ => return None,
+        })
+    }
+}
+
+/// How MIS weights two samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Heuristic {
+    /// `p_a / (p_a + p_b)`.
+    Balance,
+    /// `p_a² / (p_a² + p_b²)`.
+    Power,
+}
+
+impl Heuristic {
+    /// The heuristic called `name` (`"balance"`, `"power"`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "balance" => Some(Heuristic::Balance),
+            "power" => Some(Heuristic::Power),
+            _ => None,
+        }
+    }
+
+    #[inline(always)]
+    fn weight(self, pdf_a: f64, pdf_b: f64) -> f64 {
+        match self {
+            Heuristic::Balance => mis::balance_heuristic(pdf_a, pdf_b),
+            Heuristic::Power => mis::power_heuristic(pdf_a, pdf_b, 2.0),
+        }
+    }
+}
+
+/// How to estimate: `n` evaluations by `strategy` (MIS weights by
+/// `heuristic`), random numbers from the stream of `seed`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Plan {
+    /// Number of evaluations, at least 1.
+    pub n: usize,
+    /// The sampling strategy.
+    pub strategy: Strategy,
+    /// The MIS heuristic (for [`Strategy::Mis`]).
+    pub heuristic: Heuristic,
+    /// Seed of the PCG32 stream.
+    pub seed: u64,
+}
+
+/// A Monte Carlo estimate of an RGB quantity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate {
+    /// The mean of the evaluations.
+    pub value: V3<f64>,
+    /// Its standard error, `s/√n`.
+    pub stderr: V3<f64>,
+    /// The number of evaluations.
+    pub n: usize,
+}
+
+/// Running mean and sum of squared deviations (Welford), merged in a fixed
+/// order (Chan et al.).
+#[derive(Clone, Copy, Debug, Default)]
+struct Moments {
+    n: f64,
+    mean: V3<f64>,
+    m2: V3<f64>,
+}
+
+impl Moments {
+    #[inline(always)]
+    fn push(&mut self, f: V3<f64>) {
+        self.n += 1.0;
+        for (k, &x) in f.iter().enumerate() {
+            let delta = x - self.mean[k];
+            self.mean[k] += delta / self.n;
+            self.m2[k] += delta * (x - self.mean[k]);
+        }
+    }
+
+    fn merge(self, other: Moments) -> Moments {
+        let n = self.n + other.n;
+        if n == 0.0 {
+            return self;
+        }
+        let mut out = Moments {
+            n,
+            ..Moments::default()
+        };
+        for k in 0..3 {
+            let delta = other.mean[k] - self.mean[k];
+            out.mean[k] = self.mean[k] + delta * other.n / n;
+            out.m2[k] = self.m2[k] + other.m2[k] + delta * delta * self.n * other.n / n;
+        }
+        out
+    }
+}
+
+/// The mean and standard error of `f(rng)` over `n` evaluations, each with
+/// its own stretch of `draws` numbers of the stream of `seed`.
+fn estimate(
+    n: usize,
+    seed: u64,
+    draws: u64,
+    f: impl Fn(&mut Rng) -> V3<f64> + Sync,
+) -> Result<Estimate> {
+    let base = Rng::new(seed, 0);
+    let parts = Mutex::new(Vec::new());
+    parallel::for_each_chunk(n, (), |range, ()| {
+        // One partial sum per block of CHUNK items, whatever the range a
+        // thread is handed: the same sums in the same order on any pool.
+        let mut local = Vec::new();
+        for start in range.clone().step_by(parallel::CHUNK) {
+            let mut rng = base.jumped(start as u64 * draws);
+            let mut m = Moments::default();
+            for _ in start..(start + parallel::CHUNK).min(range.end) {
+                m.push(f(&mut rng));
+            }
+            local.push((start, m));
+        }
+        parts
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .extend(local);
+        true
+    })?;
+    let mut parts = parts.into_inner().unwrap_or_else(|p| p.into_inner());
+    parts.sort_by_key(|p| p.0);
+    let m = parts
+        .into_iter()
+        .fold(Moments::default(), |acc, (_, m)| acc.merge(m));
+    let stderr = if n > 1 {
+        m.m2.map(|v| (v / (m.n - 1.0) / m.n).sqrt())
+    } else {
+        [f64::INFINITY; 3]
+    };
+    Ok(Estimate {
+        value: m.mean,
+        stderr,
+        n,
+    })
+}
+
+fn check(n: usize, normal: V3<f64>) -> Result<V3<f64>> {
+    if n == 0 {
+        return Err(Error::Integer {
+            arg: "n",
+            value: "0".into(),
+            requirement: "must be at least 1".into(),
+        });
+    }
+    let len = dot(normal, normal).sqrt();
+    if !(len > 0.0 && len.is_finite()) {
+        return Err(Error::Parameter {
+            arg: "normal",
+            value: len,
+            requirement: "must be finite and non-zero (its length is shown)",
+        });
+    }
+    Ok(normal.map(|x| x / len))
+}
+
+fn unsupported(strategy: Strategy, allowed: &str) -> Error {
+    Error::Choice {
+        arg: "strategy",
+        value: format!("{strategy:?}").to_lowercase(),
+        requirement: format!("must be one of {allowed}"),
+    }
+}
+
+#[inline(always)]
+fn dot(a: V3<f64>, b: V3<f64>) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+fn scaled(v: V3<f64>, s: f64) -> V3<f64> {
+    v.map(|x| x * s)
+}
+
+#[inline(always)]
+fn add(a: V3<f64>, b: V3<f64>) -> V3<f64> {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+#[inline(always)]
+fn next2(rng: &mut Rng) -> [f64; 2] {
+    [rng.next_float(), rng.next_float()]
+}
+
+/// The irradiance at a surface of unit `normal` (world) lit by `env`.
+///
+/// # Errors
+/// [`Error::Integer`] for `n = 0`, [`Error::Parameter`] for a zero or
+/// non-finite normal, [`Error::Choice`] for [`Strategy::Bsdf`].
+pub fn irradiance(env: &EnvMap, normal: V3<f64>, plan: Plan) -> Result<Estimate> {
+    let Plan {
+        n,
+        strategy,
+        heuristic,
+        seed,
+    } = plan;
+    let normal = check(n, normal)?;
+    let frame = Frame::from_normal(normal);
+    let cosine_pdf = |d: V3<f64>| dot(d, normal).max(0.0) / PI;
+    match strategy {
+        Strategy::Uniform => estimate(n, seed, 2, |rng| {
+            let d = frame.to_world(warp::square_to_uniform_hemisphere(next2(rng)));
+            scaled(env.eval(d), dot(d, normal).max(0.0) * 2.0 * PI)
+        }),
+        Strategy::Cosine => estimate(n, seed, 2, |rng| {
+            let local = warp::square_to_cosine_hemisphere(next2(rng));
+            let f = if local[2] > 0.0 { PI } else { 0.0 };
+            scaled(env.eval(frame.to_world(local)), f)
+        }),
+        Strategy::Envmap => estimate(n, seed, 2, |rng| {
+            let s = env.sample(next2(rng));
+            scaled(s.weight, dot(s.direction, normal).max(0.0))
+        }),
+        Strategy::Mis => estimate(n, seed, 4, |rng| {
+            let d = frame.to_world(warp::square_to_cosine_hemisphere(next2(rng)));
+            let p = cosine_pdf(d);
+            let from_cosine = if p > 0.0 {
+                let w = heuristic.weight(p, env.pdf(d));
+                scaled(env.eval(d), w * dot(d, normal) / p)
+            } else {
+                [0.0; 3]
+            };
+            let s = env.sample(next2(rng));
+            let w = heuristic.weight(s.pdf, cosine_pdf(s.direction));
+            add(
+                from_cosine,
+                scaled(s.weight, w * dot(s.direction, normal).max(0.0)),
+            )
+        }),
+        Strategy::Bsdf => Err(unsupported(strategy, "uniform, cosine, envmap, mis")),
+    }
+}
+
+/// The radiance a Phong surface of unit `normal` (world) reflects toward the
+/// world direction `wi` under `env`.
+///
+/// # Errors
+/// As [`irradiance`], also for a zero or non-finite `wi`, and
+/// [`Error::Choice`] for [`Strategy::Uniform`] and [`Strategy::Cosine`].
+pub fn reflected_radiance(
+    env: &EnvMap,
+    phong: &Phong,
+    normal: V3<f64>,
+    wi: V3<f64>,
+    plan: Plan,
+) -> Result<Estimate> {
+    let Plan {
+        n,
+        strategy,
+        heuristic,
+        seed,
+    } = plan;
+    let normal = check(n, normal)?;
+    let wi = check(n, wi).map_err(|e| match e {
+        Error::Parameter {
+            value, requirement, ..
+        } => Error::Parameter {
+            arg: "wi",
+            value,
+            requirement,
+        },
+        other => other,
+    })?;
+    let frame = Frame::from_normal(normal);
+    let wi = frame.to_local(wi);
+    // f_r · cos⁺θ of a world direction, and the BRDF's sampling density.
+    let reflect = |d: V3<f64>| {
+        let wo = frame.to_local(d);
+        scaled(phong.eval(wi, wo), wo[2].max(0.0))
+    };
+    let bsdf_sample = |rng: &mut Rng| {
+        let s = phong.sample(wi, [rng.next_float(), rng.next_float(), rng.next_float()]);
+        (frame.to_world(s.wo), s)
+    };
+    let times = |a: V3<f64>, b: V3<f64>| [a[0] * b[0], a[1] * b[1], a[2] * b[2]];
+    match strategy {
+        Strategy::Bsdf => estimate(n, seed, 3, |rng| {
+            let (d, s) = bsdf_sample(rng);
+            times(s.weight, env.eval(d))
+        }),
+        Strategy::Envmap => estimate(n, seed, 2, |rng| {
+            let s = env.sample(next2(rng));
+            times(s.weight, reflect(s.direction))
+        }),
+        Strategy::Mis => estimate(n, seed, 5, |rng| {
+            let (d, b) = bsdf_sample(rng);
+            let w = heuristic.weight(b.pdf, env.pdf(d));
+            let from_bsdf = scaled(times(b.weight, env.eval(d)), w);
+            let s = env.sample(next2(rng));
+            let w = heuristic.weight(s.pdf, phong.pdf(wi, frame.to_local(s.direction)));
+            add(from_bsdf, scaled(times(s.weight, reflect(s.direction)), w))
+        }),
+        Strategy::Uniform | Strategy::Cosine => Err(unsupported(strategy, "bsdf, envmap, mis")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::envmap::Options;
+    use crate::phong::Selection;
+
+    fn plan(n: usize, strategy: Strategy, seed: u64) -> Plan {
+        Plan {
+            n,
+            strategy,
+            heuristic: Heuristic::Power,
+            seed,
+        }
+    }
+
+    fn sky() -> EnvMap {
+        let (w, h) = (32, 17);
+        let mut data = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                let v = if (x, y) == (10, 5) {
+                    200.0
+                } else {
+                    0.5 + y as f32 / 16.0
+                };
+                data.extend([v, 0.8 * v, 0.6 * v]);
+            }
+        }
+        EnvMap::new(w, h, &data, Options::default()).unwrap()
+    }
+
+    fn z(a: &Estimate, b: &Estimate) -> f64 {
+        (a.value[0] - b.value[0]) / a.stderr[0].hypot(b.stderr[0])
+    }
+
+    #[test]
+    fn strategies_agree_and_mis_is_deterministic() {
+        let env = sky();
+        let normal = [0.3, 0.9, 0.1];
+        let reference = irradiance(&env, normal, plan(400_000, Strategy::Envmap, 1)).unwrap();
+        for strategy in [Strategy::Uniform, Strategy::Cosine, Strategy::Mis] {
+            let e = irradiance(&env, normal, plan(400_000, strategy, 2)).unwrap();
+            assert!(z(&e, &reference).abs() < 5.0, "{e:?} vs {reference:?}");
+        }
+        parallel::set_num_threads(1).unwrap();
+        let one = irradiance(&env, normal, plan(100_000, Strategy::Mis, 3)).unwrap();
+        parallel::set_num_threads(3).unwrap();
+        let three = irradiance(&env, normal, plan(100_000, Strategy::Mis, 3)).unwrap();
+        assert_eq!(one, three);
+    }
+
+    #[test]
+    fn reflected_strategies_agree() {
+        let env = sky();
+        let phong = Phong::new([0.2; 3], [0.6; 3], 40.0, Selection::Max).unwrap();
+        let (normal, wi) = ([0.0, 1.0, 0.0], [0.5, 0.8, 0.0]);
+        let reference =
+            reflected_radiance(&env, &phong, normal, wi, plan(400_000, Strategy::Mis, 1)).unwrap();
+        for strategy in [Strategy::Bsdf, Strategy::Envmap] {
+            let e =
+                reflected_radiance(&env, &phong, normal, wi, plan(400_000, strategy, 2)).unwrap();
+            assert!(z(&e, &reference).abs() < 5.0, "{e:?} vs {reference:?}");
+        }
+        let cosine = plan(10, Strategy::Cosine, 1);
+        assert!(reflected_radiance(&env, &phong, normal, wi, cosine).is_err());
+        assert!(irradiance(&env, [0.0; 3], cosine).is_err());
+        assert!(irradiance(&env, normal, plan(0, Strategy::Cosine, 1)).is_err());
+    }
+}
