@@ -252,11 +252,100 @@ def suite_phong(n: int, repeat: int, mi) -> list[Timing]:
     ]
 
 
+def _numpy_envmap_sampler(image: np.ndarray):
+    """Lat-long envmap sampling with numpy: luminance x sin(theta) per texel,
+    marginal CDF over rows, conditional CDFs within rows, searchsorted."""
+    h, w, _ = image.shape
+    lum = image @ np.array([0.2126, 0.7152, 0.0722])
+    weights = lum * np.sin(np.pi * (np.arange(h) + 0.5) / h)[:, None]
+    rows = np.cumsum(weights, axis=1)
+    marginal = np.cumsum(rows[:, -1])
+    total = marginal[-1]
+
+    def sample(u: np.ndarray):
+        y = np.minimum(np.searchsorted(marginal, u[:, 1] * total, side="right"), h - 1)
+        row = rows[y]
+        x = np.minimum((row < (u[:, 0] * row[:, -1])[:, None]).sum(1), w - 1)
+        v = (y + 0.5) / h
+        uu = (x + 0.5) / w
+        theta, phi = np.pi * v, 2 * np.pi * uu
+        d = np.stack([np.sin(phi) * np.sin(theta), np.cos(theta), -np.cos(phi) * np.sin(theta)], 1)
+        pdf = weights[y, x] / total * w * h / (2 * np.pi**2 * np.sin(theta))
+        return d, pdf, image[y, x] / pdf[:, None]
+
+    return sample
+
+
+def suite_envmap(n: int, repeat: int, mi) -> list[Timing]:
+    """The packaged sky resampled to 1024 x 512 (and 2048 x 1024 for the
+    build): EnvMap build, sample and pdf beside Mitsuba 3's envmap emitter
+    (llvm) and a numpy sampler (on 1/10 of the samples)."""
+    sky = {res: mcs.EnvMap().convert("latlong", res).image for res in [1024, 2048]}
+    image = sky[1024]
+    out = []
+    for res, img in sky.items():
+        label = f"EnvMap build {res}x{res // 2} (texels/s)"
+        out.append(Timing(label, "mcsample", "float32", img.shape[0] * img.shape[1],
+                          measure(lambda img=img: mcs.EnvMap(img), repeat)))
+        if mi is not None:
+            bitmap = mi.Bitmap(img)
+            out.append(Timing(label, "Mitsuba 3 llvm", "float32", img.shape[0] * img.shape[1],
+                              measure(lambda bitmap=bitmap: mi.load_dict(
+                                  {"type": "envmap", "bitmap": bitmap}), repeat)))
+    env = mcs.EnvMap(image)
+    u64 = mcs.uniform(n, 2, seed=5)
+    u32 = u64.astype(np.float32)
+    d64 = env.sample(u64).direction
+    d32 = d64.astype(np.float32)
+    out += [
+        Timing("EnvMap.sample 1024x512", "mcsample", "float64", n,
+               measure(lambda: env.sample(u64), repeat)),
+        Timing("EnvMap.sample 1024x512", "mcsample", "float32", n,
+               measure(lambda: env.sample(u32), repeat)),
+        Timing("EnvMap.pdf 1024x512", "mcsample", "float64", n,
+               measure(lambda: env.pdf(d64), repeat)),
+        Timing("EnvMap.pdf 1024x512", "mcsample", "float32", n,
+               measure(lambda: env.pdf(d32), repeat)),
+        Timing("EnvMap.eval 1024x512", "mcsample", "float32", n,
+               measure(lambda: env.eval(d32), repeat)),
+    ]
+    numpy_sample = _numpy_envmap_sampler(image)
+    m = max(n // 10, 1)
+    out.append(Timing("EnvMap.sample 1024x512", "numpy", "float64", m,
+                      measure(lambda: numpy_sample(u64[:m]), max(repeat // 2, 1), 1)))
+    if mi is not None:
+        import drjit as dr
+
+        emitter = mi.load_dict({"type": "envmap", "bitmap": mi.Bitmap(image)})
+        it = dr.zeros(mi.Interaction3f, n)
+        uf = mi.Point2f(u32.T)
+
+        def mi_sample():
+            ds, w = emitter.sample_direction(it, uf)
+            dr.eval(ds.d, ds.pdf, w)
+            dr.sync_thread()
+
+        ds = dr.zeros(mi.DirectionSample3f, n)
+        ds.d = mi.Vector3f(d32.T)
+
+        def mi_pdf():
+            p = emitter.pdf_direction(it, ds)
+            dr.eval(p)
+            dr.sync_thread()
+
+        out += [Timing("EnvMap.sample 1024x512", "Mitsuba 3 llvm", "float32", n,
+                       measure(mi_sample, repeat)),
+                Timing("EnvMap.pdf 1024x512", "Mitsuba 3 llvm", "float32", n,
+                       measure(mi_pdf, repeat))]
+    return out
+
+
 SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
     "rng": suite_rng,
     "warps": suite_warps,
     "distr": suite_distr,
     "phong": suite_phong,
+    "envmap": suite_envmap,
 }
 
 
