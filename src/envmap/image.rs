@@ -57,7 +57,16 @@ impl Image {
             }
             _ => {}
         }
-        if let Some(i) = data.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+        // One branch-free pass for the common case (NaN fails both
+        // comparisons); find the index only on failure.
+        let valid = |v: f32| (0.0..=f32::MAX).contains(&v);
+        let all_valid = data.iter().fold(true, |ok, &v| ok & valid(v));
+        let bad = if all_valid {
+            None
+        } else {
+            data.iter().position(|&v| !valid(v))
+        };
+        if let Some(i) = bad {
             let (pixel, c) = (i / 3, i % 3);
             let (y, x) = (pixel / width, pixel % width);
             let index = match mapping {

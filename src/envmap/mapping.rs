@@ -11,6 +11,7 @@
 //! `jacobian(p)` is `dω/dp`, the solid angle per unit area of the domain, so
 //! that a density `p_p` on the domain is `p_p / jacobian` per steradian.
 
+use crate::math::sin_cos_turn;
 use crate::warp::V3;
 use std::f64::consts::PI;
 
@@ -85,8 +86,8 @@ impl Mapping {
         let [s, t] = p;
         match self {
             Mapping::LatLong => {
-                let (sin_theta, cos_theta) = (PI * t).sin_cos();
-                let (sin_phi, cos_phi) = (2.0 * PI * s).sin_cos();
+                let (sin_theta, cos_theta) = sin_cos_turn(0.5 * t);
+                let (sin_phi, cos_phi) = sin_cos_turn(s);
                 [sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta]
             }
             Mapping::Angular => {
@@ -95,7 +96,7 @@ impl Mapping {
                 if r == 0.0 {
                     return [0.0, 0.0, 1.0];
                 }
-                let (sin_theta, cos_theta) = (PI * r.min(1.0)).sin_cos();
+                let (sin_theta, cos_theta) = sin_cos_turn(0.5 * r.min(1.0));
                 [a / r * sin_theta, b / r * sin_theta, cos_theta]
             }
             Mapping::Cube => {
@@ -193,8 +194,13 @@ pub fn polar_angle(c: f64, a: f64, b: f64) -> f64 {
 /// `d/|d|`, or `d` itself when it has length 0.
 #[inline]
 pub fn normalized(d: V3<f64>) -> V3<f64> {
-    let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-    if norm > 0.0 { d.map(|x| x / norm) } else { d }
+    let norm2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    if norm2 > 0.0 {
+        let inv = 1.0 / norm2.sqrt();
+        d.map(|x| x * inv)
+    } else {
+        d
+    }
 }
 
 #[cfg(test)]

@@ -42,6 +42,7 @@ pub use mapping::{Mapping, normalized, polar_angle};
 
 use crate::distr::PiecewiseConstant2D;
 use crate::error::{Error, Result};
+use crate::math::sin_cos_turn;
 use crate::warp::{self, V3};
 use std::f64::consts::PI;
 
@@ -312,11 +313,7 @@ impl EnvMap {
                 let s = q[0] + 0.5 / self.image.width() as f64;
                 [if s >= 1.0 { s - 1.0 } else { s }, q[1]]
             }
-            Mapping::Angular => {
-                let (sin_psi, cos_psi) = (2.0 * PI * q[0]).sin_cos();
-                let (a, b) = (q[1] * cos_psi, q[1] * sin_psi);
-                [(a + 1.0) * 0.5, (1.0 - b) * 0.5]
-            }
+            Mapping::Angular => angular_uv(q[0], q[1]),
             Mapping::Cube => q,
         }
     }
@@ -502,7 +499,7 @@ fn piecewise_table(image: &Image, options: &Options) -> Distribution {
 /// The domain point of polar coordinates `(ψ, ρ)` around +Z of an angular
 /// map.
 fn angular_uv(psi: f64, rho: f64) -> [f64; 2] {
-    let (sin_psi, cos_psi) = (2.0 * PI * psi).sin_cos();
+    let (sin_psi, cos_psi) = sin_cos_turn(psi);
     [(rho * cos_psi + 1.0) * 0.5, (1.0 - rho * sin_psi) * 0.5]
 }
 
