@@ -226,6 +226,20 @@ def test_files_round_trip(tmp_path):
         np.testing.assert_array_equal(loaded.image, faces)
 
 
+def test_radiance_hdr_files(tmp_path):
+    """A 4 x 3 RGBE file written by hand (flat scanlines): texels decode to
+    mantissa / 256 * 2^(exponent - 128) (the image crate's decoding, without
+    Radiance's half-step offset)."""
+    pixels = np.array([[[128, 64, 32, 129], [255, 0, 0, 128], [0, 0, 0, 0], [1, 2, 3, 140]]] * 3,
+                      np.uint8)
+    path = tmp_path / "probe.hdr"
+    path.write_bytes(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 3 +X 4\n" + pixels.tobytes())
+    env = mcs.EnvMap.load(path)
+    expected = pixels[..., :3] / 256 * 2.0 ** (pixels[..., 3:].astype(float) - 128)
+    expected[pixels[..., 3] == 0] = 0
+    np.testing.assert_allclose(env.image, expected, rtol=1e-6)
+
+
 def test_packaged_sky():
     path = mcs.data.sky_path()
     assert path.stat().st_size < 300_000

@@ -141,6 +141,20 @@ def test_mitsubas_samples_follow_our_mitsuba_mode_pdf(mi, maps, name):
 
 
 @pytest.mark.parametrize("name", ["sky", "one-hot", "sunsky"])
+@pytest.mark.parametrize("sampling", ["piecewise", "mitsuba"])
+def test_our_samples_follow_our_pdf(mi, maps, name, sampling):
+    env = mcs.EnvMap(maps[name], sampling=sampling)
+    if sampling == "mitsuba":
+        domain, res, ires = "sphere", 51, 16
+    else:
+        domain = stats.EnvMapDomain(env)
+        res, ires = domain.cells, 4
+    result = stats.chi2_test(lambda u: env.sample(u).direction, env.pdf, domain, res=res,
+                             ires=ires, test_count=6)
+    assert result.passed, result.message
+
+
+@pytest.mark.parametrize("name", ["sky", "one-hot", "sunsky"])
 def test_two_sample_test_against_mitsubas_sampler(mi, maps, name):
     _llvm(mi)
     emitter = _emitter(mi, maps[name])
