@@ -183,6 +183,21 @@ where
     Ok(pool.install(|| split(0..n, outputs, &kernel)))
 }
 
+/// Runs `f` inside mcsample's pool, so that rayon's parallel iterators in
+/// it use [`num_threads`] threads (for builds whose units of work are not
+/// items of a batch, such as the rows of a table). Results must not depend
+/// on the thread count; that is up to `f`.
+///
+/// # Errors
+/// Only when the thread count cannot be determined (see [`num_threads`]).
+pub fn install<R: Send>(f: impl FnOnce() -> R + Send) -> Result<R> {
+    let threads = num_threads()?;
+    if threads == 1 {
+        return Ok(f());
+    }
+    Ok(pool(threads)?.install(f))
+}
+
 fn split<O, K>(range: Range<usize>, outputs: O, kernel: &K) -> bool
 where
     O: Outputs,

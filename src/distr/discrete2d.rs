@@ -3,6 +3,8 @@
 use super::{Discrete1D, check_weights};
 use crate::error::{Error, Result};
 use crate::math::Real;
+use crate::parallel;
+use rayon::prelude::*;
 
 /// A discrete distribution over the cells `(row, col)` of a `rows × cols`
 /// table of non-negative weights, sampled by the two-step method.
@@ -55,10 +57,21 @@ impl Discrete2D {
                 max: super::MAX_ENTRIES,
             });
         }
-        let conditionals: Vec<Option<Discrete1D>> = weights
-            .chunks(cols_nz)
-            .map(Discrete1D::from_checked)
-            .collect();
+        // Rows are independent: build them on all cores (large tables only).
+        let rows_of = || -> Vec<Option<Discrete1D>> {
+            if weights.len() < 1 << 16 {
+                weights
+                    .chunks(cols_nz)
+                    .map(Discrete1D::from_checked)
+                    .collect()
+            } else {
+                weights
+                    .par_chunks(cols_nz)
+                    .map(Discrete1D::from_checked)
+                    .collect()
+            }
+        };
+        let conditionals = parallel::install(rows_of)?;
         let row_sums: Vec<f64> = conditionals
             .iter()
             .map(|c| c.as_ref().map_or(0.0, Discrete1D::sum))

@@ -43,7 +43,9 @@ pub use mapping::{Mapping, normalized, polar_angle};
 use crate::distr::PiecewiseConstant2D;
 use crate::error::{Error, Result};
 use crate::math::sin_cos_turn;
+use crate::parallel;
 use crate::warp::{self, V3};
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// A 3×3 matrix, row-major.
@@ -178,8 +180,8 @@ impl EnvMap {
             Distribution::Black
         } else {
             match options.sampling {
-                Sampling::Piecewise => piecewise_table(&image, &options),
-                Sampling::Mitsuba => mitsuba_grid(&image, options.compensate),
+                Sampling::Piecewise => piecewise_table(&image, &options)?,
+                Sampling::Mitsuba => mitsuba_grid(&image, options.compensate)?,
             }
         };
         Ok(EnvMap {
@@ -421,14 +423,11 @@ fn sampling_luminance(
     mapping: Mapping,
     weights: [f64; 3],
     compensate: bool,
-) -> Vec<f64> {
-    let lum: Vec<f64> = image
-        .texels()
-        .iter()
-        .map(|t| (0..3).map(|k| weights[k] * f64::from(t[k])).sum())
-        .collect();
+) -> Result<Vec<f64>> {
+    let luminance = |t: &[f32; 3]| (0..3).map(|k| weights[k] * f64::from(t[k])).sum::<f64>();
+    let lum: Vec<f64> = parallel::install(|| image.texels().par_iter().map(luminance).collect())?;
     if !compensate {
-        return lum;
+        return Ok(lum);
     }
     let (w, h) = (image.width(), image.height());
     let (mut sum, mut count, mut min) = (0.0, 0usize, f64::INFINITY);
@@ -443,9 +442,9 @@ fn sampling_luminance(
     }
     let mean = sum / count.max(1) as f64;
     if mean - min <= 0.01 * mean {
-        return lum;
+        return Ok(lum);
     }
-    lum.into_iter().map(|l| (l - mean).max(0.0)).collect()
+    Ok(lum.into_iter().map(|l| (l - mean).max(0.0)).collect())
 }
 
 /// The piecewise-constant table of [`Sampling::Piecewise`], or
@@ -460,9 +459,9 @@ fn sampling_luminance(
 ///   the mean of `Y·J` over 4 × 4 points; a sector whose points all miss the
 ///   light but whose footprint touches a lit texel gets that texel's `Y`
 ///   times `J` at its centre / 16, so that lit sectors are never 0.
-fn piecewise_table(image: &Image, options: &Options) -> Distribution {
+fn piecewise_table(image: &Image, options: &Options) -> Result<Distribution> {
     let mapping = options.mapping;
-    let lum = sampling_luminance(image, mapping, [0.2126, 0.7152, 0.0722], options.compensate);
+    let lum = sampling_luminance(image, mapping, [0.2126, 0.7152, 0.0722], options.compensate)?;
     let (w, h) = (image.width(), image.height());
     let (cols, rows, domain) = match mapping {
         Mapping::LatLong => (w, h - 1, [[0.0, 1.0], [0.0, 1.0]]),
@@ -478,22 +477,33 @@ fn piecewise_table(image: &Image, options: &Options) -> Distribution {
         (0..4).map(|k| wt[k] * lum[idx[k]]).sum::<f64>()
     };
     let polar = |rho: f64| 2.0 * PI * PI * (PI * rho).sin().max(0.0);
-    let mut values = Vec::with_capacity(rows * cols);
-    for j in 0..rows {
-        for i in 0..cols {
+    let fill_row = |(j, row): (usize, &mut [f64])| {
+        if mapping == Mapping::LatLong {
+            // A patch's mean luminance is that of its four corner texels.
+            let jacobian = 0.25 * polar((j as f64 + 0.5) * size[1]);
+            let (top, bottom) = (&lum[j * w..(j + 1) * w], &lum[(j + 1) * w..(j + 2) * w]);
+            for (i, v) in row.iter_mut().enumerate() {
+                let next = if i + 1 == w { 0 } else { i + 1 };
+                *v = (top[i] + top[next] + bottom[i] + bottom[next]) * jacobian;
+            }
+            return;
+        }
+        for (i, v) in row.iter_mut().enumerate() {
             let q = [
                 (i as f64 + 0.5) * size[0],
                 domain[1][0] + (j as f64 + 0.5) * size[1],
             ];
-            values.push(match mapping {
-                Mapping::LatLong => bilinear_lum([q[0] + 0.5 / w as f64, q[1]]) * polar(q[1]),
-                Mapping::Cube => bilinear_lum(q) * mapping.jacobian(q),
+            *v = match mapping {
                 Mapping::Angular => angular_sector(q, size, image, &lum, &bilinear_lum),
-            });
+                _ => bilinear_lum(q) * mapping.jacobian(q),
+            };
         }
-    }
-    PiecewiseConstant2D::new(&values, rows, cols, domain)
-        .map_or(Distribution::Black, Distribution::Piecewise)
+    };
+    // Rows are independent: fill them on all cores.
+    let mut values = vec![0.0; rows * cols];
+    parallel::install(|| values.par_chunks_mut(cols).enumerate().for_each(fill_row))?;
+    Ok(PiecewiseConstant2D::new(&values, rows, cols, domain)
+        .map_or(Distribution::Black, Distribution::Piecewise))
 }
 
 /// The domain point of polar coordinates `(ψ, ρ)` around +Z of an angular
@@ -561,8 +571,8 @@ fn angular_sector(
 
 /// The vertex grid of [`Sampling::Mitsuba`]: luminance (Mitsuba's weights)
 /// × sin θ of the row, the first column repeated after the last.
-fn mitsuba_grid(image: &Image, compensate: bool) -> Distribution {
-    let lum = sampling_luminance(image, Mapping::LatLong, MITSUBA_LUMINANCE, compensate);
+fn mitsuba_grid(image: &Image, compensate: bool) -> Result<Distribution> {
+    let lum = sampling_luminance(image, Mapping::LatLong, MITSUBA_LUMINANCE, compensate)?;
     let (w, h) = (image.width(), image.height());
     let mut values = Vec::with_capacity((w + 1) * h);
     for y in 0..h {
@@ -570,7 +580,7 @@ fn mitsuba_grid(image: &Image, compensate: bool) -> Distribution {
         let row = &lum[y * w..(y + 1) * w];
         values.extend(row.iter().chain(&row[..1]).map(|l| l * sin_theta));
     }
-    BilinearGrid::new(values, w + 1, h).map_or(Distribution::Black, Distribution::Bilinear)
+    Ok(BilinearGrid::new(values, w + 1, h).map_or(Distribution::Black, Distribution::Bilinear))
 }
 
 #[cfg(test)]

@@ -84,10 +84,13 @@ fn to_world_arg(ob: Option<&Bound<'_, PyAny>>) -> PyResult<Matrix3> {
     }))
 }
 
-/// The texels of `image` for `mapping` as `(width, height, data)`: shape
+/// The texels of `image` for `mapping` as `(width, height, array)`: shape
 /// `(H, W, 3)`, or `(6, R, R, 3)` for cube maps (faces stacked).
-fn image_arg(image: &Bound<'_, PyAny>, mapping: Mapping) -> PyResult<(usize, usize, Vec<f32>)> {
-    let array: PyArrayLikeDyn<'_, f32, AllowTypeChange> = image
+fn image_arg<'py>(
+    image: &Bound<'py, PyAny>,
+    mapping: Mapping,
+) -> PyResult<(usize, usize, PyArrayLikeDyn<'py, f32, AllowTypeChange>)> {
+    let array: PyArrayLikeDyn<'py, f32, AllowTypeChange> = image
         .extract()
         .map_err(|e| PyTypeError::new_err(format!("image must be an array of numbers: {e}")))?;
     let shape = array.shape().to_vec();
@@ -106,7 +109,7 @@ fn image_arg(image: &Bound<'_, PyAny>, mapping: Mapping) -> PyResult<(usize, usi
             .into());
         }
     };
-    Ok((width, height, array.as_array().iter().copied().collect()))
+    Ok((width, height, array))
 }
 
 /// A file's image for `mapping`: RGB(A) (alpha dropped); cube maps as a
@@ -230,12 +233,8 @@ fn settings(
 }
 
 impl PyEnvMap {
-    fn build(
-        py: Python<'_>,
-        (w, h, data): (usize, usize, Vec<f32>),
-        options: Options,
-    ) -> PyResult<Self> {
-        Ok(Self(detached(py, || EnvMap::new(w, h, &data, options))?))
+    fn build(py: Python<'_>, w: usize, h: usize, data: &[f32], options: Options) -> PyResult<Self> {
+        Ok(Self(detached(py, || EnvMap::new(w, h, data, options))?))
     }
 
     fn directions<'py, F: PyFloat, const M: usize>(
@@ -320,26 +319,31 @@ impl PyEnvMap {
         compensate: bool,
     ) -> PyResult<Self> {
         let s = settings(mapping, to_world, scale, sampling, compensate)?;
-        let texels = match image.filter(|i| !i.is_none()) {
-            Some(image) => image_arg(image, s.mapping)?,
-            None => {
-                if s.mapping != Mapping::LatLong {
-                    return Err(Error::Choice {
-                        arg: "mapping",
-                        value: s.mapping.name().into(),
-                        requirement: "the packaged sky (image=None) is lat-long; convert() it"
-                            .into(),
-                    }
-                    .into());
+        let Some(image) = image.filter(|i| !i.is_none()) else {
+            if s.mapping != Mapping::LatLong {
+                return Err(Error::Choice {
+                    arg: "mapping",
+                    value: s.mapping.name().into(),
+                    requirement: "the packaged sky (image=None) is lat-long; convert() it".into(),
                 }
-                let path: PathBuf = py
-                    .import("mcsample.data")?
-                    .call_method0("sky_path")?
-                    .extract()?;
-                detached(py, || read_image(&path, Mapping::LatLong))?
+                .into());
             }
+            let path: PathBuf = py
+                .import("mcsample.data")?
+                .call_method0("sky_path")?
+                .extract()?;
+            let (w, h, data) = detached(py, || read_image(&path, Mapping::LatLong))?;
+            return Self::build(py, w, h, &data, s.options);
         };
-        Self::build(py, texels, s.options)
+        let (w, h, array) = image_arg(image, s.mapping)?;
+        // Read a C-ordered array in place; copy anything else once.
+        match array.as_slice().ok().filter(|_| array.is_c_contiguous()) {
+            Some(data) => Self::build(py, w, h, data, s.options),
+            None => {
+                let data: Vec<f32> = array.as_array().iter().copied().collect();
+                Self::build(py, w, h, &data, s.options)
+            }
+        }
     }
 
     /// Reads an environment map from an OpenEXR or Radiance .hdr file
@@ -360,8 +364,8 @@ impl PyEnvMap {
         compensate: bool,
     ) -> PyResult<Self> {
         let s = settings(mapping, to_world, scale, sampling, compensate)?;
-        let texels = detached(py, || read_image(&path, s.mapping))?;
-        Self::build(py, texels, s.options)
+        let (w, h, data) = detached(py, || read_image(&path, s.mapping))?;
+        Self::build(py, w, h, &data, s.options)
     }
 
     /// Radiance arriving from world directions d, per RGB channel.
