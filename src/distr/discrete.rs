@@ -6,8 +6,10 @@ use crate::error::{Error, Result};
 use crate::math::Real;
 
 /// Tables shorter than this are searched without a guide table: a binary
-/// search over a few cache lines is as fast.
-const GUIDE_MIN_LEN: usize = 1024;
+/// search over a cache line or two is as fast. (Above it, even a table of a
+/// few hundred entries, such as an environment map's marginal, gains: its
+/// binary search is a chain of dependent loads.)
+const GUIDE_MIN_LEN: usize = 64;
 
 /// A discrete distribution over the indices `0..n`, with probabilities
 /// proportional to non-negative weights `w`.
