@@ -132,63 +132,118 @@ impl Phong {
         self.diffuse_probability
     }
 
-    /// `max(0, cos α)ⁿ`, with α between `wo` and the mirror of `wi`.
+    /// The BRDF seen from `wi`: what every evaluation and sample for that
+    /// `wi` shares, computed once in the kernel's float type.
     #[inline(always)]
-    fn lobe<F: Real>(&self, wi: V3<F>, wo: V3<F>) -> F {
-        let r = reflect(wi);
-        let cos_alpha = dot(r, wo);
-        if cos_alpha > F::zero() {
-            F::pow_positive(cos_alpha.min(F::one()), F::c(self.exponent))
-        } else {
-            F::zero()
+    pub fn view<F: Real>(&self, wi: V3<F>) -> PhongView<F> {
+        let mirror = reflect(wi);
+        let n = self.exponent;
+        let inv_pi = std::f64::consts::FRAC_1_PI;
+        PhongView {
+            wi_above: wi[2] > F::zero(),
+            mirror,
+            mirror_frame: Frame::from_normal(mirror),
+            exponent: F::c(n),
+            diffuse_probability: F::c(self.diffuse_probability),
+            diffuse: self.diffuse.map(|v| F::c(v * inv_pi)),
+            specular: self.specular.map(|v| F::c(v * (n + 2.0) * 0.5 * inv_pi)),
+            glossy_norm: F::c((n + 1.0) * 0.5 * inv_pi),
         }
     }
 
     /// The BRDF value `f_r(wi, wo)` per RGB channel (no cosine).
     #[inline(always)]
     pub fn eval<F: Real>(&self, wi: V3<F>, wo: V3<F>) -> V3<F> {
-        self.eval_with_lobe(wi, wo, self.lobe(wi, wo))
+        self.view(wi).eval(wo)
     }
 
     /// The density of [`Phong::sample`] at `wo`, per steradian.
     #[inline(always)]
     pub fn pdf<F: Real>(&self, wi: V3<F>, wo: V3<F>) -> F {
-        self.pdf_with_lobe(wo, self.lobe(wi, wo))
-    }
-
-    #[inline(always)]
-    fn eval_with_lobe<F: Real>(&self, wi: V3<F>, wo: V3<F>, lobe: F) -> V3<F> {
-        let norm = F::c((self.exponent + 2.0) * 0.5 * std::f64::consts::FRAC_1_PI);
-        let above = wi[2] > F::zero() && wo[2] > F::zero();
-        std::array::from_fn(|k| {
-            let f = F::c(self.diffuse[k] * std::f64::consts::FRAC_1_PI)
-                + F::c(self.specular[k]) * norm * lobe;
-            if above { f } else { F::zero() }
-        })
-    }
-
-    #[inline(always)]
-    fn pdf_with_lobe<F: Real>(&self, wo: V3<F>, lobe: F) -> F {
-        let pd = F::c(self.diffuse_probability);
-        let diffuse = warp::square_to_cosine_hemisphere_pdf(wo);
-        let glossy = F::c((self.exponent + 1.0) * 0.5 * std::f64::consts::FRAC_1_PI) * lobe;
-        pd * diffuse + (F::one() - pd) * glossy
+        self.view(wi).pdf(wo)
     }
 
     /// A direction drawn from the mixture for `wi`: `u[2]` picks the part,
     /// `u[0..2]` place the direction. `u` in `[0, 1]³`.
     #[inline(always)]
     pub fn sample<F: Real>(&self, wi: V3<F>, u: [F; 3]) -> PhongSample<F> {
-        let diffuse = u[2] < F::c(self.diffuse_probability);
+        self.view(wi).sample(u)
+    }
+}
+
+/// A [`Phong`] BRDF for one incident direction `wi`, with the mirror
+/// direction, its frame and the constants of `f_r` and of the density
+/// precomputed: batches that share `wi` build it once, outside their loop
+/// (which then holds only the per-`wo` work and vectorises).
+#[derive(Clone, Copy, Debug)]
+pub struct PhongView<F> {
+    wi_above: bool,
+    mirror: V3<F>,
+    mirror_frame: Frame<F>,
+    exponent: F,
+    diffuse_probability: F,
+    /// `ρd/π`.
+    diffuse: V3<F>,
+    /// `ρs·(n + 2)/(2π)`.
+    specular: V3<F>,
+    /// `(n + 1)/(2π)`.
+    glossy_norm: F,
+}
+
+impl<F: Real> PhongView<F> {
+    /// `max(0, cos α)ⁿ`, with α between `wo` and the mirror of `wi`.
+    #[inline(always)]
+    fn lobe(&self, wo: V3<F>) -> F {
+        let cos_alpha = dot(self.mirror, wo);
+        if cos_alpha > F::zero() {
+            F::pow_positive(cos_alpha.min(F::one()), self.exponent)
+        } else {
+            F::zero()
+        }
+    }
+
+    /// `f_r(wi, wo)` per RGB channel (no cosine).
+    #[inline(always)]
+    pub fn eval(&self, wo: V3<F>) -> V3<F> {
+        self.eval_with_lobe(wo, self.lobe(wo))
+    }
+
+    /// The density of [`PhongView::sample`] at `wo`, per steradian.
+    #[inline(always)]
+    pub fn pdf(&self, wo: V3<F>) -> F {
+        self.pdf_with_lobe(wo, self.lobe(wo))
+    }
+
+    #[inline(always)]
+    fn eval_with_lobe(&self, wo: V3<F>, lobe: F) -> V3<F> {
+        let above = self.wi_above && wo[2] > F::zero();
+        std::array::from_fn(|k| {
+            let f = self.diffuse[k] + self.specular[k] * lobe;
+            if above { f } else { F::zero() }
+        })
+    }
+
+    #[inline(always)]
+    fn pdf_with_lobe(&self, wo: V3<F>, lobe: F) -> F {
+        let pd = self.diffuse_probability;
+        let diffuse = warp::square_to_cosine_hemisphere_pdf(wo);
+        pd * diffuse + (F::one() - pd) * self.glossy_norm * lobe
+    }
+
+    /// A direction drawn from the mixture: `u[2]` picks the part, `u[0..2]`
+    /// place the direction. `u` in `[0, 1]³`.
+    #[inline(always)]
+    pub fn sample(&self, u: [F; 3]) -> PhongSample<F> {
+        let diffuse = u[2] < self.diffuse_probability;
         // Both candidates, then a select: the loop over samples stays
         // branch-free.
         let d = warp::square_to_cosine_hemisphere([u[0], u[1]]);
-        let local = warp::square_to_cosine_power_hemisphere([u[0], u[1]], F::c(self.exponent));
-        let g = Frame::from_normal(reflect(wi)).to_world(local);
+        let local = warp::square_to_cosine_power_hemisphere([u[0], u[1]], self.exponent);
+        let g = self.mirror_frame.to_world(local);
         let wo = if diffuse { d } else { g };
-        let lobe = self.lobe(wi, wo);
+        let lobe = self.lobe(wo);
         let pdf = self.pdf_with_lobe(wo, lobe);
-        let f = self.eval_with_lobe(wi, wo, lobe);
+        let f = self.eval_with_lobe(wo, lobe);
         let scale = if pdf > F::zero() {
             wo[2].max(F::zero()) / pdf
         } else {

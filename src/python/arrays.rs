@@ -265,6 +265,39 @@ where
     map_into(py, x, check, None, kernel)
 }
 
+/// [`map`] for kernels that cannot vectorise (table lookups, library
+/// calls): a plain loop per chunk, without the SIMD dispatch and the
+/// transposes of [`map_rows`], which would only add work to them.
+pub fn map_each<'py, F, T, const K: usize, const M: usize>(
+    py: Python<'py>,
+    x: &Points<'py, F, K>,
+    check: Check,
+    kernel: impl Fn([F; K]) -> [T; M] + Sync + Send,
+) -> PyResult<Bound<'py, PyAny>>
+where
+    F: PyFloat,
+    T: Element + Copy + Default + Send,
+{
+    let out = zeros::<T>(py, &x.out_shape(M));
+    {
+        let mut guard = out.readwrite();
+        let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
+        let in_rows = x.rows();
+        let valid = run_batch(py, x.n, out_rows, |range, chunk: &mut [[T; M]]| {
+            let mut ok = true;
+            for (o, p) in chunk.iter_mut().zip(&in_rows[range]) {
+                ok &= check.holds_all(p);
+                *o = kernel(*p);
+            }
+            ok
+        })?;
+        if !valid {
+            return Err(x.invalid(check));
+        }
+    }
+    finish(out)
+}
+
 /// The array results go to: `out` when given (checked to be a writeable,
 /// C-ordered array of `shape` and of dtype `T`, as numpy's ufuncs check
 /// theirs), else a fresh one.

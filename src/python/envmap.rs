@@ -1,7 +1,7 @@
 //! `mcsample.EnvMap`: environment maps (see [`crate::envmap`]), batched
 //! over directions and uniform samples.
 
-use super::arrays::{Check, Points, PyFloat, finish, map, with_precision, zeros};
+use super::arrays::{Check, Points, PyFloat, finish, map, map_each, with_precision, zeros};
 use super::parallel::{detached, run_batch};
 use crate::envmap::{EnvMap, Mapping, Matrix3, Options, Sampling};
 use crate::error::{Error, shape_str};
@@ -245,7 +245,7 @@ impl PyEnvMap {
     ) -> PyResult<Bound<'py, PyAny>> {
         let d = Points::<F, 3>::extract(d, "d")?;
         let env = &self.0;
-        map(py, &d, Check::Finite, |x: [F; 3]| {
+        map_each(py, &d, Check::Finite, |x: [F; 3]| {
             kernel(env, x.map(F::f64)).map(F::c)
         })
     }

@@ -263,10 +263,11 @@ impl PyPhong {
                         } else {
                             &rows_u[range]
                         };
+                        let view = phong.view(w);
                         let sample = {
                             #[inline(always)]
                             |x: [F; 3]| {
-                                let s = phong.sample(w, x);
+                                let s = view.sample(x);
                                 let [a, b, c] = s.wo;
                                 let [d, e, f] = s.weight;
                                 [a, b, c, s.pdf, d, e, f, F::c(f64::from(s.component))]
