@@ -132,6 +132,13 @@ pub struct EnvMap {
     distribution: Distribution,
 }
 
+/// A direction located in the sampling table ([`EnvMap::pdf_query`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PdfQuery {
+    q: [f64; 2],
+    jacobian: f64,
+}
+
 /// One sample of [`EnvMap::sample`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EnvSample {
@@ -245,13 +252,33 @@ impl EnvMap {
     /// steradian.
     #[inline]
     pub fn pdf(&self, d: V3<f64>) -> f64 {
+        self.pdf_at(self.pdf_query(d))
+    }
+
+    /// The first half of [`EnvMap::pdf`], which reads no table: where `d`
+    /// falls in the sampling table, and the Jacobian there. Batches run it
+    /// over a block of directions before [`EnvMap::pdf_at`] reads the table
+    /// for all of them, so that those reads (cache misses for a large map)
+    /// overlap instead of waiting one after the other.
+    #[inline]
+    pub fn pdf_query(&self, d: V3<f64>) -> PdfQuery {
         let local = self.to_local(d);
+        PdfQuery {
+            q: self.table_point(local),
+            jacobian: self.table_jacobian(local),
+        }
+    }
+
+    /// The second half of [`EnvMap::pdf`]: the table's density at the
+    /// query's point, per steradian.
+    #[inline]
+    pub fn pdf_at(&self, query: PdfQuery) -> f64 {
         let pdf_q = match &self.distribution {
-            Distribution::Piecewise(table) => table.pdf(self.table_point(local)),
-            Distribution::Bilinear(grid) => grid.pdf(self.table_point(local)),
+            Distribution::Piecewise(table) => table.pdf(query.q),
+            Distribution::Bilinear(grid) => grid.pdf(query.q),
             Distribution::Black => return 0.0,
         };
-        pdf_q / self.table_jacobian(local)
+        pdf_q / query.jacobian
     }
 
     /// A direction drawn with density [`EnvMap::pdf`], for `u` in `[0, 1]²`.

@@ -3,7 +3,10 @@
 
 use super::arrays::{Check, Points, PyFloat, finish, map, map_each, with_precision, zeros};
 use super::parallel::{detached, run_batch};
-use crate::envmap::{EnvMap, Mapping, Matrix3, Options, Sampling};
+use crate::envmap::{EnvMap, Mapping, Matrix3, Options, PdfQuery, Sampling};
+
+/// Directions per block of `EnvMap.pdf` (see `pdf_as`).
+const PDF_BLOCK: usize = 64;
 use crate::error::{Error, shape_str};
 use crate::io;
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
@@ -250,6 +253,43 @@ impl PyEnvMap {
         })
     }
 
+    /// `pdf` in blocks of [`PDF_BLOCK`] directions: first every direction's
+    /// place in the table, then the table reads, which then overlap.
+    fn pdf_as<'py, F: PyFloat>(
+        &self,
+        py: Python<'py>,
+        d: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let d = Points::<F, 3>::extract(d, "d")?;
+        let out = zeros::<F>(py, &d.out_shape(1));
+        {
+            let mut guard = out.readwrite();
+            let rows = d.rows();
+            let env = &self.0;
+            let valid = run_batch(py, d.n, guard.as_slice_mut()?, |range, chunk: &mut [F]| {
+                let mut ok = true;
+                let mut queries = [PdfQuery::default(); PDF_BLOCK];
+                for (o, x) in chunk
+                    .chunks_mut(PDF_BLOCK)
+                    .zip(rows[range].chunks(PDF_BLOCK))
+                {
+                    for (q, x) in queries.iter_mut().zip(x) {
+                        ok &= Check::Finite.holds_all(x);
+                        *q = env.pdf_query(x.map(F::f64));
+                    }
+                    for (o, q) in o.iter_mut().zip(&queries) {
+                        *o = F::c(env.pdf_at(*q));
+                    }
+                }
+                ok
+            })?;
+            if !valid {
+                return Err(d.invalid(Check::Finite));
+            }
+        }
+        finish(out)
+    }
+
     fn sample_as<'py, F: PyFloat>(
         &self,
         py: Python<'py>,
@@ -391,7 +431,7 @@ impl PyEnvMap {
     /// -------
     /// ndarray, shape (N,) (a scalar for one direction).
     fn pdf<'py>(&self, py: Python<'py>, d: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        with_precision!(d, F => self.directions::<F, 1>(py, d, |e, x| [e.pdf(x)]))
+        with_precision!(d, F => self.pdf_as::<F>(py, d))
     }
 
     /// Directions drawn with density ``pdf``.
