@@ -17,6 +17,8 @@
 //!   by several strategies and MIS.
 //! - [`phong`]: the energy-normalised Phong BRDF and its sampling.
 //! - [`mis`]: multiple importance sampling heuristics.
+//! - [`render`]: a compact renderer (BVH, camera, direct and path
+//!   integrators) for comparing sampling strategies with Mitsuba 3.
 //! - [`frame`]: orthonormal frames around a normal.
 //! - [`io`]: EXR, Radiance HDR and PNG files.
 //! - [`simd`]: runtime dispatch of batch loops to AVX2 + FMA.
@@ -45,6 +47,7 @@ pub mod math;
 pub mod mis;
 pub mod parallel;
 pub mod phong;
+pub mod render;
 pub mod rng;
 pub mod simd;
 pub mod warp;

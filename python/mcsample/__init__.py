@@ -7,6 +7,8 @@ steradian on directions, +z normal) are in the README.
 """
 
 from . import data, distr, estimators, io, mis, stats, warp
+from .rendering import RenderResult, render
+from .scene import Scene, look_at
 from ._core import (
     EnvMap,
     EnvSample,
@@ -30,6 +32,10 @@ from .distr import (
 
 __all__ = [
     "EnvMap",
+    "RenderResult",
+    "Scene",
+    "look_at",
+    "render",
     "EnvSample",
     "data",
     "AliasTable",

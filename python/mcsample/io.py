@@ -9,9 +9,9 @@ import os
 
 import numpy as np
 
-from ._core.io import read_exr, read_hdr, write_exr, write_png
+from ._core.io import read_exr, read_hdr, read_mesh, write_exr, write_png
 
-__all__ = ["read_exr", "read_hdr", "read_image", "write_exr", "write_png"]
+__all__ = ["read_exr", "read_hdr", "read_image", "read_mesh", "write_exr", "write_png"]
 
 
 def read_image(path: str | os.PathLike[str]) -> np.ndarray:

@@ -15,8 +15,16 @@ import re
 import subprocess
 import sys
 from types import ModuleType
+from typing import TYPE_CHECKING
 
-__all__ = ["available", "choose_variant", "find_libllvm", "llvm_usable", "load", "register_phong"]
+import numpy as np
+
+if TYPE_CHECKING:
+    from .rendering import RenderResult
+    from .scene import Scene
+
+__all__ = ["available", "choose_variant", "find_libllvm", "llvm_usable", "load", "register_phong",
+           "render_reference"]
 
 #: Oldest libLLVM major version Dr.Jit's LLVM backend accepts.
 MIN_LLVM = 16
@@ -138,3 +146,45 @@ def register_phong() -> str:
         mi.register_bsdf(TYPE_NAME, lambda props: cls(props))
         _REGISTERED.add(variant)
     return TYPE_NAME
+
+
+def render_reference(scene: "Scene", spp: int, seed: int = 0, integrator: str | None = None,
+                     max_depth: int | None = None, rr_depth: int | None = None,
+                     variant: str | None = None) -> "RenderResult":
+    """Renders ``scene`` in Mitsuba 3 (``variant``: default
+    :func:`choose_variant`) with its ``path`` or ``direct`` integrator
+    wrapped in ``moment``, so each pixel comes with the variance of its mean
+    luminance. The film uses a box filter, as mcsample's.
+
+    Returns a :class:`mcsample.RenderResult` whose ``variance`` is None
+    (Mitsuba reports moments in XYZ, from which per-RGB-channel variances
+    cannot be recovered) and whose ``luminance_variance`` is
+    (E[Y²] − E[Y]²) / (spp − 1); ``seconds`` includes Mitsuba's JIT
+    compilation unless its kernels are cached from an earlier call.
+    """
+    from .rendering import RenderResult
+
+    mi = load(variant)
+    defaults = scene.integrator
+    kind = integrator or defaults.get("integrator", "path")
+    if kind not in ("path", "direct"):
+        raise ValueError(f"integrator = {kind!r}: must be 'path' or 'direct'")
+    nested: dict = {"type": kind}
+    if kind == "path":
+        nested["max_depth"] = int(max_depth if max_depth is not None
+                                  else defaults.get("max_depth", -1))
+        nested["rr_depth"] = int(rr_depth if rr_depth is not None
+                                 else defaults.get("rr_depth", 5))
+    d = scene.to_mitsuba(spp=spp)
+    d["integrator"] = {"type": "moment", "nested": nested}
+    mi_scene = mi.load_dict(d)
+    import time
+
+    start = time.perf_counter()
+    out = np.asarray(mi.render(mi_scene, spp=spp, seed=seed), dtype=np.float64)
+    seconds = time.perf_counter() - start
+    # Channels: R, G, B, nested.X, Y, Z, m2_nested.X, Y, Z.
+    m1, m2 = out[..., 4], out[..., 7]
+    var = np.maximum(m2 - m1 * m1, 0.0) / max(spp - 1, 1)
+    return RenderResult(out[..., :3].astype(np.float32), None, var.astype(np.float32),
+                        spp, seconds)

@@ -121,7 +121,48 @@ pub fn write_png(
 }
 
 /// Registers the io functions in module `m`.
+/// Reads a triangle mesh from a PLY (ASCII or binary) or OBJ file.
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+///     A ``.ply`` or ``.obj`` file; polygons are split into triangle fans.
+///
+/// Returns
+/// -------
+/// (vertices, faces, normals)
+///     float64 ``(N, 3)``, int64 ``(M, 3)`` and float64 ``(N, 3)`` vertex
+///     normals, or None when the file has none.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn read_mesh<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<(
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Option<Bound<'py, PyAny>>,
+)> {
+    let mesh = detached(py, || crate::render::mesh_file::read_mesh(&path))?;
+    let rows3 = |v: Vec<[f64; 3]>| -> PyResult<Bound<'py, PyAny>> {
+        let n = v.len();
+        Ok(PyArray1::from_vec(py, v.into_iter().flatten().collect())
+            .reshape([n, 3])?
+            .into_any())
+    };
+    let m = mesh.faces.len();
+    let faces = PyArray1::from_vec(py, mesh.faces.into_iter().flatten().collect())
+        .reshape([m, 3])?
+        .into_any();
+    Ok((
+        rows3(mesh.vertices)?,
+        faces,
+        mesh.normals.map(rows3).transpose()?,
+    ))
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
     m.add_function(wrap_pyfunction!(write_exr, m)?)?;
     m.add_function(wrap_pyfunction!(read_hdr, m)?)?;

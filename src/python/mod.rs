@@ -12,6 +12,7 @@ mod io;
 mod mis;
 mod parallel;
 mod phong;
+mod render;
 mod rng;
 mod warp;
 
@@ -54,5 +55,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     submodule(m, "io", io::register)?;
     submodule(m, "mis", mis::register)?;
     submodule(m, "estimators", estimators::register)?;
+    submodule(m, "render", render::register)?;
     Ok(())
 }

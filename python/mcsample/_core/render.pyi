@@ -1,0 +1,39 @@
+"""Stub of ``mcsample._core.render``: see ``mcsample.scene`` and
+``mcsample.rendering`` for the docs."""
+
+from typing import Callable, Sequence, final
+
+import numpy as np
+from numpy.typing import NDArray
+
+from . import EnvMap, Phong
+
+_Matrix = Sequence[Sequence[float]]
+_RGB = Sequence[float]
+
+@final
+class SceneBuilder:
+    def __init__(self) -> None: ...
+    def add_mesh(self, vertices: NDArray[np.float64], faces: NDArray[np.int64],
+                 normals: NDArray[np.float64] | None, face_normals: bool, bsdf: Phong,
+                 two_sided: bool, emission: _RGB | None) -> None: ...
+    def add_sphere(self, center: _RGB, radius: float, flip_normals: bool, bsdf: Phong,
+                   two_sided: bool, emission: _RGB | None) -> None: ...
+    def add_disk(self, to_world: _Matrix, bsdf: Phong, two_sided: bool,
+                 emission: _RGB | None) -> None: ...
+    def set_envmap(self, env: EnvMap) -> None: ...
+    def set_constant(self, radiance: _RGB) -> None: ...
+    def set_camera(self, to_world: _Matrix, fov: float, fov_axis: str, width: int, height: int,
+                   near_clip: float, far_clip: float, aperture_radius: float,
+                   focus_distance: float) -> None: ...
+    def build(self) -> CompiledScene: ...
+
+@final
+class CompiledScene:
+    @property
+    def film(self) -> tuple[int, int]: ...
+
+def render(
+    scene: CompiledScene, spp: int, seed: int, integrator: str, strategy: str, heuristic: str,
+    max_depth: int, rr_depth: int, callback: Callable[[int], object] | None = None,
+) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32]]: ...

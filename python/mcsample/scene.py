@@ -1,0 +1,547 @@
+"""Scenes described by the Mitsuba 3 scene dictionary.
+
+``Scene.from_mitsuba(d)`` reads the subset of Mitsuba's dictionary format
+that mcsample renders; ``scene.to_mitsuba()`` gives back a dictionary that
+``mi.load_dict`` renders to the same image (with mcsample's Phong registered
+as the ``"mcsample_phong"`` plugin, see :func:`mcsample.mitsuba.register_phong`).
+
+The subset (anything else raises ValueError naming the key):
+
+- shapes: ``sphere`` (center, radius, to_world, flip_normals), ``rectangle``,
+  ``disk``, ``cube``, ``ply`` and ``obj`` (filename, face_normals,
+  flip_normals, to_world), and ``mesh`` — mcsample's own type for numpy
+  arrays: ``vertices`` (N, 3), ``faces`` (M, 3) and optional ``normals``
+  (N, 3). Each may hold a ``bsdf`` and an ``area`` emitter (``radiance``).
+- bsdfs: ``diffuse`` (reflectance), ``mcsample_phong`` (diffuse_reflectance,
+  specular_reflectance, exponent), ``twosided`` around either, and
+  ``{"type": "ref", "id": ...}`` to a top-level bsdf. A shape without one
+  gets Mitsuba's default, diffuse 0.5.
+- emitters: ``envmap`` (filename, scale, to_world; or an :class:`EnvMap`
+  given directly as the value, in any mapping) and ``constant`` (radiance).
+- sensors: ``perspective`` (fov, fov_axis, near_clip, far_clip, to_world)
+  and ``thinlens`` (also aperture_radius, focus_distance), with an
+  ``hdrfilm`` (width, height, box ``rfilter``) and an ``independent``
+  sampler (sample_count: the default spp).
+- ``integrator``: ``path`` or ``direct`` (max_depth, rr_depth): the
+  defaults of :func:`mcsample.render`.
+
+Colours are a float, an RGB triple or ``{"type": "rgb", "value": ...}``.
+``to_world`` is a Mitsuba transform, a 4×4 array-like, or (handy in JSON)
+``{"look_at": {"origin": ..., "target": ..., "up": ...}}``.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+import numpy as np
+
+from ._core import EnvMap, Phong
+from ._core.io import read_mesh
+from ._core.render import CompiledScene, SceneBuilder
+
+__all__ = ["Scene", "look_at"]
+
+#: Mitsuba's default film size and field of view (focal length 50 mm on a
+#: 36 mm wide film).
+DEFAULT_WIDTH, DEFAULT_HEIGHT = 768, 576
+
+
+def look_at(origin: Any, target: Any, up: Any) -> np.ndarray:
+    """The 4×4 camera-to-world matrix of Mitsuba's ``look_at``: camera +z
+    toward ``target``, +y along ``up`` (made orthogonal), +x = up × dir."""
+    o, t, u = (np.asarray(v, dtype=np.float64).reshape(3) for v in (origin, target, up))
+    d = t - o
+    if not np.linalg.norm(d) > 0:
+        raise ValueError("look_at: origin and target must differ")
+    d /= np.linalg.norm(d)
+    left = np.cross(u, d)
+    if not np.linalg.norm(left) > 0:
+        raise ValueError("look_at: up must not be parallel to target - origin")
+    left /= np.linalg.norm(left)
+    new_up = np.cross(d, left)
+    m = np.eye(4)
+    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = left, new_up, d, o
+    return m
+
+
+def _matrix(value: Any, key: str) -> np.ndarray:
+    """A 4×4 float64 matrix from a Mitsuba transform, an array-like or a
+    ``{"look_at": {...}}`` dict."""
+    if isinstance(value, Mapping):
+        if set(value) != {"look_at"}:
+            raise ValueError(f"{key}: a dict transform must be {{'look_at': {{...}}}}")
+        la = dict(value["look_at"])
+        unknown = set(la) - {"origin", "target", "up"}
+        if unknown or len(la) != 3:
+            raise ValueError(f"{key}.look_at needs exactly origin, target and up")
+        return look_at(la["origin"], la["target"], la["up"])
+    source = value.matrix if hasattr(value, "matrix") and not hasattr(value, "shape") else value
+    try:
+        m = np.asarray(source, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{key} must be a 4x4 matrix or a Mitsuba transform: {e}") from None
+    m = m.reshape(m.shape[:2]) if m.ndim == 3 and m.shape[2] == 1 else m
+    if m.shape != (4, 4):
+        raise ValueError(f"{key} must be a 4x4 matrix, got shape {m.shape}")
+    if not np.all(np.isfinite(m)):
+        raise ValueError(f"{key} has entries that are not finite")
+    return m
+
+
+def _rgb(value: Any, key: str) -> list[float]:
+    if isinstance(value, Mapping):
+        if value.get("type") != "rgb" or set(value) - {"type", "value"}:
+            raise ValueError(f"{key}: only constant colours are supported "
+                             "(a float, an RGB triple or {'type': 'rgb', 'value': ...})")
+        value = value["value"]
+    try:
+        rgb = np.broadcast_to(np.asarray(value, dtype=np.float64), (3,))
+    except (TypeError, ValueError):
+        raise ValueError(f"{key} must be a float or an RGB triple, got {value!r}") from None
+    if not np.all(np.isfinite(rgb)) or np.any(rgb < 0):
+        raise ValueError(f"{key} = {value!r}: must be finite and >= 0")
+    return [float(v) for v in rgb]
+
+
+def _float(value: Any, key: str) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{key} must be a number, got {value!r}") from None
+    if not math.isfinite(x):
+        raise ValueError(f"{key} = {x}: must be finite")
+    return x
+
+
+def _check_keys(d: Mapping[str, Any], allowed: set[str], where: str) -> None:
+    for k in d:
+        if k not in allowed and k not in ("type", "id"):
+            raise ValueError(f"{where}.{k}: not supported by mcsample "
+                             f"(supported: {', '.join(sorted(allowed)) or 'none'})")
+
+
+@dataclass
+class Material:
+    """A Phong BRDF (diffuse is Phong with no specular part) and its sides."""
+    diffuse: list[float]
+    specular: list[float]
+    exponent: float
+    two_sided: bool
+    kind: str  # "diffuse" or "phong"
+
+    def phong(self) -> Phong:
+        return Phong(self.diffuse, self.specular, self.exponent)
+
+    def to_mitsuba(self, phong_type: str) -> dict[str, Any]:
+        if self.kind == "diffuse":
+            inner: dict[str, Any] = {"type": "diffuse",
+                                     "reflectance": {"type": "rgb", "value": self.diffuse}}
+        else:
+            inner = {"type": phong_type,
+                     "diffuse_reflectance": {"type": "rgb", "value": self.diffuse},
+                     "specular_reflectance": {"type": "rgb", "value": self.specular},
+                     "exponent": self.exponent}
+        return {"type": "twosided", "bsdf": inner} if self.two_sided else inner
+
+
+DEFAULT_MATERIAL = Material([0.5] * 3, [0.0] * 3, 0.0, False, "diffuse")
+
+
+@dataclass
+class ShapeRecord:
+    """One shape in world space, as mcsample renders it."""
+    kind: str  # "mesh", "sphere" or "disk"
+    material: Material
+    emission: list[float] | None
+    vertices: np.ndarray | None = None
+    faces: np.ndarray | None = None
+    normals: np.ndarray | None = None
+    face_normals: bool = False
+    center: list[float] | None = None
+    radius: float = 1.0
+    flip_normals: bool = False
+    to_world: np.ndarray | None = None
+
+
+@dataclass
+class Camera:
+    to_world: np.ndarray
+    fov: float
+    fov_axis: str = "x"
+    width: int = DEFAULT_WIDTH
+    height: int = DEFAULT_HEIGHT
+    near_clip: float = 1e-2
+    far_clip: float = 1e4
+    aperture_radius: float = 0.0
+    focus_distance: float = 0.0
+    sample_count: int | None = None
+
+
+def _material(d: Any, key: str, refs: Mapping[str, Material]) -> Material:
+    if not isinstance(d, Mapping) or "type" not in d:
+        raise ValueError(f"{key} must be a bsdf dict with a 'type'")
+    kind = d["type"]
+    if kind == "ref":
+        _check_keys(d, set(), key)
+        if d.get("id") not in refs:
+            raise ValueError(f"{key}: no top-level bsdf with id {d.get('id')!r}")
+        return refs[d["id"]]
+    if kind == "twosided":
+        _check_keys(d, {"bsdf"}, key)
+        inner = _material(d["bsdf"], f"{key}.bsdf", refs)
+        return Material(inner.diffuse, inner.specular, inner.exponent, True, inner.kind)
+    if kind == "diffuse":
+        _check_keys(d, {"reflectance"}, key)
+        rho = _rgb(d.get("reflectance", 0.5), f"{key}.reflectance")
+        return Material(rho, [0.0] * 3, 0.0, False, "diffuse")
+    if kind == "mcsample_phong":
+        _check_keys(d, {"diffuse_reflectance", "specular_reflectance", "exponent"}, key)
+        m = Material(_rgb(d.get("diffuse_reflectance", 0.5), f"{key}.diffuse_reflectance"),
+                     _rgb(d.get("specular_reflectance", 0.2), f"{key}.specular_reflectance"),
+                     _float(d.get("exponent", 30.0), f"{key}.exponent"), False, "phong")
+        m.phong()  # energy conservation and exponent checks, with their messages
+        return m
+    raise ValueError(f"{key}.type = {kind!r}: mcsample supports the bsdfs 'diffuse', "
+                     "'mcsample_phong', 'twosided' and 'ref'")
+
+
+def _transform_mesh(v: np.ndarray, n: np.ndarray | None, m: np.ndarray | None):
+    if m is None:
+        return v, n
+    v = v @ m[:3, :3].T + m[:3, 3]
+    if n is not None:
+        n = n @ np.linalg.inv(m[:3, :3])  # inverse transpose, row vectors
+        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    return v, n
+
+
+def _rectangle() -> tuple[np.ndarray, np.ndarray]:
+    v = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], dtype=np.float64)
+    return v, np.array([[0, 1, 2], [2, 3, 0]], dtype=np.int64)
+
+
+def _cube() -> tuple[np.ndarray, np.ndarray]:
+    verts, faces = [], []
+    for axis in range(3):
+        for sign in (-1.0, 1.0):
+            # Two in-plane axes ordered so that (a × b) points along +sign·axis.
+            a, b = (axis + 1) % 3, (axis + 2) % 3
+            if sign < 0:
+                a, b = b, a
+            base = len(verts)
+            for s, t in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                p = np.zeros(3)
+                p[axis], p[a], p[b] = sign, s, t
+                verts.append(p)
+            faces += [[base, base + 1, base + 2], [base + 2, base + 3, base]]
+    return np.array(verts), np.array(faces, dtype=np.int64)
+
+
+_SHAPE_KEYS = {
+    "sphere": {"center", "radius", "to_world", "flip_normals"},
+    "rectangle": {"to_world", "flip_normals"},
+    "disk": {"to_world", "flip_normals"},
+    "cube": {"to_world", "flip_normals"},
+    "ply": {"filename", "to_world", "face_normals", "flip_normals"},
+    "obj": {"filename", "to_world", "face_normals", "flip_normals"},
+    "mesh": {"vertices", "faces", "normals", "to_world", "face_normals", "flip_normals"},
+}
+
+
+def _shape(d: Mapping[str, Any], key: str, refs: Mapping[str, Material]) -> ShapeRecord:
+    kind = d["type"]
+    _check_keys(d, _SHAPE_KEYS[kind] | {"bsdf", "emitter"}, key)
+    material = _material(d["bsdf"], f"{key}.bsdf", refs) if "bsdf" in d else DEFAULT_MATERIAL
+    emission = None
+    if "emitter" in d:
+        e = d["emitter"]
+        if not isinstance(e, Mapping) or e.get("type") != "area":
+            raise ValueError(f"{key}.emitter: only {{'type': 'area', 'radiance': ...}} "
+                             "emitters can sit on a shape")
+        _check_keys(e, {"radiance"}, f"{key}.emitter")
+        emission = _rgb(e.get("radiance", 1.0), f"{key}.emitter.radiance")
+    m = _matrix(d["to_world"], f"{key}.to_world") if "to_world" in d else None
+    flip = bool(d.get("flip_normals", False))
+    rec = ShapeRecord(kind="mesh", material=material, emission=emission, flip_normals=flip)
+    if kind == "sphere":
+        center = np.asarray(d.get("center", [0.0, 0.0, 0.0]), dtype=np.float64).reshape(3)
+        radius = _float(d.get("radius", 1.0), f"{key}.radius")
+        if m is not None:
+            scales = np.linalg.norm(m[:3, :3], axis=0)
+            if not np.allclose(scales, scales[0], rtol=1e-5):
+                raise ValueError(f"{key}.to_world: a sphere takes a uniform scale only")
+            center = m[:3, :3] @ center + m[:3, 3]
+            radius *= float(scales[0])
+        rec.kind, rec.center, rec.radius = "sphere", [float(c) for c in center], radius
+        return rec
+    if kind == "disk":
+        rec.kind = "disk"
+        rec.to_world = m if m is not None else np.eye(4)
+        if flip:
+            rec.to_world = rec.to_world @ np.diag([1.0, -1.0, -1.0, 1.0])
+        return rec
+    if kind in ("rectangle", "cube"):
+        v, f = _rectangle() if kind == "rectangle" else _cube()
+        n, rec.face_normals = None, True
+    elif kind == "mesh":
+        try:
+            v = np.asarray(d["vertices"], dtype=np.float64)
+            f = np.asarray(d["faces"])
+        except KeyError as e:
+            raise ValueError(f"{key}: a mesh needs 'vertices' and 'faces'") from None
+        if v.ndim != 2 or v.shape[1] != 3 or f.ndim != 2 or f.shape[1] != 3:
+            raise ValueError(f"{key}: vertices must be (N, 3) and faces (M, 3), "
+                             f"got {v.shape} and {f.shape}")
+        if not np.issubdtype(f.dtype, np.integer):
+            raise ValueError(f"{key}.faces must hold integers, got {f.dtype}")
+        f = f.astype(np.int64)
+        n = None if d.get("normals") is None else np.asarray(d["normals"], dtype=np.float64)
+        rec.face_normals = bool(d.get("face_normals", False))
+    else:
+        if "filename" not in d:
+            raise ValueError(f"{key}: a {kind} shape needs a 'filename'")
+        v, f, n = read_mesh(os.fspath(d["filename"]))
+        rec.face_normals = bool(d.get("face_normals", False))
+    if flip:
+        f = f[:, ::-1].copy()
+        n = None if n is None else -n
+    rec.vertices, rec.normals = _transform_mesh(v, n, m)
+    rec.faces = f
+    return rec
+
+
+def _environment(d: Any, key: str) -> tuple[str, Any]:
+    if isinstance(d, EnvMap):
+        return "envmap", d
+    kind = d["type"]
+    if kind == "constant":
+        _check_keys(d, {"radiance"}, key)
+        return "constant", _rgb(d.get("radiance", 1.0), f"{key}.radiance")
+    _check_keys(d, {"filename", "scale", "to_world"}, key)
+    if "filename" not in d:
+        raise ValueError(f"{key}: an envmap needs a 'filename' (or give an mcsample.EnvMap)")
+    to_world = _matrix(d["to_world"], f"{key}.to_world") if "to_world" in d else None
+    scale = _float(d.get("scale", 1.0), f"{key}.scale")
+    return "envmap", EnvMap.load(os.fspath(d["filename"]), to_world=to_world, scale=scale)
+
+
+def _camera(d: Mapping[str, Any], key: str) -> Camera:
+    kind = d["type"]
+    lens = {"aperture_radius", "focus_distance"} if kind == "thinlens" else set()
+    _check_keys(d, {"fov", "fov_axis", "to_world", "near_clip", "far_clip", "film", "sampler"}
+                | lens, key)
+    if "fov" not in d:
+        raise ValueError(f"{key}: give the field of view as 'fov' (degrees); "
+                         "'focal_length' is not supported")
+    cam = Camera(to_world=_matrix(d["to_world"], f"{key}.to_world") if "to_world" in d
+                 else np.eye(4), fov=_float(d["fov"], f"{key}.fov"),
+                 fov_axis=str(d.get("fov_axis", "x")),
+                 near_clip=_float(d.get("near_clip", 1e-2), f"{key}.near_clip"),
+                 far_clip=_float(d.get("far_clip", 1e4), f"{key}.far_clip"))
+    if kind == "thinlens":
+        cam.aperture_radius = _float(d.get("aperture_radius", 0.03), f"{key}.aperture_radius")
+        cam.focus_distance = _float(d.get("focus_distance", 0.0), f"{key}.focus_distance")
+    film = d.get("film", {"type": "hdrfilm"})
+    if film.get("type") != "hdrfilm":
+        raise ValueError(f"{key}.film.type = {film.get('type')!r}: must be 'hdrfilm'")
+    _check_keys(film, {"width", "height", "rfilter", "pixel_format"}, f"{key}.film")
+    cam.width = int(film.get("width", DEFAULT_WIDTH))
+    cam.height = int(film.get("height", DEFAULT_HEIGHT))
+    rfilter = film.get("rfilter", {"type": "box"})
+    if rfilter.get("type") != "box" or set(rfilter) - {"type"}:
+        raise ValueError(f"{key}.film.rfilter: mcsample renders with a box filter only "
+                         "({'type': 'box'})")
+    if film.get("pixel_format", "rgb") not in ("rgb", "rgba"):
+        raise ValueError(f"{key}.film.pixel_format must be 'rgb' or 'rgba'")
+    sampler = d.get("sampler")
+    if sampler is not None:
+        if sampler.get("type") != "independent":
+            raise ValueError(f"{key}.sampler.type must be 'independent'")
+        _check_keys(sampler, {"sample_count", "seed"}, f"{key}.sampler")
+        cam.sample_count = int(sampler.get("sample_count", 4))
+    return cam
+
+
+@dataclass
+class Scene:
+    """A scene mcsample can render and Mitsuba 3 can render too.
+
+    Build one with :meth:`from_mitsuba`; render it with
+    :func:`mcsample.render`, and in Mitsuba with
+    :func:`mcsample.mitsuba.render_reference`.
+    """
+
+    shapes: list[ShapeRecord]
+    environment: tuple[str, Any] | None
+    camera: Camera
+    integrator: dict[str, Any] = field(default_factory=dict)
+    source: dict[str, Any] = field(default_factory=dict, repr=False)
+    _compiled: CompiledScene | None = field(default=None, repr=False)
+
+    @classmethod
+    def from_mitsuba(cls, d: Mapping[str, Any]) -> "Scene":
+        """Reads a Mitsuba 3 scene dict (the subset in this module's doc).
+
+        Raises ValueError naming the first key outside that subset or with a
+        bad value, OSError for a mesh or image file that cannot be read.
+        """
+        if not isinstance(d, Mapping) or d.get("type") != "scene":
+            raise ValueError("a scene dict has 'type': 'scene' at the top level")
+        refs: dict[str, Material] = {}
+        for key, value in d.items():
+            if isinstance(value, Mapping) and value.get("type") in (
+                    "diffuse", "mcsample_phong", "twosided"):
+                refs[str(value.get("id", key))] = _material(value, key, refs)
+        shapes, environment, camera, integrator = [], None, None, {}
+        for key, value in d.items():
+            if key == "type":
+                continue
+            kind = value.get("type") if isinstance(value, Mapping) else None
+            if isinstance(value, EnvMap) or kind in ("envmap", "constant"):
+                if environment is not None:
+                    raise ValueError(f"{key}: a scene holds at most one environment emitter")
+                environment = _environment(value, key)
+            elif kind in _SHAPE_KEYS:
+                shapes.append(_shape(value, key, refs))
+            elif kind in ("perspective", "thinlens"):
+                if camera is not None:
+                    raise ValueError(f"{key}: mcsample renders scenes with one sensor")
+                camera = _camera(value, key)
+            elif kind in ("path", "direct"):
+                _check_keys(value, {"max_depth", "rr_depth", "hide_emitters"}, key)
+                if value.get("hide_emitters", False):
+                    raise ValueError(f"{key}.hide_emitters: not supported by mcsample")
+                integrator = {"integrator": kind,
+                              **{k: int(value[k]) for k in ("max_depth", "rr_depth")
+                                 if k in value}}
+            elif kind in ("diffuse", "mcsample_phong", "twosided"):
+                continue  # a top-level bsdf, referenced by id
+            else:
+                raise ValueError(f"{key}: type {kind!r} is not supported by mcsample "
+                                 "(see mcsample.scene for the subset it reads)")
+        if camera is None:
+            raise ValueError("the scene has no sensor ('perspective' or 'thinlens')")
+        return cls(shapes, environment, camera, integrator, source=dict(d))
+
+    @property
+    def compiled(self) -> CompiledScene:
+        """The Rust scene (BVH and light selection), built on first use."""
+        if self._compiled is None:
+            b = SceneBuilder()
+            for i, s in enumerate(self.shapes):
+                bsdf, two = s.material.phong(), s.material.two_sided
+                if s.kind == "sphere":
+                    b.add_sphere(s.center, s.radius, s.flip_normals, bsdf, two, s.emission)
+                elif s.kind == "disk":
+                    b.add_disk(s.to_world.tolist(), bsdf, two, s.emission)
+                else:
+                    b.add_mesh(np.ascontiguousarray(s.vertices),
+                               np.ascontiguousarray(s.faces),
+                               None if s.normals is None else np.ascontiguousarray(s.normals),
+                               s.face_normals, bsdf, two, s.emission)
+            if self.environment is not None:
+                kind, value = self.environment
+                if kind == "envmap":
+                    b.set_envmap(value)
+                else:
+                    b.set_constant(value)
+            c = self.camera
+            b.set_camera(c.to_world.tolist(), c.fov, c.fov_axis, c.width, c.height,
+                         c.near_clip, c.far_clip, c.aperture_radius, c.focus_distance)
+            self._compiled = b.build()
+        return self._compiled
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """``(width, height)`` of the film."""
+        return self.camera.width, self.camera.height
+
+    def to_mitsuba(self, spp: int | None = None, directory: str | None = None,
+                   latlong_width: int | None = None) -> dict[str, Any]:
+        """A dict for ``mi.load_dict`` (a Mitsuba variant must be set; the
+        Phong plugin is registered here). Meshes are written as PLY files
+        into ``directory`` (a new temporary folder by default); a non-lat-long
+        envmap is converted to lat-long (``latlong_width`` columns, default
+        4× the source's resolution) for Mitsuba's envmap emitter."""
+        import mitsuba as mi
+
+        from .mitsuba import register_phong
+
+        phong_type = register_phong()
+        directory = directory or tempfile.mkdtemp(prefix="mcsample-scene-")
+        c = self.camera
+        sensor: dict[str, Any] = {
+            "type": "thinlens" if c.aperture_radius > 0 else "perspective",
+            "fov": c.fov, "fov_axis": c.fov_axis, "near_clip": c.near_clip,
+            "far_clip": c.far_clip, "to_world": mi.ScalarTransform4f(c.to_world.tolist()),
+            "film": {"type": "hdrfilm", "width": c.width, "height": c.height,
+                     "rfilter": {"type": "box"}, "pixel_format": "rgb"},
+            "sampler": {"type": "independent",
+                        "sample_count": int(spp or c.sample_count or 4)},
+        }
+        if c.aperture_radius > 0:
+            sensor.update(aperture_radius=c.aperture_radius, focus_distance=c.focus_distance)
+        out: dict[str, Any] = {"type": "scene", "sensor": sensor}
+        for i, s in enumerate(self.shapes):
+            d: dict[str, Any]
+            if s.kind == "sphere":
+                d = {"type": "sphere", "center": s.center, "radius": s.radius,
+                     "flip_normals": s.flip_normals}
+            elif s.kind == "disk":
+                d = {"type": "disk", "to_world": mi.ScalarTransform4f(s.to_world.tolist())}
+            else:
+                path = os.path.join(directory, f"shape{i}.ply")
+                write_ply(path, s.vertices, s.faces, None if s.face_normals else s.normals)
+                d = {"type": "ply", "filename": path, "face_normals": s.face_normals}
+            d["bsdf"] = s.material.to_mitsuba(phong_type)
+            if s.emission is not None:
+                d["emitter"] = {"type": "area", "radiance": {"type": "rgb", "value": s.emission}}
+            out[f"shape{i}"] = d
+        if self.environment is not None:
+            kind, value = self.environment
+            if kind == "constant":
+                out["environment"] = {"type": "constant",
+                                      "radiance": {"type": "rgb", "value": value}}
+            else:
+                env = value
+                if env.mapping != "latlong":
+                    w = latlong_width or 4 * env.image.shape[1]
+                    env = env.convert("latlong", w)
+                m = np.eye(4)
+                m[:3, :3] = np.asarray(env.to_world)
+                out["environment"] = {
+                    "type": "envmap", "scale": float(env.scale),
+                    "bitmap": mi.Bitmap(np.ascontiguousarray(env.image, dtype=np.float32)),
+                    "to_world": mi.ScalarTransform4f(m.tolist()),
+                }
+        return out
+
+    def copy(self) -> "Scene":
+        """A deep copy (change it and render again)."""
+        return copy.deepcopy(self)
+
+
+def write_ply(path: str, vertices: np.ndarray, faces: np.ndarray,
+              normals: np.ndarray | None = None) -> None:
+    """Writes a binary little-endian PLY: float vertices (and normals),
+    int faces."""
+    v = np.asarray(vertices, dtype="<f4")
+    f = np.asarray(faces, dtype="<i4")
+    props = ["x", "y", "z"] + (["nx", "ny", "nz"] if normals is not None else [])
+    cols = v if normals is None else np.hstack([v, np.asarray(normals, dtype="<f4")])
+    header = ["ply", "format binary_little_endian 1.0", f"element vertex {len(v)}"]
+    header += [f"property float {p}" for p in props]
+    header += [f"element face {len(f)}", "property list uchar int vertex_indices",
+               "end_header"]
+    faces_rec = np.zeros(len(f), dtype=[("n", "u1"), ("i", "<i4", (3,))])
+    faces_rec["n"], faces_rec["i"] = 3, f
+    with open(path, "wb") as fh:
+        fh.write(("\n".join(header) + "\n").encode("ascii"))
+        fh.write(np.ascontiguousarray(cols, dtype="<f4").tobytes())
+        fh.write(faces_rec.tobytes())

@@ -1,0 +1,361 @@
+//! `mcsample._core.render`: the scene builder, the compiled scene and the
+//! render call (GIL released, progress reported, Ctrl-C honoured).
+
+use std::sync::Arc;
+use std::sync::mpsc;
+use std::time::Duration;
+
+use numpy::{PyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use super::arrays::index_arg;
+use super::envmap::PyEnvMap;
+use super::error::guarded;
+use super::phong::PyPhong;
+use crate::render::camera::{Camera, FovAxis};
+use crate::render::scene::{Environment, Geometry, Material, Shape, affine};
+use crate::render::{Heuristic, Integrator, Progress, Scene, Settings, Strategy};
+
+fn rows<'py, T: numpy::Element + Copy, const K: usize>(
+    a: &PyReadonlyArray2<'py, T>,
+    arg: &'static str,
+) -> PyResult<Vec<[T; K]>> {
+    let view = a.as_array();
+    if view.ncols() != K {
+        return Err(PyValueError::new_err(format!(
+            "{arg} must have shape (N, {K}), got {:?}",
+            view.shape()
+        )));
+    }
+    Ok(view
+        .rows()
+        .into_iter()
+        .map(|r| std::array::from_fn(|k| r[k]))
+        .collect())
+}
+
+/// Collects shapes, lights and the camera of a scene, then builds it
+/// (``mcsample.Scene.from_mitsuba`` drives it; most users never call it).
+#[pyclass(module = "mcsample._core.render", name = "SceneBuilder")]
+#[derive(Default)]
+pub struct PySceneBuilder {
+    shapes: Vec<Shape>,
+    environment: Option<Environment>,
+    camera: Option<(Camera, usize, usize)>,
+}
+
+impl PySceneBuilder {
+    fn push(
+        &mut self,
+        geometry: crate::Result<Geometry>,
+        bsdf: &PyPhong,
+        two_sided: bool,
+        emission: Option<[f64; 3]>,
+    ) -> PyResult<()> {
+        if let Some(l) = emission
+            && let Some(k) = l.iter().position(|v| !(v.is_finite() && *v >= 0.0))
+        {
+            return Err(PyValueError::new_err(format!(
+                "emission[{k}] = {}: radiance must be finite and >= 0",
+                l[k]
+            )));
+        }
+        self.shapes.push(Shape {
+            geometry: geometry?,
+            material: Material {
+                bsdf: *bsdf.inner(),
+                two_sided,
+            },
+            emission,
+        });
+        Ok(())
+    }
+
+    fn set_environment(&mut self, env: Environment) -> PyResult<()> {
+        if self.environment.is_some() {
+            return Err(PyValueError::new_err(
+                "a scene holds at most one environment emitter (envmap or constant)",
+            ));
+        }
+        self.environment = Some(env);
+        Ok(())
+    }
+}
+
+#[pymethods]
+impl PySceneBuilder {
+    #[new]
+    fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a triangle mesh: ``vertices`` (N, 3) float64 in world space,
+    /// ``faces`` (M, 3) int64, ``normals`` (N, 3) or None.
+    #[pyo3(signature = (vertices, faces, normals, face_normals, bsdf, two_sided, emission))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_mesh(
+        &mut self,
+        py: Python<'_>,
+        vertices: PyReadonlyArray2<'_, f64>,
+        faces: PyReadonlyArray2<'_, i64>,
+        normals: Option<PyReadonlyArray2<'_, f64>>,
+        face_normals: bool,
+        bsdf: PyRef<'_, PyPhong>,
+        two_sided: bool,
+        emission: Option<[f64; 3]>,
+    ) -> PyResult<()> {
+        let v = rows::<f64, 3>(&vertices, "vertices")?;
+        let f = rows::<i64, 3>(&faces, "faces")?;
+        let n = normals
+            .as_ref()
+            .map(|n| rows::<f64, 3>(n, "normals"))
+            .transpose()?;
+        let geometry = py.detach(|| Geometry::mesh(&v, &f, n.as_deref(), face_normals));
+        self.push(geometry, &bsdf, two_sided, emission)
+    }
+
+    /// Adds a sphere.
+    #[pyo3(signature = (center, radius, flip_normals, bsdf, two_sided, emission))]
+    fn add_sphere(
+        &mut self,
+        center: [f64; 3],
+        radius: f64,
+        flip_normals: bool,
+        bsdf: PyRef<'_, PyPhong>,
+        two_sided: bool,
+        emission: Option<[f64; 3]>,
+    ) -> PyResult<()> {
+        let geometry = Geometry::sphere(center, radius, flip_normals);
+        self.push(geometry, &bsdf, two_sided, emission)
+    }
+
+    /// Adds Mitsuba's unit disk placed by the row-major 4×4 ``to_world``.
+    #[pyo3(signature = (to_world, bsdf, two_sided, emission))]
+    fn add_disk(
+        &mut self,
+        to_world: [[f64; 4]; 4],
+        bsdf: PyRef<'_, PyPhong>,
+        two_sided: bool,
+        emission: Option<[f64; 3]>,
+    ) -> PyResult<()> {
+        self.push(Geometry::disk(to_world), &bsdf, two_sided, emission)
+    }
+
+    /// Lights the scene with an environment map.
+    fn set_envmap(&mut self, env: PyRef<'_, PyEnvMap>) -> PyResult<()> {
+        self.set_environment(Environment::Map(Box::new(env.inner().clone())))
+    }
+
+    /// Lights the scene with the same radiance from every direction.
+    fn set_constant(&mut self, radiance: [f64; 3]) -> PyResult<()> {
+        if let Some(k) = radiance.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+            return Err(PyValueError::new_err(format!(
+                "radiance[{k}] = {}: must be finite and >= 0",
+                radiance[k]
+            )));
+        }
+        self.set_environment(Environment::Constant(radiance))
+    }
+
+    /// Sets the camera and the film size.
+    #[pyo3(signature = (to_world, fov, fov_axis, width, height, near_clip, far_clip, aperture_radius, focus_distance))]
+    #[allow(clippy::too_many_arguments)]
+    fn set_camera(
+        &mut self,
+        to_world: [[f64; 4]; 4],
+        fov: f64,
+        fov_axis: &str,
+        width: &Bound<'_, PyAny>,
+        height: &Bound<'_, PyAny>,
+        near_clip: f64,
+        far_clip: f64,
+        aperture_radius: f64,
+        focus_distance: f64,
+    ) -> PyResult<()> {
+        let axis = FovAxis::from_name(fov_axis).ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "fov_axis = {fov_axis:?}: must be 'x', 'y', 'diagonal', 'smaller' or 'larger'"
+            ))
+        })?;
+        let width = index_arg(width, "width", 1, 1 << 15)? as usize;
+        let height = index_arg(height, "height", 1, 1 << 15)? as usize;
+        let camera = Camera::new(
+            affine("to_world", to_world)?,
+            fov,
+            axis,
+            width,
+            height,
+            near_clip,
+            far_clip,
+            aperture_radius,
+            focus_distance,
+        )?;
+        self.camera = Some((camera, width, height));
+        Ok(())
+    }
+
+    /// The scene, with its BVH and light selection built.
+    fn build(&mut self, py: Python<'_>) -> PyResult<PyScene> {
+        let (camera, width, height) = self
+            .camera
+            .ok_or_else(|| PyValueError::new_err("the scene has no sensor"))?;
+        let shapes = std::mem::take(&mut self.shapes);
+        let environment = self.environment.take();
+        let scene =
+            py.detach(|| guarded(|| Ok(Scene::new(shapes, environment, camera, width, height)?)))?;
+        Ok(PyScene(Arc::new(scene)))
+    }
+}
+
+/// A scene ready to render (``mcsample.Scene`` holds one).
+#[pyclass(module = "mcsample._core.render", name = "CompiledScene", frozen)]
+pub struct PyScene(Arc<Scene>);
+
+#[pymethods]
+impl PyScene {
+    /// ``(width, height)`` of the film in pixels.
+    #[getter]
+    fn film(&self) -> (usize, usize) {
+        self.0.film()
+    }
+}
+
+fn choice<T: Copy>(arg: &str, value: &str, options: &[(&str, T)]) -> PyResult<T> {
+    options
+        .iter()
+        .find(|(name, _)| *name == value)
+        .map(|(_, v)| *v)
+        .ok_or_else(|| {
+            let names: Vec<String> = options.iter().map(|(n, _)| format!("{n:?}")).collect();
+            PyValueError::new_err(format!(
+                "{arg} = {value:?}: must be one of {}",
+                names.join(", ")
+            ))
+        })
+}
+
+/// Renders ``scene``; returns ``(image, variance, luminance_variance)`` as
+/// flat float32 arrays of ``height * width * 3`` (the last ``height *
+/// width``). ``callback(samples_done)`` is
+/// called about ten times a second, holding the GIL; a pending signal (such
+/// as Ctrl-C) stops the render and is raised once its threads have stopped.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+#[pyo3(signature = (scene, spp, seed, integrator, strategy, heuristic, max_depth, rr_depth, callback = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn render<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, PyScene>,
+    spp: &Bound<'py, PyAny>,
+    seed: &Bound<'py, PyAny>,
+    integrator: &str,
+    strategy: &str,
+    heuristic: &str,
+    max_depth: i64,
+    rr_depth: &Bound<'py, PyAny>,
+    callback: Option<Bound<'py, PyAny>>,
+) -> PyResult<(
+    Bound<'py, PyArray1<f32>>,
+    Bound<'py, PyArray1<f32>>,
+    Bound<'py, PyArray1<f32>>,
+)> {
+    let spp = index_arg(spp, "spp", 1, u64::from(u32::MAX))? as u32;
+    let seed = index_arg(seed, "seed", 0, u64::MAX)?;
+    let rr_depth = index_arg(rr_depth, "rr_depth", 0, u64::from(u32::MAX))? as u32;
+    let max_depth = match max_depth {
+        -1 => None,
+        d if (0..=i64::from(u32::MAX)).contains(&d) => Some(d as u32),
+        d => {
+            return Err(PyValueError::new_err(format!(
+                "max_depth = {d}: must be -1 (unbounded) or >= 0"
+            )));
+        }
+    };
+    let settings = Settings {
+        integrator: choice(
+            "integrator",
+            integrator,
+            &[("direct", Integrator::Direct), ("path", Integrator::Path)],
+        )?,
+        strategy: choice(
+            "strategy",
+            strategy,
+            &[
+                ("bsdf", Strategy::Bsdf),
+                ("emitter", Strategy::Emitter),
+                ("mis", Strategy::Mis),
+            ],
+        )?,
+        heuristic: choice(
+            "heuristic",
+            heuristic,
+            &[("balance", Heuristic::Balance), ("power", Heuristic::Power)],
+        )?,
+        max_depth,
+        rr_depth,
+    };
+    let scene = Arc::clone(&scene.get().0);
+    let progress = Arc::new(Progress::default());
+    let (tx, rx) = mpsc::channel();
+    let worker = {
+        let progress = Arc::clone(&progress);
+        std::thread::spawn(move || {
+            let result = guarded(|| {
+                Ok(crate::render::render(
+                    &scene, spp, seed, &settings, &progress,
+                )?)
+            });
+            // The receiver outlives this thread (it joins it).
+            let _ = tx.send(result);
+        })
+    };
+    let tick = Duration::from_millis(100);
+    let mut rx = rx;
+    let outcome = loop {
+        // The receiver is Send but not Sync: it goes into the GIL-free
+        // closure and comes back out.
+        let (received, back) = py.detach(move || (rx.recv_timeout(tick), rx));
+        rx = back;
+        match received {
+            Ok(result) => break result,
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                break Err(pyo3::exceptions::PyRuntimeError::new_err(
+                    "internal error in mcsample: the render thread stopped without a result",
+                ));
+            }
+            Err(mpsc::RecvTimeoutError::Timeout) => {}
+        }
+        let interrupted = py.check_signals().and_then(|()| match &callback {
+            Some(cb) => cb
+                .call1((progress.samples.load(std::sync::atomic::Ordering::Relaxed),))
+                .map(|_| ()),
+            None => Ok(()),
+        });
+        if let Err(e) = interrupted {
+            progress
+                .cancel
+                .store(true, std::sync::atomic::Ordering::Relaxed);
+            py.detach(move || {
+                let _ = rx.recv();
+            });
+            let _ = worker.join();
+            return Err(e);
+        }
+    };
+    let _ = worker.join();
+    let image = outcome?;
+    Ok((
+        PyArray1::from_vec(py, image.mean),
+        PyArray1::from_vec(py, image.variance),
+        PyArray1::from_vec(py, image.luminance_variance),
+    ))
+}
+
+/// Registers ``mcsample._core.render``.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PySceneBuilder>()?;
+    m.add_class::<PyScene>()?;
+    m.add_function(wrap_pyfunction!(render, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,204 @@
+//! The acceleration structure: every primitive of the scene (triangles,
+//! spheres, disks) in one compressed wide BVH (obvhs' CWBVH, built by PLOC).
+
+use std::time::Duration;
+
+use glam::Vec3A;
+use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh, ray::RayHit};
+
+use super::shape::{Candidate, Disk, Ray, Sphere, SurfacePoint, Triangle};
+
+/// A primitive and the index of the shape (in the scene's list) it belongs
+/// to.
+#[derive(Clone, Copy, Debug)]
+pub enum Primitive {
+    /// One triangle of a mesh.
+    Triangle(Triangle),
+    /// A sphere.
+    Sphere(Sphere),
+    /// A disk.
+    Disk(Disk),
+}
+
+impl Primitive {
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<Candidate> {
+        match self {
+            Primitive::Triangle(t) => t.intersect(ray),
+            Primitive::Sphere(s) => s.intersect(ray),
+            Primitive::Disk(d) => d.intersect(ray),
+        }
+    }
+
+    fn bounds(&self) -> Aabb {
+        let (lo, hi) = match self {
+            Primitive::Triangle(t) => {
+                let (p1, p2) = (t.p0 + t.e1, t.p0 + t.e2);
+                (t.p0.min(p1).min(p2), t.p0.max(p1).max(p2))
+            }
+            Primitive::Sphere(s) => s.bounds(),
+            Primitive::Disk(d) => d.bounds(),
+        };
+        Aabb::new(lo, hi)
+    }
+
+    /// The surface point of a hit on this primitive at `p` (position along
+    /// the ray) with barycentrics `bary` (triangles).
+    #[inline]
+    pub fn point(&self, p: Vec3A, bary: [f32; 2]) -> SurfacePoint {
+        match self {
+            Primitive::Triangle(t) => t.point(bary),
+            Primitive::Sphere(s) => s.point(p),
+            Primitive::Disk(d) => d.point(p),
+        }
+    }
+}
+
+/// The closest hit of a ray.
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    /// Distance along the ray.
+    pub t: f32,
+    /// Index of the primitive in [`Accel::primitives`].
+    pub primitive: u32,
+    /// Barycentrics (triangles).
+    pub bary: [f32; 2],
+}
+
+/// Primitives, the shape each belongs to, and their BVH.
+pub struct Accel {
+    primitives: Vec<Primitive>,
+    shape_of: Vec<u32>,
+    bvh: Option<CwBvh>,
+}
+
+impl Accel {
+    /// Builds the BVH over `primitives` (each paired with its shape index).
+    pub fn new(primitives: Vec<(Primitive, u32)>) -> Self {
+        let (primitives, shape_of): (Vec<_>, Vec<_>) = primitives.into_iter().unzip();
+        let bvh = (!primitives.is_empty()).then(|| {
+            let aabbs: Vec<Aabb> = primitives.iter().map(Primitive::bounds).collect();
+            build_cwbvh(
+                &aabbs,
+                BvhBuildParams::medium_build(),
+                &mut Duration::default(),
+            )
+        });
+        Accel {
+            primitives,
+            shape_of,
+            bvh,
+        }
+    }
+
+    /// The primitives, in the order they were given.
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.primitives
+    }
+
+    /// The shape a primitive belongs to.
+    #[inline]
+    pub fn shape_of(&self, primitive: u32) -> u32 {
+        self.shape_of[primitive as usize]
+    }
+
+    /// The nearest hit in `(0, ray.tmax)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let bvh = self.bvh.as_ref()?;
+        let mut hit = RayHit::none();
+        let mut best = Hit {
+            t: ray.tmax,
+            primitive: 0,
+            bary: [0.0; 2],
+        };
+        let query = obvhs::ray::Ray::new(ray.o, ray.d, 0.0, ray.tmax);
+        bvh.ray_traverse(query, &mut hit, |r, id| {
+            let primitive = bvh.primitive_indices[id];
+            let shrunk = Ray {
+                tmax: r.tmax,
+                ..*ray
+            };
+            match self.primitives[primitive as usize].intersect(&shrunk) {
+                Some(c) => {
+                    best = Hit {
+                        t: c.t,
+                        primitive,
+                        bary: c.bary,
+                    };
+                    c.t
+                }
+                None => f32::INFINITY,
+            }
+        });
+        (best.t < ray.tmax).then_some(best)
+    }
+
+    /// Whether anything lies on the ray in `(0, ray.tmax)`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        let Some(bvh) = self.bvh.as_ref() else {
+            return false;
+        };
+        let query = obvhs::ray::Ray::new(ray.o, ray.d, 0.0, ray.tmax);
+        !bvh.ray_traverse_miss(query, |_, id| {
+            let primitive = bvh.primitive_indices[id] as usize;
+            self.primitives[primitive]
+                .intersect(ray)
+                .map_or(f32::INFINITY, |c| c.t)
+        })
+    }
+
+    /// Bounds of the whole scene, or `None` when it has no primitive.
+    pub fn bounds(&self) -> Option<(Vec3A, Vec3A)> {
+        self.bvh
+            .as_ref()
+            .map(|b| (b.total_aabb.min, b.total_aabb.max))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn nearest_of_many_spheres_and_occlusion() {
+        let prims: Vec<(Primitive, u32)> = (0..100)
+            .map(|i| {
+                let s = Sphere {
+                    center: DVec3::new(0.0, 0.0, -3.0 * (i as f64 + 1.0)),
+                    radius: 1.0,
+                    flip: false,
+                };
+                (Primitive::Sphere(s), i)
+            })
+            .collect();
+        let accel = Accel::new(prims);
+        let ray = Ray {
+            o: Vec3A::ZERO,
+            d: Vec3A::NEG_Z,
+            tmax: f32::INFINITY,
+        };
+        let hit = accel.intersect(&ray).unwrap();
+        assert_eq!(accel.shape_of(hit.primitive), 0);
+        assert!((hit.t - 2.0).abs() < 1e-5);
+        assert!(accel.occluded(&ray));
+        assert!(!accel.occluded(&Ray { tmax: 1.5, ..ray }));
+        let up = Ray { d: Vec3A::Y, ..ray };
+        assert!(accel.intersect(&up).is_none());
+    }
+
+    #[test]
+    fn empty_scene_hits_nothing() {
+        let accel = Accel::new(Vec::new());
+        let ray = Ray {
+            o: Vec3A::ZERO,
+            d: Vec3A::X,
+            tmax: f32::INFINITY,
+        };
+        assert!(accel.intersect(&ray).is_none());
+        assert!(!accel.occluded(&ray));
+        assert!(accel.bounds().is_none());
+    }
+}

@@ -1,0 +1,230 @@
+//! The integrators: direct illumination and unidirectional path tracing,
+//! each by BSDF sampling, emitter sampling or MIS of the two.
+//!
+//! One loop serves both (direct lighting is a path of at most two segments):
+//!
+//! ```text
+//! L = Σ_k β_k · w_k · Le_k,   β_{k+1} = β_k · f_r cos θ / p_bsdf   (÷ q past rr_depth)
+//! ```
+//!
+//! Emission found by a BSDF-sampled ray is weighted by `w = h(p_bsdf, p_light)`
+//! under MIS, 1 under BSDF sampling and 0 under emitter sampling (which
+//! counts it through next-event estimation instead); next-event estimation
+//! adds `β f_r cos θ Le / p_light · h(p_light, p_bsdf)`, with `h = 1` under
+//! emitter sampling. Emission seen straight from the camera always counts.
+//! Path lengths follow Mitsuba's `max_depth`: 1 is emission only, 2 direct
+//! illumination, −1 unbounded.
+
+use glam::Vec3A;
+
+use super::scene::Scene;
+use super::shape::Ray;
+use crate::frame::Frame;
+use crate::mis;
+use crate::rng::Rng;
+
+/// Which light transport to compute.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Integrator {
+    /// Emitted and direct light (paths of at most two segments).
+    Direct,
+    /// Paths of any length (up to `max_depth`), with Russian roulette.
+    Path,
+}
+
+/// How light is found at each shading point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Strategy {
+    /// Only by sampling the BSDF and following the ray.
+    Bsdf,
+    /// Only by sampling the emitters (next-event estimation).
+    Emitter,
+    /// Both, weighted by the MIS heuristic.
+    Mis,
+}
+
+/// The MIS heuristic.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Heuristic {
+    /// `p_a / (p_a + p_b)`.
+    Balance,
+    /// `p_a² / (p_a² + p_b²)`.
+    Power,
+}
+
+/// What to render and how.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    /// Direct or path.
+    pub integrator: Integrator,
+    /// BSDF, emitter or MIS.
+    pub strategy: Strategy,
+    /// The MIS heuristic.
+    pub heuristic: Heuristic,
+    /// Longest path in segments (Mitsuba's `max_depth`); `None`: unbounded.
+    /// The direct integrator uses 2.
+    pub max_depth: Option<u32>,
+    /// Russian roulette starts at this depth (path only).
+    pub rr_depth: u32,
+}
+
+impl Settings {
+    fn weight(&self, pdf_a: f32, pdf_b: f32) -> f32 {
+        match self.heuristic {
+            Heuristic::Balance => mis::balance_heuristic(pdf_a, pdf_b),
+            Heuristic::Power => mis::power_heuristic(pdf_a, pdf_b, 2.0),
+        }
+    }
+
+    fn max_depth(&self) -> u32 {
+        match self.integrator {
+            Integrator::Direct => 2,
+            Integrator::Path => self.max_depth.unwrap_or(u32::MAX),
+        }
+    }
+}
+
+/// Offset of a ray origin off a surface, as Mitsuba's: `(1 + max |p_i|) ε`
+/// with `ε = 1500 · 2⁻²⁴`.
+#[inline]
+fn offset(p: Vec3A, n: Vec3A, toward: Vec3A) -> Vec3A {
+    let eps = (1.0 + p.abs().max_element()) * (1500.0 / 16_777_216.0);
+    if n.dot(toward) >= 0.0 {
+        p + n * eps
+    } else {
+        p - n * eps
+    }
+}
+
+#[inline]
+fn mul(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] * b[0], a[1] * b[1], a[2] * b[2]]
+}
+
+#[inline]
+fn add_scaled(acc: &mut [f32; 3], a: [f32; 3], b: [f32; 3], s: f32) {
+    for k in 0..3 {
+        acc[k] += a[k] * b[k] * s;
+    }
+}
+
+/// The radiance arriving at the camera along `ray`: one sample of the
+/// estimator above, drawing its random numbers from `rng`.
+pub fn radiance(scene: &Scene, mut ray: Ray, rng: &mut Rng, settings: &Settings) -> [f32; 3] {
+    let max_depth = settings.max_depth();
+    let mut l = [0.0f32; 3];
+    if max_depth == 0 {
+        return l;
+    }
+    let mut beta = [1.0f32; 3];
+    let mut bsdf_pdf = 0.0f32;
+    let mut depth = 0u32;
+    loop {
+        let Some(hit) = scene.accel().intersect(&ray) else {
+            if let Some(env) = scene.environment() {
+                let w = emission_weight(settings, depth, bsdf_pdf, || scene.environment_pdf(ray.d));
+                add_scaled(&mut l, beta, env.eval(ray.d), w);
+            }
+            break;
+        };
+        let shape = scene.accel().shape_of(hit.primitive);
+        let primitive = &scene.accel().primitives()[hit.primitive as usize];
+        let sp = primitive.point(ray.o + ray.d * hit.t, hit.bary);
+        let wi = -ray.d;
+        if let Some(le) = scene.emitted(shape, sp.ng, wi) {
+            let w = emission_weight(settings, depth, bsdf_pdf, || {
+                scene.area_pdf(shape, sp.ng, ray.d, hit.t)
+            });
+            add_scaled(&mut l, beta, le, w);
+        }
+        if depth + 1 >= max_depth {
+            break;
+        }
+        let material = scene.material(shape);
+        let ns = if material.two_sided && sp.ns.dot(wi) < 0.0 {
+            -sp.ns
+        } else {
+            sp.ns
+        };
+        let frame = Frame::from_normal(ns.to_array());
+        let view = material.bsdf.view(frame.to_local(wi.to_array()));
+
+        if settings.strategy != Strategy::Bsdf {
+            let u = [rng.next_float(), rng.next_float(), rng.next_float()];
+            if let Some(ls) = scene.sample_light(sp.p, u) {
+                let wo = frame.to_local(ls.d.to_array());
+                let f = view.eval(wo);
+                if f.iter().any(|&v| v > 0.0) {
+                    let origin = offset(sp.p, sp.ng, ls.d);
+                    let tmax = if ls.dist.is_finite() {
+                        (ls.d.dot(sp.p + ls.d * ls.dist - origin)) * (1.0 - 1e-4)
+                    } else {
+                        f32::INFINITY
+                    };
+                    let shadow = Ray {
+                        o: origin,
+                        d: ls.d,
+                        tmax,
+                    };
+                    if !scene.accel().occluded(&shadow) {
+                        let w = if settings.strategy == Strategy::Mis {
+                            settings.weight(ls.pdf, view.pdf(wo))
+                        } else {
+                            1.0
+                        };
+                        let s = w * wo[2].abs() / ls.pdf;
+                        add_scaled(&mut l, beta, mul(f, ls.radiance), s);
+                    }
+                }
+            }
+            // Under emitter sampling, the next vertex's emission is not
+            // counted: when it would be the last, stop here.
+            if settings.strategy == Strategy::Emitter && depth + 2 >= max_depth {
+                break;
+            }
+        }
+
+        let u = [rng.next_float(), rng.next_float(), rng.next_float()];
+        let s = view.sample(u);
+        if s.weight.iter().all(|&v| v <= 0.0) {
+            break;
+        }
+        beta = mul(beta, s.weight);
+        bsdf_pdf = s.pdf;
+        let d = Vec3A::from(frame.to_world(s.wo)).normalize();
+        ray = Ray {
+            o: offset(sp.p, sp.ng, d),
+            d,
+            tmax: f32::INFINITY,
+        };
+        depth += 1;
+        if settings.integrator == Integrator::Path && depth >= settings.rr_depth {
+            let q = beta.iter().copied().fold(0.0f32, f32::max).min(0.95);
+            if rng.next_float::<f32>() >= q {
+                break;
+            }
+            beta = beta.map(|b| b / q);
+        }
+    }
+    l
+}
+
+/// The weight of emission found at path depth `depth` (0: seen from the
+/// camera) after a BSDF sample of density `bsdf_pdf`; `light_pdf` gives the
+/// density emitter sampling would have had for it.
+#[inline]
+fn emission_weight(
+    settings: &Settings,
+    depth: u32,
+    bsdf_pdf: f32,
+    light_pdf: impl FnOnce() -> f32,
+) -> f32 {
+    if depth == 0 {
+        return 1.0;
+    }
+    match settings.strategy {
+        Strategy::Bsdf => 1.0,
+        Strategy::Emitter => 0.0,
+        Strategy::Mis => settings.weight(bsdf_pdf, light_pdf()),
+    }
+}

@@ -1,0 +1,192 @@
+//! Triangle meshes from PLY (ASCII or binary, via `ply-rs-bw`) and Wavefront
+//! OBJ files (via `tobj`): positions, faces (polygons split into fans) and,
+//! when the file has them, vertex normals.
+
+use std::path::Path;
+
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{DefaultElement, Property};
+
+use crate::error::{Error, Result};
+
+/// The contents of a mesh file.
+#[derive(Clone, Debug, Default)]
+pub struct MeshData {
+    /// Vertex positions.
+    pub vertices: Vec<[f64; 3]>,
+    /// Triangles as vertex indices.
+    pub faces: Vec<[i64; 3]>,
+    /// One normal per vertex, if the file has them.
+    pub normals: Option<Vec<[f64; 3]>>,
+}
+
+fn io_error(path: &Path, message: impl Into<String>) -> Error {
+    Error::Io {
+        path: path.to_path_buf(),
+        message: message.into(),
+    }
+}
+
+/// Reads a `.ply` or `.obj` file (chosen by extension).
+///
+/// # Errors
+/// [`Error::Io`] for a file that cannot be read, is not a mesh of that
+/// format, or lacks positions or faces.
+pub fn read_mesh(path: &Path) -> Result<MeshData> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let mesh = match ext.as_deref() {
+        Some("ply") => read_ply(path)?,
+        Some("obj") => read_obj(path)?,
+        _ => return Err(io_error(path, "unknown mesh format: expected .ply or .obj")),
+    };
+    if mesh.vertices.is_empty() || mesh.faces.is_empty() {
+        return Err(io_error(path, "the mesh has no vertices or no faces"));
+    }
+    Ok(mesh)
+}
+
+fn scalar(e: &DefaultElement, key: &str) -> Option<f64> {
+    match e.get(key)? {
+        Property::Double(v) => Some(*v),
+        p => p.to_f32_lossy().map(f64::from),
+    }
+}
+
+fn list(p: &Property) -> Option<Vec<i64>> {
+    Some(match p {
+        Property::ListChar(v) => v.iter().map(|&x| i64::from(x)).collect(),
+        Property::ListUChar(v) => v.iter().map(|&x| i64::from(x)).collect(),
+        Property::ListShort(v) => v.iter().map(|&x| i64::from(x)).collect(),
+        Property::ListUShort(v) => v.iter().map(|&x| i64::from(x)).collect(),
+        Property::ListInt(v) => v.iter().map(|&x| i64::from(x)).collect(),
+        Property::ListUInt(v) => v.iter().map(|&x| i64::from(x)).collect(),
+        _ => return None,
+    })
+}
+
+/// Splits the polygon `poly` into the fan `(p0, p_k, p_k+1)`.
+fn fan(poly: &[i64], faces: &mut Vec<[i64; 3]>) {
+    for k in 1..poly.len().saturating_sub(1) {
+        faces.push([poly[0], poly[k], poly[k + 1]]);
+    }
+}
+
+fn read_ply(path: &Path) -> Result<MeshData> {
+    let file = std::fs::File::open(path).map_err(|e| io_error(path, e.to_string()))?;
+    let mut reader = std::io::BufReader::new(file);
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(&mut reader)
+        .map_err(|e| io_error(path, format!("not a readable PLY file: {e}")))?;
+    let verts = ply
+        .payload
+        .get("vertex")
+        .ok_or_else(|| io_error(path, "PLY file without a 'vertex' element"))?;
+    let mut vertices = Vec::with_capacity(verts.len());
+    let mut normals = Vec::with_capacity(verts.len());
+    for v in verts {
+        let p = ["x", "y", "z"].map(|k| scalar(v, k));
+        let [Some(x), Some(y), Some(z)] = p else {
+            return Err(io_error(path, "PLY vertices need x, y and z"));
+        };
+        vertices.push([x, y, z]);
+        if let [Some(a), Some(b), Some(c)] = ["nx", "ny", "nz"].map(|k| scalar(v, k)) {
+            normals.push([a, b, c]);
+        }
+    }
+    let mut faces = Vec::new();
+    for f in ply
+        .payload
+        .get("face")
+        .map(Vec::as_slice)
+        .unwrap_or_default()
+    {
+        let poly = f
+            .get("vertex_indices")
+            .or_else(|| f.get("vertex_index"))
+            .and_then(list)
+            .ok_or_else(|| io_error(path, "PLY faces need a 'vertex_indices' list"))?;
+        fan(&poly, &mut faces);
+    }
+    let normals = (normals.len() == vertices.len()).then_some(normals);
+    Ok(MeshData {
+        vertices,
+        faces,
+        normals,
+    })
+}
+
+fn read_obj(path: &Path) -> Result<MeshData> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let (models, _) = tobj::load_obj(path, &options)
+        .map_err(|e| io_error(path, format!("not a readable OBJ file: {e}")))?;
+    let mut mesh = MeshData::default();
+    let mut normals = Vec::new();
+    let mut all_have_normals = true;
+    for model in models {
+        let m = model.mesh;
+        let base = mesh.vertices.len() as i64;
+        mesh.vertices.extend(
+            m.positions
+                .chunks_exact(3)
+                .map(|p| [p[0], p[1], p[2]].map(f64::from)),
+        );
+        all_have_normals &= m.normals.len() == m.positions.len();
+        normals.extend(
+            m.normals
+                .chunks_exact(3)
+                .map(|p| [p[0], p[1], p[2]].map(f64::from)),
+        );
+        mesh.faces.extend(
+            m.indices
+                .chunks_exact(3)
+                .map(|f| [f[0], f[1], f[2]].map(|i| base + i64::from(i))),
+        );
+    }
+    mesh.normals = all_have_normals.then_some(normals);
+    Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ascii_ply_with_a_quad_and_normals() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("quad.ply");
+        std::fs::write(
+            &path,
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+             property float z\nproperty float nx\nproperty float ny\nproperty float nz\n\
+             element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+             0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n",
+        )
+        .unwrap();
+        let m = read_mesh(&path).unwrap();
+        assert_eq!(m.vertices.len(), 4);
+        assert_eq!(m.faces, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(m.normals.unwrap()[2], [0.0, 0.0, 1.0]);
+    }
+
+    #[test]
+    fn obj_triangle_and_bad_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.obj");
+        std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        let m = read_mesh(&path).unwrap();
+        assert_eq!(m.faces, vec![[0, 1, 2]]);
+        assert!(m.normals.is_none());
+        let bad = dir.path().join("bad.ply");
+        std::fs::write(&bad, "not a ply").unwrap();
+        assert!(matches!(read_mesh(&bad), Err(Error::Io { .. })));
+        assert!(read_mesh(&dir.path().join("missing.obj")).is_err());
+        assert!(read_mesh(&dir.path().join("x.stl")).is_err());
+    }
+}

@@ -1,0 +1,530 @@
+//! A scene: shapes with their materials and emission, an optional
+//! environment, the camera and the film size; and its lights, chosen by
+//! power for emitter sampling.
+
+use glam::{DVec3, Vec3A};
+
+use super::accel::{Accel, Primitive};
+use super::camera::Camera;
+use super::shape::{Disk, Sphere, SurfacePoint, Triangle};
+use crate::distr::Discrete1D;
+use crate::envmap::EnvMap;
+use crate::error::{Error, Result};
+use crate::math::luminance;
+use crate::phong::Phong;
+use crate::warp;
+
+/// A surface's BSDF: the Phong BRDF (a diffuse material is Phong with
+/// `ρs = 0`), reflecting on the front side only unless `two_sided`, as in
+/// Mitsuba (seen from the back, a one-sided material is black).
+#[derive(Clone, Copy, Debug)]
+pub struct Material {
+    /// The BRDF.
+    pub bsdf: Phong,
+    /// Whether the back side reflects like the front.
+    pub two_sided: bool,
+}
+
+/// The geometry of one shape.
+#[derive(Clone, Debug)]
+pub enum Geometry {
+    /// A triangle mesh (world space).
+    Mesh(Vec<Triangle>),
+    /// A sphere.
+    Sphere(Sphere),
+    /// A disk.
+    Disk(Disk),
+}
+
+/// A shape: geometry, material and, for an area light, its radiance (RGB,
+/// emitted from the front side only, constant over the surface).
+#[derive(Clone, Debug)]
+pub struct Shape {
+    /// Where it is.
+    pub geometry: Geometry,
+    /// How it reflects.
+    pub material: Material,
+    /// Emitted radiance, for an area light.
+    pub emission: Option<[f64; 3]>,
+}
+
+/// Light from infinitely far away.
+#[derive(Clone, Debug)]
+pub enum Environment {
+    /// An environment map (sampled by its own importance sampling).
+    Map(Box<EnvMap>),
+    /// The same radiance from every direction (sampled uniformly on the
+    /// sphere, pdf `1/(4π)`).
+    Constant([f64; 3]),
+}
+
+impl Environment {
+    /// Radiance arriving from world direction `d`.
+    #[inline]
+    pub fn eval(&self, d: Vec3A) -> [f32; 3] {
+        match self {
+            Environment::Map(env) => env.eval(d.as_dvec3().to_array()).map(|v| v as f32),
+            Environment::Constant(l) => l.map(|v| v as f32),
+        }
+    }
+
+    /// Density of [`Environment::sample`] at `d`, per steradian.
+    #[inline]
+    pub fn pdf(&self, d: Vec3A) -> f32 {
+        match self {
+            Environment::Map(env) => env.pdf(d.as_dvec3().to_array()) as f32,
+            Environment::Constant(_) => 0.25 * std::f32::consts::FRAC_1_PI,
+        }
+    }
+
+    /// A direction, its density per steradian and its radiance.
+    #[inline]
+    pub fn sample(&self, u: [f32; 2]) -> (Vec3A, f32, [f32; 3]) {
+        match self {
+            Environment::Map(env) => {
+                let s = env.sample(u.map(f64::from));
+                let l = s.weight.map(|w| (w * s.pdf) as f32);
+                (
+                    Vec3A::from(DVec3::from(s.direction).as_vec3()),
+                    s.pdf as f32,
+                    l,
+                )
+            }
+            Environment::Constant(l) => {
+                let d = warp::square_to_uniform_sphere(u);
+                (Vec3A::from(d), self.pdf(Vec3A::Z), l.map(|v| v as f32))
+            }
+        }
+    }
+
+    /// `∫ Y(L(ω)) dω` over the sphere, by the midpoint rule on a 256 × 128
+    /// grid in (φ, cos θ) (for choosing among lights; it need not be exact).
+    fn luminance_integral(&self) -> f64 {
+        let (nx, ny) = (256, 128);
+        let mut sum = 0.0;
+        for j in 0..ny {
+            let z = 1.0 - 2.0 * (j as f64 + 0.5) / ny as f64;
+            let r = (1.0 - z * z).sqrt();
+            for i in 0..nx {
+                let phi = 2.0 * std::f64::consts::PI * (i as f64 + 0.5) / nx as f64;
+                let d = Vec3A::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32);
+                sum += luminance(self.eval(d).map(f64::from));
+            }
+        }
+        sum * 4.0 * std::f64::consts::PI / (nx * ny) as f64
+    }
+}
+
+/// Something emitter sampling can draw a direction toward.
+#[derive(Clone, Debug)]
+enum Light {
+    /// The emitting shape `shape`, whose primitives are
+    /// `primitives[first..first + areas.len()]`, one chosen by area.
+    Area {
+        first: u32,
+        areas: Option<Discrete1D>,
+        total_area: f32,
+        radiance: [f32; 3],
+    },
+    Environment,
+}
+
+/// A direction toward a light, from emitter sampling.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the shading point toward the light.
+    pub d: Vec3A,
+    /// Distance to the light point (infinite for the environment).
+    pub dist: f32,
+    /// Density per steradian, including the choice of the light.
+    pub pdf: f32,
+    /// Radiance arriving along `d` (before the visibility test).
+    pub radiance: [f32; 3],
+}
+
+/// A scene ready to render.
+pub struct Scene {
+    accel: Accel,
+    materials: Vec<Material>,
+    emission: Vec<Option<[f32; 3]>>,
+    light_of_shape: Vec<Option<u32>>,
+    environment: Option<Environment>,
+    env_light: Option<u32>,
+    lights: Vec<Light>,
+    light_choice: Option<Discrete1D>,
+    camera: Camera,
+    width: usize,
+    height: usize,
+}
+
+impl Scene {
+    /// Builds the BVH and the light selection (by power: `π A Y(L)` for an
+    /// area light, `π R² ∫ Y(L) dω` for the environment, R the radius of the
+    /// scene's bounding sphere).
+    ///
+    /// # Errors
+    /// [`Error::Parameter`] for a film of zero pixels.
+    pub fn new(
+        shapes: Vec<Shape>,
+        environment: Option<Environment>,
+        camera: Camera,
+        width: usize,
+        height: usize,
+    ) -> Result<Self> {
+        if width == 0 || height == 0 {
+            return Err(Error::Parameter {
+                arg: "film",
+                value: (width * height) as f64,
+                requirement: "width and height must be >= 1",
+            });
+        }
+        let mut primitives = Vec::new();
+        let mut materials = Vec::with_capacity(shapes.len());
+        let mut emission = Vec::with_capacity(shapes.len());
+        let mut light_of_shape = Vec::with_capacity(shapes.len());
+        let mut lights = Vec::new();
+        let mut powers = Vec::new();
+        for (index, shape) in shapes.into_iter().enumerate() {
+            let id = index as u32;
+            let first = primitives.len() as u32;
+            let areas: Vec<f64> = match shape.geometry {
+                Geometry::Mesh(tris) => {
+                    let areas = tris.iter().map(|t| f64::from(t.area())).collect();
+                    primitives.extend(tris.into_iter().map(|t| (Primitive::Triangle(t), id)));
+                    areas
+                }
+                Geometry::Sphere(s) => {
+                    primitives.push((Primitive::Sphere(s), id));
+                    vec![s.area()]
+                }
+                Geometry::Disk(d) => {
+                    primitives.push((Primitive::Disk(d), id));
+                    vec![f64::from(d.area)]
+                }
+            };
+            materials.push(shape.material);
+            let radiance = shape.emission.map(|l| l.map(|v| v as f32));
+            emission.push(radiance);
+            let total: f64 = areas.iter().sum();
+            let power = shape
+                .emission
+                .map_or(0.0, |l| std::f64::consts::PI * total * luminance(l));
+            if power > 0.0 {
+                light_of_shape.push(Some(lights.len() as u32));
+                lights.push(Light::Area {
+                    first,
+                    areas: (areas.len() > 1)
+                        .then(|| Discrete1D::new(&areas))
+                        .transpose()?,
+                    total_area: total as f32,
+                    radiance: radiance.unwrap_or_default(),
+                });
+                powers.push(power);
+            } else {
+                light_of_shape.push(None);
+            }
+        }
+        let accel = Accel::new(primitives);
+        let radius = accel
+            .bounds()
+            .map_or(1.0, |(lo, hi)| 0.5 * f64::from((hi - lo).length()));
+        let mut env_light = None;
+        if let Some(env) = &environment {
+            let power = std::f64::consts::PI * radius * radius * env.luminance_integral();
+            if power > 0.0 {
+                env_light = Some(lights.len() as u32);
+                lights.push(Light::Environment);
+                powers.push(power);
+            }
+        }
+        let light_choice = (!powers.is_empty())
+            .then(|| Discrete1D::new(&powers))
+            .transpose()?;
+        Ok(Scene {
+            accel,
+            materials,
+            emission,
+            light_of_shape,
+            environment,
+            env_light,
+            lights,
+            light_choice,
+            camera,
+            width,
+            height,
+        })
+    }
+
+    /// The film size `(width, height)` in pixels.
+    pub fn film(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// The camera.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The ray tracer.
+    pub fn accel(&self) -> &Accel {
+        &self.accel
+    }
+
+    /// The material of shape `shape`.
+    #[inline]
+    pub fn material(&self, shape: u32) -> &Material {
+        &self.materials[shape as usize]
+    }
+
+    /// The environment, if any.
+    pub fn environment(&self) -> Option<&Environment> {
+        self.environment.as_ref()
+    }
+
+    /// Radiance emitted by shape `shape` at a point with geometric normal
+    /// `ng` toward `w` (unit, away from the surface): its radiance on the
+    /// front side, 0 behind it or for a shape that does not emit.
+    #[inline]
+    pub fn emitted(&self, shape: u32, ng: Vec3A, w: Vec3A) -> Option<[f32; 3]> {
+        self.emission[shape as usize].filter(|_| ng.dot(w) > 0.0)
+    }
+
+    fn choice_pmf(&self, light: Option<u32>) -> f32 {
+        match (light, &self.light_choice) {
+            (Some(l), Some(choice)) => choice.pmf(l as usize) as f32,
+            _ => 0.0,
+        }
+    }
+
+    /// Density per steradian with which emitter sampling from a shading point
+    /// draws the direction that reaches shape `shape` at distance `dist`,
+    /// where its geometric normal is `ng` and the direction is `d`.
+    #[inline]
+    pub fn area_pdf(&self, shape: u32, ng: Vec3A, d: Vec3A, dist: f32) -> f32 {
+        let light = self.light_of_shape[shape as usize];
+        let Some(Light::Area { total_area, .. }) = light.map(|l| &self.lights[l as usize]) else {
+            return 0.0;
+        };
+        let cos = ng.dot(d).abs();
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        self.choice_pmf(light) * dist * dist / (cos * total_area)
+    }
+
+    /// Density per steradian with which emitter sampling draws the
+    /// environment direction `d`.
+    #[inline]
+    pub fn environment_pdf(&self, d: Vec3A) -> f32 {
+        match &self.environment {
+            Some(env) => self.choice_pmf(self.env_light) * env.pdf(d),
+            None => 0.0,
+        }
+    }
+
+    /// Emitter sampling from the shading point `x`: a light chosen by power
+    /// (`u[0]`), then a point on it uniformly by area or an environment
+    /// direction by the environment's own sampling (`u[1..3]`). `None` when
+    /// the scene has no light or the sample carries no radiance.
+    #[inline]
+    pub fn sample_light(&self, x: Vec3A, u: [f32; 3]) -> Option<LightSample> {
+        let choice = self.light_choice.as_ref()?;
+        let index = choice.sample(u[0]);
+        let pmf = choice.pmf(index) as f32;
+        match &self.lights[index] {
+            Light::Environment => {
+                let env = self.environment.as_ref()?;
+                let (d, pdf, radiance) = env.sample([u[1], u[2]]);
+                (pdf > 0.0).then_some(LightSample {
+                    d,
+                    dist: f32::INFINITY,
+                    pdf: pdf * pmf,
+                    radiance,
+                })
+            }
+            Light::Area {
+                first,
+                areas,
+                total_area,
+                radiance,
+            } => {
+                let (k, u1) = match areas {
+                    Some(a) => a.sample_reuse(u[1]),
+                    None => (0, u[1]),
+                };
+                let primitive = &self.accel.primitives()[*first as usize + k];
+                let y: SurfacePoint = match primitive {
+                    Primitive::Triangle(t) => t.sample([u1, u[2]]),
+                    Primitive::Sphere(s) => s.sample([u1, u[2]]),
+                    Primitive::Disk(d) => d.sample([u1, u[2]]),
+                };
+                let to_light = y.p - x;
+                let dist = to_light.length();
+                if dist <= 0.0 {
+                    return None;
+                }
+                let d = to_light / dist;
+                let cos = -y.ng.dot(d);
+                (cos > 0.0).then(|| LightSample {
+                    d,
+                    dist,
+                    pdf: pmf * dist * dist / (cos * total_area),
+                    radiance: *radiance,
+                })
+            }
+        }
+    }
+}
+
+fn finite_rows<const K: usize>(arg: &'static str, rows: &[[f64; K]]) -> Result<()> {
+    for (i, row) in rows.iter().enumerate() {
+        if let Some(k) = row.iter().position(|v| !v.is_finite()) {
+            return Err(Error::Element {
+                arg,
+                index: format!("[{i}, {k}]"),
+                value: row[k],
+                requirement: "must be finite".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Angle-weighted vertex normals (Thürmer and Wüthrich): each face adds its
+/// unit normal times its corner angle at the vertex.
+fn vertex_normals(vertices: &[Vec3A], faces: &[[usize; 3]]) -> Vec<Vec3A> {
+    let mut normals = vec![Vec3A::ZERO; vertices.len()];
+    for f in faces {
+        let p = f.map(|i| vertices[i]);
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+        for k in 0..3 {
+            let a = (p[(k + 1) % 3] - p[k]).normalize_or_zero();
+            let b = (p[(k + 2) % 3] - p[k]).normalize_or_zero();
+            let angle = a.dot(b).clamp(-1.0, 1.0).acos();
+            normals[f[k]] += n * angle;
+        }
+    }
+    normals.iter().map(|n| n.normalize_or_zero()).collect()
+}
+
+impl Geometry {
+    /// A triangle mesh of `vertices` (world space) and `faces` (vertex
+    /// indices, counter-clockwise seen from the front). Shading normals:
+    /// `normals` when given (one per vertex), else angle-weighted vertex
+    /// normals unless `face_normals`, as Mitsuba's meshes.
+    ///
+    /// # Errors
+    /// [`Error::Element`] for a coordinate or normal that is not finite,
+    /// [`Error::Index`] for a face index out of range, [`Error::Shape`] for
+    /// normals not one per vertex.
+    pub fn mesh(
+        vertices: &[[f64; 3]],
+        faces: &[[i64; 3]],
+        normals: Option<&[[f64; 3]]>,
+        face_normals: bool,
+    ) -> Result<Self> {
+        finite_rows("vertices", vertices)?;
+        let nv = vertices.len();
+        let mut idx = Vec::with_capacity(faces.len());
+        for (i, f) in faces.iter().enumerate() {
+            if let Some(k) = f.iter().position(|&v| v < 0 || v as usize >= nv) {
+                return Err(Error::Index {
+                    arg: "faces",
+                    index: format!("[{i}, {k}]"),
+                    value: f[k],
+                    len: nv,
+                });
+            }
+            idx.push(f.map(|v| v as usize));
+        }
+        let points: Vec<Vec3A> = vertices
+            .iter()
+            .map(|v| Vec3A::from(DVec3::from(*v).as_vec3()))
+            .collect();
+        let shading: Option<Vec<Vec3A>> = match (normals, face_normals) {
+            (_, true) => None,
+            (Some(n), false) => {
+                finite_rows("normals", n)?;
+                if n.len() != nv {
+                    return Err(Error::Shape {
+                        arg: "normals",
+                        expected: format!("({nv}, 3), one per vertex"),
+                        got: format!("({}, 3)", n.len()),
+                    });
+                }
+                Some(
+                    n.iter()
+                        .map(|v| Vec3A::from(DVec3::from(*v).as_vec3()).normalize_or_zero())
+                        .collect(),
+                )
+            }
+            (None, false) => Some(vertex_normals(&points, &idx)),
+        };
+        let tris = idx
+            .iter()
+            .map(|f| {
+                let p = f.map(|i| points[i]);
+                Triangle {
+                    p0: p[0],
+                    e1: p[1] - p[0],
+                    e2: p[2] - p[0],
+                    normals: shading.as_ref().map(|n| f.map(|i| n[i])),
+                }
+            })
+            // Degenerate triangles are never hit and have no area to sample.
+            .filter(|t| t.area() > 0.0)
+            .collect();
+        Ok(Geometry::Mesh(tris))
+    }
+
+    /// A sphere of `radius > 0` around `center`; normals inward if `flip`.
+    ///
+    /// # Errors
+    /// [`Error::Parameter`] for a radius that is not finite and > 0,
+    /// [`Error::Element`] for a centre that is not finite.
+    pub fn sphere(center: [f64; 3], radius: f64, flip: bool) -> Result<Self> {
+        finite_rows("center", &[center])?;
+        if !(radius > 0.0 && radius.is_finite()) {
+            return Err(Error::Parameter {
+                arg: "radius",
+                value: radius,
+                requirement: "must be finite and > 0",
+            });
+        }
+        Ok(Geometry::Sphere(Sphere {
+            center: DVec3::from(center),
+            radius,
+            flip,
+        }))
+    }
+
+    /// Mitsuba's `disk`: the unit disk in the plane z = 0 (normal +z) placed
+    /// by the affine `to_world` (row-major 4×4; the last row is ignored).
+    ///
+    /// # Errors
+    /// [`Error::Element`] for a matrix entry that is not finite,
+    /// [`Error::Parameter`] for a matrix that flattens the disk.
+    pub fn disk(to_world: [[f64; 4]; 4]) -> Result<Self> {
+        let m = affine("to_world", to_world)?;
+        Disk::new(m).map(Geometry::Disk).ok_or(Error::Parameter {
+            arg: "to_world",
+            value: 0.0,
+            requirement: "must not flatten the disk (its determinant is 0)",
+        })
+    }
+}
+
+/// The affine map of a row-major 4×4 matrix (its last row ignored).
+///
+/// # Errors
+/// [`Error::Element`] for an entry that is not finite.
+pub fn affine(arg: &'static str, m: [[f64; 4]; 4]) -> Result<glam::Affine3A> {
+    finite_rows(arg, &m)?;
+    let col = |c: usize| glam::Vec3::new(m[0][c] as f32, m[1][c] as f32, m[2][c] as f32);
+    Ok(glam::Affine3A::from_cols(
+        col(0).into(),
+        col(1).into(),
+        col(2).into(),
+        col(3).into(),
+    ))
+}

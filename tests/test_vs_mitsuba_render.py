@@ -1,0 +1,137 @@
+"""One scene, rendered by mcsample and by Mitsuba 3: statistically the same
+image. Each side reports per-pixel means and the variance of each pixel's
+mean luminance (Mitsuba through its ``moment`` integrator), so the per-pixel
+z-scores must behave as N(0, 1) (stats.image_ztest: mean near 0, variance in
+[0.7, 1.4], at most a handful of |z| > 5, whole-image means within 3 SE)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import mcsample as mcs
+from mcsample import stats
+from scenes import (diffuse_sphere_under_sky, ground, icosphere, mesh_scene, phong_spheres,
+                    sensor, sphere_on_plane, sunless_sky)
+
+pytestmark = pytest.mark.mitsuba
+
+SPP = 256
+
+
+#: Pixels whose relative standard error is below this on both sides (the
+#: directly seen sky, smooth over a pixel) are deterministic up to float32
+#: rounding, which dominates Mitsuba's E[Y²] − E[Y]² there: they are compared
+#: to a relative tolerance instead of entering the z-test.
+EXACT = 1e-4
+
+
+def _ztest(ours, ref):
+    a, b = ours.luminance, ref.luminance
+    va, vb = ours.luminance_variance, ref.luminance_variance
+    scale = np.maximum(np.abs(b), 1e-6)
+    noisy = (np.sqrt(va) > EXACT * scale) | (np.sqrt(vb) > EXACT * scale)
+    t = stats.image_ztest(a[noisy], va[noisy], b[noisy], vb[noisy])
+    exact_ok = np.allclose(a[~noisy], b[~noisy], rtol=1e-3, atol=1e-6)
+    if not exact_ok:
+        t.passed = False
+        t.messages.append("FAILED: noise-free pixels differ by more than 1e-3")
+    return t
+
+
+def _compare(mi, d, integrator="path", strategy="mis", ref_scene=None, spp=SPP, seed=1):
+    scene = mcs.Scene.from_mitsuba(d)
+    ours = mcs.render(scene, spp, integrator=integrator, strategy=strategy, seed=seed,
+                      progress=False)
+    ref_scene = ref_scene if ref_scene is not None else scene
+    ref = mcs.mitsuba.render_reference(ref_scene, spp, seed=seed + 100, integrator=integrator)
+    return _ztest(ours, ref), ours, ref
+
+
+def _angular_sky():
+    return mcs.EnvMap().convert("angular", 256)
+
+
+def _scene_dicts(tmp_path):
+    v, f = icosphere(3)
+    path = tmp_path / "blob.ply"
+    mcs.scene.write_ply(str(path), v * [0.6, 0.45, 0.6] + [0, 0.45, 0], f)
+    return {
+        "diffuse sphere, default sky": diffuse_sphere_under_sky(),
+        "phong spheres n = 1..1000, sky with sun": phong_spheres(),
+        "sphere on plane, sky + area light": sphere_on_plane(),
+        "triangle mesh from PLY": mesh_scene(path),
+        # The camera looks down on the floor: the sky is not seen directly,
+        # where the resampling to lat-long for Mitsuba would show as a
+        # (deterministic) difference.
+        "angular sky": dict(sphere_on_plane(_angular_sky()), floor=ground(size=30.0),
+                            sensor=sensor(origin=(0, 4.0, 3.0), target=(0, 0.3, 0))),
+    }
+
+
+@pytest.mark.parametrize("name", ["diffuse sphere, default sky",
+                                  "phong spheres n = 1..1000, sky with sun",
+                                  "sphere on plane, sky + area light",
+                                  "triangle mesh from PLY", "angular sky"])
+@pytest.mark.parametrize("integrator", ["direct", "path"])
+def test_mis_render_equals_mitsubas(mi, tmp_path, name, integrator):
+    t, ours, ref = _compare(mi, _scene_dicts(tmp_path)[name], integrator=integrator)
+    print(f"{name} ({integrator}): {t.message}")
+    assert t.passed, t.message
+    assert ours.luminance.mean() > 0.05
+
+
+@pytest.mark.parametrize("strategy", ["bsdf", "emitter", "mis"])
+@pytest.mark.parametrize("integrator", ["direct", "path"])
+def test_every_strategy_converges_to_mitsubas_image(mi, strategy, integrator):
+    """Sphere on a plane under the sunless sky and a large area light (the
+    sun makes BSDF sampling heavy-tailed at any affordable spp, which is
+    what MIS is for: see the relMSE test)."""
+    t, _, _ = _compare(mi, sphere_on_plane(sunless_sky()), integrator=integrator,
+                       strategy=strategy, spp=512)
+    assert t.passed, t.message
+
+
+def test_a_wrong_envmap_fails_the_test(mi):
+    """By construction: mcsample renders with the sky flipped upside down,
+    shifted by one texel, or with its emitter-sampling pdf off by 5%
+    (emitter sampling only, where that pdf divides every sample: the image
+    scales by 1/1.05); each must fail against Mitsuba's render of the true
+    sky, while the true sky passes."""
+    image = mcs.EnvMap().convert("latlong", (32, 64)).image  # coarse: one texel = 5.6°
+    true = mcs.EnvMap(image)
+    # A close-up: the sphere fills the frame, so every pixel is lit only
+    # through emitter sampling, and the 5% pdf error scales all of them.
+    d = dict(diffuse_sphere_under_sky(true),
+             sensor=sensor(origin=(0, 0.6, 1.5), target=(0, 0.6, 0), fov=30))
+    ref = mcs.mitsuba.render_reference(mcs.Scene.from_mitsuba(d), SPP, seed=7,
+                                       integrator="direct")
+
+    def ours(env, strategy="mis", scale=1.0):
+        r = mcs.render(mcs.Scene.from_mitsuba(dict(d, sky=env)), SPP, integrator="direct",
+                       strategy=strategy, seed=3, progress=False)
+        r.image = r.image / scale
+        r.luminance_variance = r.luminance_variance / scale ** 2
+        return _ztest(r, ref)
+
+    assert ours(true).passed
+    assert ours(true, "emitter").passed
+    assert not ours(mcs.EnvMap(image[::-1].copy())).passed
+    assert not ours(mcs.EnvMap(np.roll(image, 1, axis=1))).passed
+    assert not ours(true, "emitter", scale=1.05).passed
+
+
+def test_mis_beats_each_strategy_on_glossy_spheres_under_the_sun(mi):
+    """relMSE at equal spp against a high-spp MIS reference: MIS is lower
+    than BSDF sampling and than emitter sampling (printed)."""
+    scene = mcs.Scene.from_mitsuba(phong_spheres())
+    reference = mcs.render(scene, 4096, integrator="direct", strategy="mis", seed=99,
+                           progress=False).image
+    errors = {}
+    for strategy in ("bsdf", "emitter", "mis"):
+        img = mcs.render(scene, 64, integrator="direct", strategy=strategy, seed=5,
+                         progress=False).image
+        errors[strategy] = stats.relmse(img, reference)
+    print("relMSE at 64 spp:", {k: f"{v:.4g}" for k, v in errors.items()})
+    assert errors["mis"] < errors["bsdf"]
+    assert errors["mis"] < errors["emitter"]
