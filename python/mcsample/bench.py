@@ -340,12 +340,63 @@ def suite_envmap(n: int, repeat: int, mi) -> list[Timing]:
     return out
 
 
+def _render_scenes(size: int = 256) -> dict[str, dict]:
+    """The issue's two speed scenes: a diffuse sphere under the packaged sky,
+    and a sphere on a plane lit by the sky and a rectangular area light."""
+    sensor = {"type": "perspective", "fov": 35,
+              "to_world": mcs.look_at([0, 1.2, 4.5], [0, 0.6, 0], [0, 1, 0]),
+              "film": {"type": "hdrfilm", "width": size, "height": size,
+                       "rfilter": {"type": "box"}}}
+    ball = {"type": "sphere", "center": [0, 0.6, 0], "radius": 0.6,
+            "bsdf": {"type": "diffuse", "reflectance": [0.7, 0.6, 0.5]}}
+    floor = {"type": "rectangle", "bsdf": {"type": "diffuse", "reflectance": 0.5},
+             "to_world": np.array([[4.0, 0, 0, 0], [0, 0, 4.0, 0], [0, -4.0, 0, 0], [0, 0, 0, 1]])}
+    light = {"type": "rectangle", "emitter": {"type": "area", "radiance": [12.0, 11.0, 9.0]},
+             "to_world": np.array([[0.4, 0, 0, 1.0], [0, 0, 1, 2.0], [0, -0.4, 0, 0.8],
+                                   [0, 0, 0, 1]])}
+    sky = mcs.EnvMap()
+    return {
+        "sphere under sky": {"type": "scene", "sensor": sensor, "sky": sky, "ball": ball},
+        "sphere on plane": {"type": "scene", "sensor": sensor, "sky": sky, "ball": ball,
+                            "floor": floor, "light": light},
+    }
+
+
+def suite_render(n: int, repeat: int, mi, spp: int = 64) -> list[Timing]:
+    """Samples (camera paths) per second at 256 x 256, 64 spp, MIS, direct and
+    path; Mitsuba's time excludes its JIT compilation (warm-up renders)."""
+    out = []
+    repeat = min(repeat, 3)
+    for name, d in _render_scenes().items():
+        scene = mcs.Scene.from_mitsuba(d)
+        w, h = scene.size
+        samples = w * h * spp
+        mi_scene = None
+        if mi is not None:
+            mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp))
+        for integrator in ("direct", "path"):
+            case = f"render {name}, {integrator}"
+            out.append(Timing(case, "mcsample", "float32", samples, measure(
+                lambda: mcs.render(scene, spp, integrator=integrator, progress=False),
+                repeat, 1)))
+            if mi_scene is not None:
+                mi_int = mi.load_dict({"type": integrator})
+
+                def run_mitsuba():
+                    img = mi.render(mi_scene, integrator=mi_int, spp=spp)
+                    np.asarray(img)
+                out.append(Timing(case, "mitsuba llvm_ad_rgb", "float32", samples,
+                                  measure(run_mitsuba, repeat, 2)))
+    return out
+
+
 SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
     "rng": suite_rng,
     "warps": suite_warps,
     "distr": suite_distr,
     "phong": suite_phong,
     "envmap": suite_envmap,
+    "render": suite_render,
 }
 
 
