@@ -322,14 +322,15 @@ pub fn reflected_radiance(
         other => other,
     })?;
     let frame = Frame::from_normal(normal);
-    let wi = frame.to_local(wi);
+    // The BRDF seen from wi, built once for all n samples.
+    let view = phong.view(frame.to_local(wi));
     // f_r · cos⁺θ of a world direction, and the BRDF's sampling density.
     let reflect = |d: V3<f64>| {
         let wo = frame.to_local(d);
-        scaled(phong.eval(wi, wo), wo[2].max(0.0))
+        scaled(view.eval(wo), wo[2].max(0.0))
     };
     let bsdf_sample = |rng: &mut Rng| {
-        let s = phong.sample(wi, [rng.next_float(), rng.next_float(), rng.next_float()]);
+        let s = view.sample([rng.next_float(), rng.next_float(), rng.next_float()]);
         (frame.to_world(s.wo), s)
     };
     let times = |a: V3<f64>, b: V3<f64>| [a[0] * b[0], a[1] * b[1], a[2] * b[2]];
@@ -347,7 +348,7 @@ pub fn reflected_radiance(
             let w = heuristic.weight(b.pdf, env.pdf(d));
             let from_bsdf = scaled(times(b.weight, env.eval(d)), w);
             let s = env.sample(next2(rng));
-            let w = heuristic.weight(s.pdf, phong.pdf(wi, frame.to_local(s.direction)));
+            let w = heuristic.weight(s.pdf, view.pdf(frame.to_local(s.direction)));
             add(from_bsdf, scaled(times(s.weight, reflect(s.direction)), w))
         }),
         Strategy::Uniform | Strategy::Cosine => Err(unsupported(strategy, "bsdf, envmap, mis")),

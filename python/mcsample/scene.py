@@ -293,7 +293,7 @@ def _shape(d: Mapping[str, Any], key: str, refs: Mapping[str, Material]) -> Shap
         try:
             v = np.asarray(d["vertices"], dtype=np.float64)
             f = np.asarray(d["faces"])
-        except KeyError as e:
+        except KeyError:
             raise ValueError(f"{key}: a mesh needs 'vertices' and 'faces'") from None
         if v.ndim != 2 or v.shape[1] != 3 or f.ndim != 2 or f.shape[1] != 3:
             raise ValueError(f"{key}: vertices must be (N, 3) and faces (M, 3), "
@@ -434,7 +434,7 @@ class Scene:
         """The Rust scene (BVH and light selection), built on first use."""
         if self._compiled is None:
             b = SceneBuilder()
-            for i, s in enumerate(self.shapes):
+            for s in self.shapes:
                 bsdf, two = s.material.phong(), s.material.two_sided
                 if s.kind == "sphere":
                     b.add_sphere(s.center, s.radius, s.flip_normals, bsdf, two, s.emission)
