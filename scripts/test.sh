@@ -23,5 +23,6 @@ cargo test --quiet
 python -m mypy.stubtest mcsample._core --allowlist scripts/stubtest-allowlist.txt
 
 # Run pytest from outside the source tree so it imports the installed
-# package, not python/mcsample without its compiled core.
-cd tests && python -m pytest -q -p no:cacheprovider "$@"
+# package, not python/mcsample without its compiled core. --nbmake also
+# executes every notebook top to bottom and fails on any error.
+cd tests && python -m pytest -q -p no:cacheprovider --nbmake . ../notebooks "$@"

@@ -143,3 +143,24 @@ def test_image_ztest_accepts_agreement_and_rejects_bias(rng):
     assert not biased.passed and "3 SE" in biased.message
     shifted = np.roll(b, 1, axis=1)
     assert not stats.image_ztest(a, var, shifted, var).passed
+
+
+class _Render:
+    def __init__(self, luminance, variance):
+        self.luminance, self.luminance_variance = luminance, variance
+
+
+def test_render_ztest_compares_noise_free_pixels_by_tolerance(rng):
+    truth = rng.random((32, 32)) + 0.5
+    var = np.full(truth.shape, 1e-4)
+    var[:8] = 0.0                         # a noise-free band (seen sky)
+    a = truth + rng.normal(0, 1e-2, truth.shape) * (var > 0)
+    b = truth + rng.normal(0, 1e-2, truth.shape) * (var > 0)
+    b[:8] *= 1 + 1e-5                     # float32 rounding there
+    t = stats.render_ztest(_Render(a, var), _Render(b, var))
+    assert t.passed, t.message
+    assert t.z.shape == truth.shape and np.all(t.z[:8] == 0)
+    assert 0.8 < t.variance < 1.2         # the noise-free band does not deflate it
+    b[:8] *= 1.01
+    t = stats.render_ztest(_Render(a, var), _Render(b, var))
+    assert not t.passed and "noise-free" in t.message

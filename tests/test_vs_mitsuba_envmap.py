@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import mcsample as mcs
+from mcsample import mitsuba as mcs_mitsuba
 from mcsample import stats
 
 pytestmark = pytest.mark.mitsuba
@@ -40,11 +41,12 @@ def maps(mi):
             "sunsky": np.ascontiguousarray(baked, dtype=np.float32)}
 
 
-def _emitter(mi, image, to_world=None, scale=1.0, compensate=False):
-    d = {"type": "envmap", "bitmap": mi.Bitmap(image), "scale": scale,
-         "mis_compensation": compensate}
+def _emitter(image, to_world=None, scale=1.0, compensate=False):
+    import mitsuba as mi
+
+    d = mcs_mitsuba.envmap_dict(mcs.EnvMap(image, scale=scale, compensate=compensate))
     if to_world is not None:
-        d["to_world"] = to_world
+        d["to_world"] = to_world  # Mitsuba's own transform, as the user gave it
     return mi.load_dict(d)
 
 
@@ -57,29 +59,6 @@ def _directions(n=20000, seed=3):
 def _llvm(mi):
     if mi.variant().startswith("scalar"):
         pytest.skip("needs the llvm variant for vectorised batches")
-
-
-def _mi_eval(mi, emitter, d):
-    import drjit as dr
-    si = dr.zeros(mi.SurfaceInteraction3f, len(d))
-    si.wi = mi.Vector3f(-d.T)
-    return np.array(emitter.eval(si), dtype=np.float64).T
-
-
-def _mi_pdf(mi, emitter, d):
-    import drjit as dr
-    it = dr.zeros(mi.Interaction3f, len(d))
-    ds = dr.zeros(mi.DirectionSample3f, len(d))
-    ds.d = mi.Vector3f(d.T)
-    return np.array(emitter.pdf_direction(it, ds), dtype=np.float64)
-
-
-def _mi_sample(mi, emitter, u):
-    import drjit as dr
-    it = dr.zeros(mi.Interaction3f, len(u))
-    ds, weight = emitter.sample_direction(it, mi.Point2f(u.T.astype(np.float32)))
-    return (np.array(ds.d, dtype=np.float64).T, np.array(ds.pdf, dtype=np.float64),
-            np.array(weight, dtype=np.float64).T, np.array(ds.uv, dtype=np.float64).T)
 
 
 def _float32_close(ours, theirs, what):
@@ -102,7 +81,8 @@ def test_eval_equals_mitsubas(mi, maps, name, rotated):
     image = maps[name]
     d = _directions()
     ours = mcs.EnvMap(image, to_world=to_world, scale=scale)
-    _float32_close(ours.eval(d), _mi_eval(mi, _emitter(mi, image, to_world, scale), d), "eval")
+    theirs = mcs_mitsuba.emitter_eval(_emitter(image, to_world, scale), d)
+    _float32_close(ours.eval(d), theirs, "eval")
 
 
 @pytest.mark.parametrize("name", ["sky", "one-hot", "sunsky"])
@@ -112,19 +92,19 @@ def test_pdf_in_mitsuba_mode_equals_mitsubas(mi, maps, name, compensate):
     to_world = mi.ScalarTransform4f().rotate(list(ROTATION_AXIS), 40)
     image = maps[name]
     ours = mcs.EnvMap(image, to_world=to_world, sampling="mitsuba", compensate=compensate)
-    emitter = _emitter(mi, image, to_world, compensate=compensate)
+    emitter = _emitter(image, to_world, compensate=compensate)
     d = _directions()
     # Directions where Mitsuba's density is positive, plus its own samples.
     u = mcs.uniform(20000, 2, seed=11)
-    d = np.concatenate([d, _mi_sample(mi, emitter, u)[0]])
-    _float32_close(ours.pdf(d), _mi_pdf(mi, emitter, d), "pdf")
+    d = np.concatenate([d, mcs_mitsuba.emitter_sample(emitter, u)[0]])
+    _float32_close(ours.pdf(d), mcs_mitsuba.emitter_pdf(emitter, d), "pdf")
 
 
 def test_uv_of_mitsubas_samples(mi, maps):
     """dir_to_uv(d) is Mitsuba's uv of the sample in direction d."""
     _llvm(mi)
-    emitter = _emitter(mi, maps["sunsky"])
-    d, _, _, uv = _mi_sample(mi, emitter, mcs.uniform(20000, 2, seed=5))
+    emitter = _emitter(maps["sunsky"])
+    d, _, _, uv = mcs_mitsuba.emitter_sample(emitter, mcs.uniform(20000, 2, seed=5))
     ours = mcs.EnvMap(maps["sunsky"]).dir_to_uv(d)
     diff = (ours - uv + 0.5) % 1.0 - 0.5  # Mitsuba's u runs past 1 by half a texel
     assert np.abs(diff).max() < 1e-5
@@ -133,9 +113,10 @@ def test_uv_of_mitsubas_samples(mi, maps):
 @pytest.mark.parametrize("name", ["sky", "one-hot", "sunsky"])
 def test_mitsubas_samples_follow_our_mitsuba_mode_pdf(mi, maps, name):
     _llvm(mi)
-    emitter = _emitter(mi, maps[name])
+    emitter = _emitter(maps[name])
     ours = mcs.EnvMap(maps[name], sampling="mitsuba")
-    result = stats.chi2_test(lambda u: _mi_sample(mi, emitter, u)[0], ours.pdf, "sphere",
+    result = stats.chi2_test(lambda u: mcs_mitsuba.emitter_sample(emitter, u).direction,
+                             ours.pdf, "sphere",
                              res=51, ires=16, test_count=3)
     assert result.passed, result.message
 
@@ -157,10 +138,10 @@ def test_our_samples_follow_our_pdf(mi, maps, name, sampling):
 @pytest.mark.parametrize("name", ["sky", "one-hot", "sunsky"])
 def test_two_sample_test_against_mitsubas_sampler(mi, maps, name):
     _llvm(mi)
-    emitter = _emitter(mi, maps[name])
+    emitter = _emitter(maps[name])
     ours = mcs.EnvMap(maps[name], sampling="mitsuba")
     a = ours.sample(mcs.uniform(1_000_000, 2, seed=21)).direction
-    b = _mi_sample(mi, emitter, mcs.uniform(1_000_000, 2, seed=22))[0]
+    b = mcs_mitsuba.emitter_sample(emitter, mcs.uniform(1_000_000, 2, seed=22))[0]
     result = stats.two_sample_test(a, b, "sphere")
     assert result.passed, result.message
 
@@ -169,12 +150,13 @@ def test_two_sample_test_against_mitsubas_sampler(mi, maps, name):
 def test_weights_are_eval_over_pdf(mi, maps, name):
     """Mitsuba's own check (its test02_sampling_weights), on both samplers."""
     _llvm(mi)
-    emitter = _emitter(mi, maps[name])
-    d, pdf, weight, _ = _mi_sample(mi, emitter, mcs.uniform(50000, 2, seed=4))
+    emitter = _emitter(maps[name])
+    d, pdf, weight, _ = mcs_mitsuba.emitter_sample(emitter, mcs.uniform(50000, 2, seed=4))
     ok = pdf > 0
     # Mitsuba looks its weight up at the sampled uv and eval at the float32
     # direction: they agree to float32 round-off across a texel gradient.
-    np.testing.assert_allclose(weight[ok] * pdf[ok, None], _mi_eval(mi, emitter, d[ok]),
+    np.testing.assert_allclose(weight[ok] * pdf[ok, None],
+                               mcs_mitsuba.emitter_eval(emitter, d[ok]),
                                rtol=2e-3, atol=1e-6)
     for sampling in ["piecewise", "mitsuba"]:
         ours = mcs.EnvMap(maps[name], sampling=sampling)
@@ -193,9 +175,9 @@ def test_piecewise_mode_is_unbiased_where_mitsuba_is_not(mi):
     image = np.zeros((16, 32, 3), np.float32)
     image[0] = 5.0
     image[8] = 0.01
-    emitter = _emitter(mi, image)
+    emitter = _emitter(image)
     d = np.array([[0.01, 0.9999, 0.0]])
     d /= np.linalg.norm(d)
-    assert _mi_eval(mi, emitter, d)[0, 0] > 0
-    assert _mi_pdf(mi, emitter, d)[0] == 0
+    assert mcs_mitsuba.emitter_eval(emitter, d)[0, 0] > 0
+    assert mcs_mitsuba.emitter_pdf(emitter, d)[0] == 0
     assert mcs.EnvMap(image).pdf(d)[0] > 0

@@ -1,7 +1,7 @@
 """One scene, rendered by mcsample and by Mitsuba 3: statistically the same
 image. Each side reports per-pixel means and the variance of each pixel's
 mean luminance (Mitsuba through its ``moment`` integrator), so the per-pixel
-z-scores must behave as N(0, 1) (stats.image_ztest: mean near 0, variance in
+z-scores must behave as N(0, 1) (stats.render_ztest: mean near 0, variance in
 [0.7, 1.4], at most a handful of |z| > 5, whole-image means within 3 SE)."""
 
 from __future__ import annotations
@@ -19,33 +19,13 @@ pytestmark = pytest.mark.mitsuba
 SPP = 256
 
 
-#: Pixels whose relative standard error is below this on both sides (the
-#: directly seen sky, smooth over a pixel) are deterministic up to float32
-#: rounding, which dominates Mitsuba's E[Y²] − E[Y]² there: they are compared
-#: to a relative tolerance instead of entering the z-test.
-EXACT = 1e-4
-
-
-def _ztest(ours, ref):
-    a, b = ours.luminance, ref.luminance
-    va, vb = ours.luminance_variance, ref.luminance_variance
-    scale = np.maximum(np.abs(b), 1e-6)
-    noisy = (np.sqrt(va) > EXACT * scale) | (np.sqrt(vb) > EXACT * scale)
-    t = stats.image_ztest(a[noisy], va[noisy], b[noisy], vb[noisy])
-    exact_ok = np.allclose(a[~noisy], b[~noisy], rtol=1e-3, atol=1e-6)
-    if not exact_ok:
-        t.passed = False
-        t.messages.append("FAILED: noise-free pixels differ by more than 1e-3")
-    return t
-
-
 def _compare(mi, d, integrator="path", strategy="mis", ref_scene=None, spp=SPP, seed=1):
     scene = mcs.Scene.from_mitsuba(d)
     ours = mcs.render(scene, spp, integrator=integrator, strategy=strategy, seed=seed,
                       progress=False)
     ref_scene = ref_scene if ref_scene is not None else scene
     ref = mcs.mitsuba.render_reference(ref_scene, spp, seed=seed + 100, integrator=integrator)
-    return _ztest(ours, ref), ours, ref
+    return stats.render_ztest(ours, ref), ours, ref
 
 
 def _angular_sky():
@@ -112,7 +92,7 @@ def test_a_wrong_envmap_fails_the_test(mi):
                        strategy=strategy, seed=3, progress=False)
         r.image = r.image / scale
         r.luminance_variance = r.luminance_variance / scale ** 2
-        return _ztest(r, ref)
+        return stats.render_ztest(r, ref)
 
     assert ours(true).passed
     assert ours(true, "emitter").passed

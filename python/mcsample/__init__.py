@@ -6,7 +6,7 @@ Conventions (sample-major batches, float32 in / float32 out, densities per
 steradian on directions, +z normal) are in the README.
 """
 
-from . import data, distr, estimators, io, mis, stats, warp
+from . import data, distr, estimators, io, mis, mitsuba, plot, stats, warp
 from .rendering import RenderResult, render
 from .scene import Scene, look_at
 from ._core import (
@@ -53,6 +53,8 @@ __all__ = [
     "get_num_threads",
     "io",
     "mis",
+    "mitsuba",
+    "plot",
     "rejection_sample",
     "set_num_threads",
     "stats",

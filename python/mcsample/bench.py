@@ -10,6 +10,7 @@ samples per second. Later issues add their cases to :data:`SUITES`.
 from __future__ import annotations
 
 import statistics
+import tempfile
 import time
 from typing import Callable, NamedTuple
 
@@ -373,7 +374,8 @@ def suite_render(n: int, repeat: int, mi, spp: int = 64) -> list[Timing]:
         samples = w * h * spp
         mi_scene = None
         if mi is not None:
-            mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp))
+            with tempfile.TemporaryDirectory(prefix="mcsample-scene-") as directory:
+                mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp, directory=directory))
         for integrator in ("direct", "path"):
             case = f"render {name}, {integrator}"
             out.append(Timing(case, "mcsample", "float32", samples, measure(

@@ -43,59 +43,35 @@ SAMPLERS = [
             lambda x: warp.interval_to_power_pdf(x, 3.0), "interval"),
 ]
 
-AXES = {
-    "disk": ("phi", "r^2"), "square": ("x", "y"), "sphere": ("phi", "cos theta"),
-    "hemisphere": ("phi", "cos theta"), "interval": ("x", ""),
-}
-
 
 def run(out_dir: str = "mcsample-demo", n: int = 1_000_000, seed: int = 0) -> list[str]:
     """Draws ``n`` samples from each built-in sampler, tests them against
-    their pdf, and writes ``samplers.png`` (samples | histogram | pdf per
-    row) into ``out_dir``. Returns the paths written."""
+    their pdf, and writes ``samplers.png`` (per row: samples, histogram,
+    expected counts, difference) into ``out_dir``. Returns the paths
+    written."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from . import plot
+
     os.makedirs(out_dir, exist_ok=True)
     rows = len(SAMPLERS)
-    fig, axes = plt.subplots(rows, 3, figsize=(12, 3.2 * rows), squeeze=False)
+    fig, axes = plt.subplots(rows, 4, figsize=(17, 3.4 * rows), squeeze=False,
+                             layout="constrained")
     lines = []
     for row, s in zip(axes, SAMPLERS):
         result = stats.chi2_test(s.sample, s.pdf, s.domain, n=n, ires=s.ires, seed=seed,
                                  test_count=len(SAMPLERS))
         verdict = "passed" if result.passed else "FAILED"
         lines.append(f"{s.name:40s} chi2 p-value {result.p_value:8.4f}  {verdict}")
-        (x0, x1), (y0, y1) = result.domain.bounds
-        pts = np.asarray(s.sample(np.random.default_rng(seed).random((3000, 2))))
-        xlabel, ylabel = AXES[s.domain]
-        if s.domain == "interval":
-            centers = np.linspace(x0, x1, result.histogram.shape[1] + 1)
-            centers = 0.5 * (centers[1:] + centers[:-1])
-            row[0].plot(pts, np.random.default_rng(1).random(len(pts)), ".", ms=1)
-            row[1].bar(centers, result.histogram[0], width=centers[1] - centers[0])
-            row[2].plot(centers, result.expected[0])
-        else:
-            planar = s.domain in ("disk", "square")
-            xy = pts if planar else result.domain.to_param(pts)
-            row[0].plot(xy[:, 0], xy[:, 1], ".", ms=1)
-            if planar:
-                row[0].set_aspect("equal")
-            vmax = max(result.histogram.max(), result.expected.max())
-            for ax, data in ((row[1], result.histogram), (row[2], result.expected)):
-                im = ax.imshow(data, origin="lower", extent=(x0, x1, y0, y1), aspect="auto",
-                               vmin=0, vmax=vmax, interpolation="nearest")
-            fig.colorbar(im, ax=row[2], label="samples per cell")
+        u = np.random.default_rng(seed).random((3000, 2))
+        plot.samples(s.sample(u), s.domain, ax=row[0])
         row[0].set_title(f"{s.name}\n3000 samples")
-        row[1].set_title(f"histogram of {n:,} samples")
-        row[2].set_title(f"pdf integrated per cell\nchi2 p = {result.p_value:.3f} ({verdict})")
-        for i, ax in enumerate(row):
-            ax.set_xlabel("x" if i == 0 and s.domain == "disk" else xlabel)
-            ax.set_ylabel("y" if i == 0 and s.domain == "disk" else ylabel)
-    fig.tight_layout()
+        plot.chi2(result, axes=row[1:])
     path = os.path.join(out_dir, "samplers.png")
-    fig.savefig(path, dpi=80)
+    fig.savefig(path, dpi=70)
     plt.close(fig)
     report = os.path.join(out_dir, "chi2.txt")
     with open(report, "w") as f:
@@ -140,7 +116,7 @@ def run_render(out_dir: str = "mcsample-demo", spp: int = 32, seed: int = 0,
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from . import Scene, io, render
+    from . import Scene, io, plot, render
     from . import mitsuba as mcs_mitsuba
 
     os.makedirs(out_dir, exist_ok=True)
@@ -156,8 +132,7 @@ def run_render(out_dir: str = "mcsample-demo", spp: int = 32, seed: int = 0,
     mitsuba_result = None
     if mcs_mitsuba.available():
         mitsuba_result = mcs_mitsuba.render_reference(scene, spp, seed=seed, integrator="direct")
-        t = stats.image_ztest(results["mis"].luminance, results["mis"].luminance_variance,
-                              mitsuba_result.luminance, mitsuba_result.luminance_variance)
+        t = stats.render_ztest(results["mis"], mitsuba_result)
         lines.append(f"mitsuba  {spp} spp  {mitsuba_result.seconds:6.2f} s  relMSE "
                      f"{stats.relmse(mitsuba_result.image, ref.image):.4g} "
                      f"(z-test of mcsample MIS vs Mitsuba: {t.message.splitlines()[0]})")
@@ -167,17 +142,8 @@ def run_render(out_dir: str = "mcsample-demo", spp: int = 32, seed: int = 0,
             path = os.path.join(out_dir, f"render_{name}{ext}")
             write(path, r.image)
             paths.append(path)
-    shown = list(results.items()) + ([("mitsuba", mitsuba_result)] if mitsuba_result else [])
-    fig, axes = plt.subplots(2, len(shown), figsize=(4.2 * len(shown), 3.6), squeeze=False)
-    for col, (name, r) in enumerate(shown):
-        axes[0, col].imshow(np.clip(r.image, 0, 1) ** (1 / 2.2))
-        axes[0, col].set_title(f"{name}, {spp} spp\nrelMSE {stats.relmse(r.image, ref.image):.3g}")
-        rel = np.abs(r.luminance - ref.luminance) / (ref.luminance + 1e-2)
-        im = axes[1, col].imshow(rel, cmap="magma", vmin=0, vmax=1)
-        axes[1, col].set_title("relative error")
-        for ax in axes[:, col]:
-            ax.set_axis_off()
-    fig.colorbar(im, ax=axes[1, :].tolist(), shrink=0.8)
+    shown = dict(results, **({"mitsuba": mitsuba_result} if mitsuba_result else {}))
+    fig = plot.compare(shown, ref)
     path = os.path.join(out_dir, "strategies.png")
     fig.savefig(path, dpi=90)
     plt.close(fig)

@@ -384,6 +384,21 @@ class Scene:
     source: dict[str, Any] = field(default_factory=dict, repr=False)
     _compiled: CompiledScene | None = field(default=None, repr=False)
 
+    def __repr__(self) -> str:
+        kinds: dict[str, int] = {}
+        for shape in self.shapes:
+            kinds[shape.kind] = kinds.get(shape.kind, 0) + 1
+        shapes = ", ".join(f"{n} {k}{'es' if k == 'mesh' and n > 1 else 's' if n > 1 else ''}"
+                           for k, n in kinds.items())
+        lights = sum(s.emission is not None for s in self.shapes)
+        env = "no environment"
+        if self.environment is not None:
+            kind, value = self.environment
+            env = repr(value) if kind != "constant" else f"constant {value}"
+        c = self.camera
+        return (f"Scene({shapes}; {lights} area lights; {env}; camera {c.width}x{c.height}, "
+                f"fov {c.fov:g} ({c.fov_axis}))")
+
     @classmethod
     def from_mitsuba(cls, d: Mapping[str, Any]) -> "Scene":
         """Reads a Mitsuba 3 scene dict (the subset in this module's doc).
@@ -466,15 +481,15 @@ class Scene:
                    latlong_width: int | None = None) -> dict[str, Any]:
         """A dict for ``mi.load_dict`` (a Mitsuba variant must be set; the
         Phong plugin is registered here). Meshes are written as PLY files
-        into ``directory`` (a new temporary folder by default); a non-lat-long
+        into ``directory`` (a new temporary folder, made only when there is a
+        mesh, by default; ``mi.load_dict`` reads them); a non-lat-long
         envmap is converted to lat-long (``latlong_width`` columns, default
         4× the source's resolution) for Mitsuba's envmap emitter."""
         import mitsuba as mi
 
-        from .mitsuba import register_phong
+        from .mitsuba import envmap_dict, register_phong
 
         phong_type = register_phong()
-        directory = directory or tempfile.mkdtemp(prefix="mcsample-scene-")
         c = self.camera
         sensor: dict[str, Any] = {
             "type": "thinlens" if c.aperture_radius > 0 else "perspective",
@@ -496,6 +511,7 @@ class Scene:
             elif s.kind == "disk":
                 d = {"type": "disk", "to_world": mi.ScalarTransform4f(s.to_world.tolist())}
             else:
+                directory = directory or tempfile.mkdtemp(prefix="mcsample-scene-")
                 path = os.path.join(directory, f"shape{i}.ply")
                 write_ply(path, s.vertices, s.faces, None if s.face_normals else s.normals)
                 d = {"type": "ply", "filename": path, "face_normals": s.face_normals}
@@ -509,17 +525,7 @@ class Scene:
                 out["environment"] = {"type": "constant",
                                       "radiance": {"type": "rgb", "value": value}}
             else:
-                env = value
-                if env.mapping != "latlong":
-                    w = latlong_width or 4 * env.image.shape[1]
-                    env = env.convert("latlong", w)
-                m = np.eye(4)
-                m[:3, :3] = np.asarray(env.to_world)
-                out["environment"] = {
-                    "type": "envmap", "scale": float(env.scale),
-                    "bitmap": mi.Bitmap(np.ascontiguousarray(env.image, dtype=np.float32)),
-                    "to_world": mi.ScalarTransform4f(m.tolist()),
-                }
+                out["environment"] = envmap_dict(value, latlong_width)
         return out
 
     def copy(self) -> "Scene":

@@ -8,7 +8,8 @@
   Šidák-corrected significance level.
 - :func:`two_sample_test`: the chi-square test of homogeneity of two samplers
   that have no density.
-- image comparison: :func:`mse`, :func:`relmse`, :func:`image_ztest`.
+- image comparison: :func:`mse`, :func:`relmse`, :func:`image_ztest`, and
+  :func:`render_ztest` for two renders.
 
 Domains map target points to a parameter box whose boundary is the domain's
 boundary (so no cell straddles an edge of the support) and give the Jacobian
@@ -40,6 +41,7 @@ __all__ = [
     "make_domain",
     "mse",
     "relmse",
+    "render_ztest",
     "two_sample_test",
 ]
 
@@ -682,6 +684,11 @@ class ImageZTestResult:
     def __bool__(self) -> bool:
         return self.passed
 
+    def __repr__(self) -> str:
+        verdict = "passed" if self.passed else "FAILED"
+        return (f"ImageZTestResult({verdict}: mean={self.mean:.4g}, variance={self.variance:.4g},"
+                f" outliers={self.outliers}, mean_difference_z={self.mean_difference_z:.3g})")
+
 
 def image_ztest(a: Any, var_a: Any, b: Any, var_b: Any, outlier_z: float = 5.0,
                 max_outliers: int | None = None) -> ImageZTestResult:
@@ -733,3 +740,37 @@ def image_ztest(a: Any, var_a: Any, b: Any, var_b: Any, outlier_z: float = 5.0,
     failed = [k for k, bad in checks.items() if bad]
     messages.extend(f"FAILED: {k}" for k in failed)
     return ImageZTestResult(z, mean, variance, outliers, mean_difference_z, not failed, messages)
+
+
+def render_ztest(image: Any, reference: Any, noise_free: float = 1e-4, rtol: float = 1e-3,
+                 **kwargs: Any) -> ImageZTestResult:
+    """:func:`image_ztest` of two renders' luminances (objects with
+    ``.luminance`` and ``.luminance_variance`` (H, W), as
+    :class:`mcsample.RenderResult` and :func:`mcsample.mitsuba.render_reference`
+    return).
+
+    Pixels whose relative standard error is below ``noise_free`` on both
+    sides (e.g. directly seen sky, smooth over a pixel) are deterministic up
+    to float32 rounding, which then dominates a variance estimated as
+    E[Y²] − E[Y]²: they are compared with relative tolerance ``rtol``
+    instead of entering the z-test (the result's ``z`` is 0 there).
+    ``kwargs`` go to :func:`image_ztest`.
+    """
+    a, b = (np.asarray(x.luminance, dtype=np.float64) for x in (image, reference))
+    va, vb = (np.asarray(x.luminance_variance, dtype=np.float64) for x in (image, reference))
+    if a.shape != b.shape:
+        raise ValueError(f"image shape {a.shape} differs from reference shape {b.shape}")
+    scale = np.maximum(np.abs(b), 1e-6)
+    noisy = (np.sqrt(va) > noise_free * scale) | (np.sqrt(vb) > noise_free * scale)
+    if not noisy.any():
+        raise ValueError("no pixel of either render has noise: nothing to z-test")
+    t = image_ztest(a[noisy], va[noisy], b[noisy], vb[noisy], **kwargs)
+    z = np.zeros(a.shape)
+    z[noisy] = t.z
+    t.z = z
+    quiet = int(np.count_nonzero(~noisy))
+    t.messages.insert(1, f"{quiet} noise-free pixels compared with rtol {rtol:g}")
+    if not np.allclose(a[~noisy], b[~noisy], rtol=rtol, atol=1e-6):
+        t.passed = False
+        t.messages.append(f"FAILED: noise-free pixels differ by more than rtol {rtol:g}")
+    return t
