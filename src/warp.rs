@@ -8,7 +8,7 @@
 //! `u = 1` maps inside the domain, and inverses of degenerate points (the
 //! origin, a pole) return a valid point of the square.
 
-use crate::math::{Real, safe_sqrt, sin_cos_turn};
+use crate::math::{Real, atan2, safe_sqrt, sin_cos_turn};
 
 /// A point of the unit square or a planar domain.
 pub type P2<F> = [F; 2];
@@ -23,7 +23,7 @@ fn two_pi<F: Real>() -> F {
 /// Azimuth of `(x, y)` as a fraction of a turn, in `[0, 1)`.
 #[inline(always)]
 fn turn_fraction<F: Real>(x: F, y: F) -> F {
-    let phi = y.atan2(x) / two_pi::<F>();
+    let phi = atan2(y, x) / two_pi::<F>();
     let phi = if phi < F::zero() { phi + F::one() } else { phi };
     // -0.0 and phi + 1 rounding up to 1 both map to the start of the turn.
     if phi >= F::one() {
@@ -124,7 +124,7 @@ pub fn uniform_disk_to_square_concentric<F: Real>(p: P2<F>) -> P2<F> {
     let dominant = if horizontal { x } else { y };
     let r = (x * x + y * y).sqrt().copysign(dominant);
     // Angle of the point mirrored into the half plane of the dominant axis.
-    let phi = (y * dominant.signum()).atan2(x * dominant.signum());
+    let phi = atan2(y * dominant.signum(), x * dominant.signum());
     let t = if horizontal {
         phi / F::FRAC_PI_4()
     } else {

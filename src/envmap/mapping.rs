@@ -11,7 +11,7 @@
 //! `jacobian(p)` is `dω/dp`, the solid angle per unit area of the domain, so
 //! that a density `p_p` on the domain is `p_p / jacobian` per steradian.
 
-use crate::math::sin_cos_turn;
+use crate::math::{atan2, sin_cos_turn};
 use crate::warp::V3;
 use std::f64::consts::PI;
 
@@ -119,7 +119,7 @@ impl Mapping {
         let d = normalized(d);
         match self {
             Mapping::LatLong => {
-                let s = d[0].atan2(-d[2]) * (0.5 / PI);
+                let s = atan2(d[0], -d[2]) * (0.5 / PI);
                 let s = if s < 0.0 { s + 1.0 } else { s };
                 // -0.0 and s + 1 rounding up to 1 both mean the start of the turn.
                 let s = if s >= 1.0 { 0.0 } else { s.abs() };
@@ -188,7 +188,7 @@ impl Mapping {
 /// `acos(c)` keeps its precision near the poles.
 #[inline(always)]
 pub fn polar_angle(c: f64, a: f64, b: f64) -> f64 {
-    (a * a + b * b).sqrt().atan2(c)
+    atan2((a * a + b * b).sqrt(), c)
 }
 
 /// `d/|d|`, or `d` itself when it has length 0.

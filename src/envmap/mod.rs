@@ -40,9 +40,10 @@ pub use bilinear::BilinearGrid;
 pub use image::Image;
 pub use mapping::{Mapping, normalized, polar_angle};
 
+use crate::buffer::Buffer;
 use crate::distr::PiecewiseConstant2D;
 use crate::error::{Error, Result};
-use crate::math::sin_cos_turn;
+use crate::math::{Real, atan2, sin_cos_turn};
 use crate::parallel;
 use crate::warp::{self, V3};
 use rayon::prelude::*;
@@ -130,6 +131,106 @@ pub struct EnvMap {
     image: Image,
     options: Options,
     distribution: Distribution,
+    polar: Option<PolarTable>,
+}
+
+/// The piecewise table of a lat-long or angular map seen from a world
+/// direction, for [`EnvMap::pdf`] without branches or library calls (so
+/// that batches vectorise): the table's axes `(a, b, c)` = `axes · d`,
+/// azimuth `ψ = atan2(a, b)/2π − shift` wrapped into `[0, 1)`, polar angle
+/// `ρ = atan2(√(a² + b²), c)/π`, and the density of each cell per unit
+/// table area, row-major.
+#[derive(Clone, Debug)]
+pub struct PolarTable {
+    axes: Matrix3,
+    shift: f64,
+    rows: usize,
+    cols: usize,
+    density: Buffer<f64>,
+}
+
+/// Where a direction falls in a [`PolarTable`]: the cell's row and column
+/// (whole numbers, as floats so that batches of queries vectorise) and
+/// `dq/dω` there, computed in `F`.
+pub type PolarQuery<F> = [F; 3];
+
+impl PolarTable {
+    /// The table of `distribution` when it is a piecewise polar table, from
+    /// the `weights` it was built from (reused for the densities).
+    ///
+    /// # Errors
+    /// As [`parallel::install`].
+    fn new(
+        distribution: &Distribution,
+        mut weights: Buffer<f64>,
+        image: &Image,
+        options: &Options,
+    ) -> Result<Option<Self>> {
+        let Distribution::Piecewise(table) = distribution else {
+            return Ok(None);
+        };
+        // Rows of the local frame that give (a, b, c): lat-long (x, −z, y)
+        // with the azimuth shifted to the first texel centre, angular (y, x, z).
+        let (pick, shift): ([[f64; 3]; 3], f64) = match options.mapping {
+            Mapping::LatLong => (
+                [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]],
+                0.5 / image.width() as f64,
+            ),
+            Mapping::Angular => ([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]], 0.0),
+            Mapping::Cube => return Ok(None),
+        };
+        // axes = pick · to_worldᵀ, so that (a, b, c) = axes · d for world d.
+        let m = &options.to_world;
+        let axes = pick.map(|p| std::array::from_fn(|j| (0..3).map(|k| p[k] * m[j][k]).sum()));
+        let (rows, cols) = table.table().shape();
+        // The same division as PiecewiseConstant2D::cell_pdf, so the same bits.
+        let integral = table.integral();
+        parallel::install(|| weights.par_iter_mut().for_each(|w| *w /= integral))?;
+        let density = weights;
+        Ok(Some(PolarTable {
+            axes,
+            shift,
+            rows,
+            cols,
+            density,
+        }))
+    }
+
+    /// The cell and Jacobian of the world direction `d` (see [`PolarQuery`]).
+    #[inline(always)]
+    pub fn query<F: Real>(&self, d: V3<F>) -> PolarQuery<F> {
+        let [a, b, c] = self
+            .axes
+            .map(|m| F::c(m[0]) * d[0] + F::c(m[1]) * d[1] + F::c(m[2]) * d[2]);
+        let inv = F::one() / (a * a + b * b + c * c).sqrt().max(F::min_positive_value());
+        let (a, b, c) = (a * inv, b * inv, c * inv);
+        let r = (a * a + b * b).sqrt();
+        let psi = atan2(a, b) * F::c(0.5 / PI) - F::c(self.shift);
+        let psi = psi - psi.floor();
+        let rho = atan2(r, c) * F::c(1.0 / PI);
+        let (rows, cols) = (F::c(self.rows as f64), F::c(self.cols as f64));
+        let col = (psi * cols).floor().min(cols - F::one());
+        let row = (rho * rows).floor().min(rows - F::one());
+        let jacobian = F::c(2.0 * PI * PI) * r.max(F::c(SIN_FLOOR));
+        [row, col, F::one() / jacobian]
+    }
+
+    /// The index in [`PolarTable::density`] of a query's cell.
+    #[inline(always)]
+    pub fn cell<F: Real>(&self, [row, col, _]: PolarQuery<F>) -> usize {
+        row.f64() as usize * self.cols + col.f64() as usize
+    }
+
+    /// The density of every cell per unit table area, row-major.
+    pub fn density(&self) -> &[f64] {
+        &self.density
+    }
+
+    /// The density per steradian of a query.
+    #[inline(always)]
+    fn pdf<F: Real>(&self, query: PolarQuery<F>) -> f64 {
+        self.density.get(self.cell(query)).copied().unwrap_or(0.0) * query[2].f64()
+    }
 }
 
 /// A direction located in the sampling table ([`EnvMap::pdf_query`]).
@@ -183,18 +284,23 @@ impl EnvMap {
                 ),
             });
         }
-        let distribution = if options.scale == 0.0 {
-            Distribution::Black
+        let (distribution, polar) = if options.scale == 0.0 {
+            (Distribution::Black, None)
         } else {
             match options.sampling {
-                Sampling::Piecewise => piecewise_table(&image, &options)?,
-                Sampling::Mitsuba => mitsuba_grid(&image, options.compensate)?,
+                Sampling::Piecewise => {
+                    let (distribution, values) = piecewise_table(&image, &options)?;
+                    let polar = PolarTable::new(&distribution, values, &image, &options)?;
+                    (distribution, polar)
+                }
+                Sampling::Mitsuba => (mitsuba_grid(&image, options.compensate)?, None),
             }
         };
         Ok(EnvMap {
             image,
             options,
             distribution,
+            polar,
         })
     }
 
@@ -252,7 +358,21 @@ impl EnvMap {
     /// steradian.
     #[inline]
     pub fn pdf(&self, d: V3<f64>) -> f64 {
-        self.pdf_at(self.pdf_query(d))
+        match &self.polar {
+            Some(table) => table.pdf(table.query(d)),
+            None => self.pdf_at(self.pdf_query(d)),
+        }
+    }
+
+    /// The polar table behind [`EnvMap::pdf`] (piecewise lat-long and
+    /// angular maps; else None), for batches: [`PolarTable::query`] is
+    /// branch-free and vectorises; then the cells' densities are read, all
+    /// of a block together so that the reads overlap, and multiplied by the
+    /// query's `dq/dω`. Computed in `f64` this is [`EnvMap::pdf`]; in `f32`
+    /// a direction within a few `f32` ulps of a cell edge may be placed in
+    /// the neighbouring cell.
+    pub fn polar_table(&self) -> Option<&PolarTable> {
+        self.polar.as_ref()
     }
 
     /// The first half of [`EnvMap::pdf`], which reads no table: where `d`
@@ -327,7 +447,7 @@ impl EnvMap {
             }
             Mapping::Angular => {
                 let d = normalized(d);
-                let psi = d[1].atan2(d[0]) * (0.5 / PI);
+                let psi = atan2(d[1], d[0]) * (0.5 / PI);
                 [psi - psi.floor(), polar_angle(d[2], d[0], d[1]) / PI]
             }
             Mapping::Cube => mapping.from_dir(d),
@@ -474,8 +594,9 @@ fn sampling_luminance(
     Ok(lum.into_iter().map(|l| (l - mean).max(0.0)).collect())
 }
 
-/// The piecewise-constant table of [`Sampling::Piecewise`], or
-/// [`Distribution::Black`] when nothing is lit.
+/// The piecewise-constant table of [`Sampling::Piecewise`] (or
+/// [`Distribution::Black`] when nothing is lit) and its cells' weights,
+/// row-major.
 ///
 /// Cells and weights (luminance `Y` bilinear between texels, `J` the
 /// table's Jacobian without the floor):
@@ -486,7 +607,7 @@ fn sampling_luminance(
 ///   the mean of `Y·J` over 4 × 4 points; a sector whose points all miss the
 ///   light but whose footprint touches a lit texel gets that texel's `Y`
 ///   times `J` at its centre / 16, so that lit sectors are never 0.
-fn piecewise_table(image: &Image, options: &Options) -> Result<Distribution> {
+fn piecewise_table(image: &Image, options: &Options) -> Result<(Distribution, Buffer<f64>)> {
     let mapping = options.mapping;
     let lum = sampling_luminance(image, mapping, [0.2126, 0.7152, 0.0722], options.compensate)?;
     let (w, h) = (image.width(), image.height());
@@ -526,11 +647,13 @@ fn piecewise_table(image: &Image, options: &Options) -> Result<Distribution> {
             };
         }
     };
-    // Rows are independent: fill them on all cores.
-    let mut values = vec![0.0; rows * cols];
+    // Rows are independent: fill them on all cores. (A Buffer: it becomes
+    // the polar table's densities, read at random, best on huge pages.)
+    let mut values = Buffer::zeroed(rows * cols);
     parallel::install(|| values.par_chunks_mut(cols).enumerate().for_each(fill_row))?;
-    Ok(PiecewiseConstant2D::new(&values, rows, cols, domain)
-        .map_or(Distribution::Black, Distribution::Piecewise))
+    let distribution = PiecewiseConstant2D::new(&values, rows, cols, domain)
+        .map_or(Distribution::Black, Distribution::Piecewise);
+    Ok((distribution, values))
 }
 
 /// The domain point of polar coordinates `(ψ, ρ)` around +Z of an angular

@@ -115,6 +115,36 @@ fn samples_carry_their_own_pdf_and_weight() {
 }
 
 #[test]
+fn polar_tables_give_the_table_pdf() {
+    // The branch-free polar query (f64 and f32) against the table's own
+    // density at the same point, on random directions.
+    for env in all_maps() {
+        let Some(table) = env.polar_table() else {
+            continue;
+        };
+        let mut rng = crate::rng::Rng::new(7, 1);
+        let (mut f32_misses, n) = (0, 20_000);
+        for _ in 0..n {
+            let u = [rng.next_float::<f64>(), rng.next_float::<f64>()];
+            let d = warp::square_to_uniform_sphere(u);
+            let expected = env.pdf_at(env.pdf_query(d));
+            let q = table.query(d);
+            let ours = table.density()[table.cell(q)] * q[2];
+            assert!(
+                (ours - expected).abs() <= 1e-12 * expected,
+                "{d:?}: {ours} vs {expected}"
+            );
+            assert_eq!(env.pdf(d), ours);
+            let q = table.query(d.map(|x| x as f32));
+            let ours = table.density()[table.cell(q)] * q[2] as f64;
+            f32_misses += usize::from((ours - expected).abs() > 1e-5 * expected);
+        }
+        // In f32 only directions within a few ulps of a cell edge may move.
+        assert!(f32_misses < n / 1000, "{f32_misses} of {n}");
+    }
+}
+
+#[test]
 fn uv_round_trips_through_to_world() {
     for m in all_maps() {
         for i in 0..50 {
