@@ -392,6 +392,49 @@ def suite_render(n: int, repeat: int, mi, spp: int = 64) -> list[Timing]:
     return out
 
 
+def suite_convergence(n: int, repeat: int, mi, target: float = 0.01, spp: int = 16,
+                      ref_spp: int = 512) -> list[Timing]:
+    """Time to reach relMSE ``target`` on the demo scene (Phong spheres of
+    exponent 1 to 1000 under the packaged sky, 240 x 90, direct lighting),
+    by each strategy and by Mitsuba's MIS.
+
+    relMSE falls as C / spp for an unbiased renderer, so C is measured at
+    ``spp`` against a ``ref_spp`` MIS reference (less the reference's own
+    share, measured between two independent references), and the time to
+    the target is (C / target) spp at the measured seconds per spp. The
+    "samples" column is the pixel samples that takes."""
+    from .demo import demo_scene
+
+    scene = mcs.Scene.from_mitsuba(demo_scene(240, 90))
+    w, h = scene.size
+
+    def render(strategy: str, count: int, seed: int):
+        return mcs.render(scene, count, integrator="direct", strategy=strategy, seed=seed,
+                          progress=False)
+
+    ref_a, ref_b = render("mis", ref_spp, 1), render("mis", ref_spp, 2)
+    floor = mcs.stats.relmse(ref_a.image, ref_b.image) / 2
+    runs: dict[str, tuple[np.ndarray, float]] = {}
+    for strategy in ("bsdf", "emitter", "mis"):
+        seconds = measure(lambda strategy=strategy: render(strategy, spp, 3), repeat, 1)
+        runs[f"mcsample {strategy}"] = (render(strategy, spp, 4).image, seconds)
+    if mi is not None:
+        with tempfile.TemporaryDirectory(prefix="mcsample-scene-") as directory:
+            mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp, directory=directory))
+        mi_int = mi.load_dict({"type": "direct"})
+        seconds = measure(lambda: np.asarray(mi.render(mi_scene, integrator=mi_int, spp=spp)),
+                          repeat, 2)
+        image = np.asarray(mi.render(mi_scene, integrator=mi_int, spp=spp, seed=5))
+        runs["Mitsuba 3 llvm (MIS)"] = (image[..., :3], seconds)
+    out = []
+    for name, (image, seconds) in runs.items():
+        c = max(mcs.stats.relmse(image, ref_a.image) - floor, 1e-12) * spp
+        needed = c / target
+        out.append(Timing(f"time to relMSE {target:g}, demo", name, "float32",
+                          int(needed * w * h), needed * seconds / spp))
+    return out
+
+
 SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
     "rng": suite_rng,
     "warps": suite_warps,
@@ -399,6 +442,7 @@ SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
     "phong": suite_phong,
     "envmap": suite_envmap,
     "render": suite_render,
+    "convergence": suite_convergence,
 }
 
 
