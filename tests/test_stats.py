@@ -145,6 +145,13 @@ def test_image_ztest_accepts_agreement_and_rejects_bias(rng):
     assert not stats.image_ztest(a, var, shifted, var).passed
 
 
+def test_luminance_is_rec709():
+    rgb = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]])
+    np.testing.assert_allclose(stats.luminance(rgb), [0.2126, 0.7152, 0.0722, 1.0])
+    with pytest.raises(ValueError, match="RGB"):
+        stats.luminance(np.ones((4, 5)))
+
+
 class _Render:
     def __init__(self, luminance, variance):
         self.luminance, self.luminance_variance = luminance, variance

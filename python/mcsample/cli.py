@@ -49,8 +49,8 @@ def compare_images(image: str, reference: str, out: str | None = None) -> str:
     a, b = io.read_image(image)[..., :3], io.read_image(reference)[..., :3]
     if a.shape != b.shape:
         raise ValueError(f"images differ in size: {a.shape} and {b.shape}")
-    y = np.array([0.2126, 0.7152, 0.0722])
-    rel = np.abs(a @ y - b @ y) / (b @ y + 1e-2)
+    ya, yb = stats.luminance(a), stats.luminance(b)
+    rel = np.abs(ya - yb) / (yb + 1e-2)
     out = out or os.path.splitext(image)[0] + "_error.png"
     heat = np.stack([np.clip(rel, 0, 1), np.clip(rel - 1, 0, 1) * 0.5, 1 - np.clip(rel, 0, 1)],
                     axis=-1).astype(np.float32)

@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numpy as np
 
-from .stats import (Chi2Result, Domain, DomainLike, SphericalDomain, make_domain, relmse,
-                    render_ztest)
+from .stats import (Chi2Result, Domain, DomainLike, SphericalDomain, luminance, make_domain,
+                    relmse, render_ztest)
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -34,9 +34,6 @@ __all__ = [
     "samples",
     "tonemap",
 ]
-
-#: Rec. 709 luminance weights (DESIGN.md).
-_LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
 
 
 def _pyplot() -> Any:
@@ -88,8 +85,28 @@ def image(img: Any, exposure: float = 0.0, ax: Axes | None = None,
     return ax
 
 
-def _luminance(img: np.ndarray) -> np.ndarray:
-    return img @ _LUMINANCE if img.ndim == 3 else img
+def _z_scores(img: Any, reference: Any, variance: Any, reference_variance: Any) -> np.ndarray:
+    """Per-pixel z-scores for :func:`error_map` (see there)."""
+    renders = all(hasattr(x, "luminance_variance") for x in (img, reference))
+    if renders and variance is None and reference_variance is None:
+        return render_ztest(img, reference).z
+    a = np.asarray(getattr(img, "luminance", img), dtype=np.float64)
+    b = np.asarray(getattr(reference, "luminance", reference), dtype=np.float64)
+    if variance is None:
+        variance = getattr(img, "luminance_variance", None)
+    if reference_variance is None:
+        reference_variance = getattr(reference, "luminance_variance", None)
+    if variance is None:
+        raise ValueError("kind = 'z' needs variance= (the variance of the mean of img)")
+    var = np.asarray(variance, dtype=np.float64)
+    if reference_variance is not None:
+        var = var + np.asarray(reference_variance, dtype=np.float64)
+    if a.ndim != 2 or a.shape != b.shape or a.shape != var.shape:
+        raise ValueError(f"kind = 'z' needs (H, W) images and variances of one shape, got "
+                         f"{a.shape}, {b.shape}, {var.shape} (use .luminance and "
+                         ".luminance_variance)")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(var > 0, (a - b) / np.sqrt(var), 0.0)
 
 
 def error_map(img: Any, reference: Any, kind: str = "relative", variance: Any = None,
@@ -108,36 +125,14 @@ def error_map(img: Any, reference: Any, kind: str = "relative", variance: Any = 
       :func:`mcsample.stats.render_ztest` (0 on noise-free pixels).
     """
     ax = _axes(ax)
-    renders = all(hasattr(x, "luminance_variance") for x in (img, reference))
-    if kind == "z" and renders and variance is None and reference_variance is None:
-        z = render_ztest(img, reference).z
+    if kind == "z":
         limit = vmax or 5.0
-        im = ax.imshow(z, cmap="RdBu_r", vmin=-limit, vmax=limit, interpolation="nearest")
-        label = "z-score"
-    elif kind == "z":
-        a = np.asarray(getattr(img, "luminance", img), dtype=np.float64)
-        b = np.asarray(getattr(reference, "luminance", reference), dtype=np.float64)
-        if variance is None:
-            variance = getattr(img, "luminance_variance", None)
-        if reference_variance is None:
-            reference_variance = getattr(reference, "luminance_variance", None)
-        if variance is None:
-            raise ValueError("kind = 'z' needs variance= (the variance of the mean of img)")
-        var = np.asarray(variance, dtype=np.float64)
-        if reference_variance is not None:
-            var = var + np.asarray(reference_variance, dtype=np.float64)
-        if a.ndim != 2 or a.shape != b.shape or a.shape != var.shape:
-            raise ValueError(f"kind = 'z' needs (H, W) images and variances of one shape, got "
-                             f"{a.shape}, {b.shape}, {var.shape} (use .luminance and "
-                             ".luminance_variance)")
-        with np.errstate(divide="ignore", invalid="ignore"):
-            z = np.where(var > 0, (a - b) / np.sqrt(var), 0.0)
-        limit = vmax or 5.0
+        z = _z_scores(img, reference, variance, reference_variance)
         im = ax.imshow(z, cmap="RdBu_r", vmin=-limit, vmax=limit, interpolation="nearest")
         label = "z-score"
     elif kind in ("relative", "absolute"):
-        a = _luminance(np.asarray(getattr(img, "image", img), dtype=np.float64))
-        b = _luminance(np.asarray(getattr(reference, "image", reference), dtype=np.float64))
+        a, b = (np.asarray(getattr(x, "image", x), dtype=np.float64) for x in (img, reference))
+        a, b = (luminance(x) if x.ndim == 3 else x for x in (a, b))
         if a.shape != b.shape:
             raise ValueError(f"image shape {a.shape} differs from reference shape {b.shape}")
         err = np.abs(a - b)

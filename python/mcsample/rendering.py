@@ -16,6 +16,7 @@ import numpy as np
 
 from ._core.render import render as _render
 from .scene import Scene
+from .stats import luminance
 
 __all__ = ["RenderResult", "render"]
 
@@ -49,7 +50,7 @@ class RenderResult:
     @property
     def luminance(self) -> np.ndarray:
         """Rec. 709 luminance of :attr:`image`, (H, W)."""
-        return self.image.astype(np.float64) @ np.array([0.2126, 0.7152, 0.0722])
+        return luminance(self.image)
 
 
 def _progress_bar(total: int, enabled: bool) -> tuple[Callable[[int], None] | None, Any]:

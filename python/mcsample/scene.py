@@ -388,8 +388,7 @@ class Scene:
         kinds: dict[str, int] = {}
         for shape in self.shapes:
             kinds[shape.kind] = kinds.get(shape.kind, 0) + 1
-        shapes = ", ".join(f"{n} {k}{'es' if k == 'mesh' and n > 1 else 's' if n > 1 else ''}"
-                           for k, n in kinds.items())
+        shapes = ", ".join(f"{k} x{n}" for k, n in kinds.items())
         lights = sum(s.emission is not None for s in self.shapes)
         env = "no environment"
         if self.environment is not None:

@@ -38,6 +38,7 @@ __all__ = [
     "SphericalDomain",
     "chi2_test",
     "image_ztest",
+    "luminance",
     "make_domain",
     "mse",
     "relmse",
@@ -650,6 +651,15 @@ def _pair(a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
     if a.shape != b.shape:
         raise ValueError(f"images must have the same shape, got {a.shape} and {b.shape}")
     return a, b
+
+
+def luminance(rgb: Any) -> np.ndarray:
+    """Rec. 709 luminance Y = 0.2126 R + 0.7152 G + 0.0722 B of linear RGB
+    values, (..., 3) → (...), float64."""
+    x = np.asarray(rgb, dtype=np.float64)
+    if x.shape[-1:] != (3,):
+        raise ValueError(f"luminance needs RGB values on the last axis, got shape {x.shape}")
+    return x @ np.array([0.2126, 0.7152, 0.0722])
 
 
 def mse(image: Any, reference: Any) -> float:
