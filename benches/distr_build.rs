@@ -50,6 +50,12 @@ fn main() {
     println!("Discrete1D sample: {:.1} M/s (1 thread)", 1e4 / ms);
     let ms = median_ms(|| out.iter_mut().zip(&us).for_each(|(o, &u)| *o = t.sample(u)));
     println!("AliasTable sample: {:.1} M/s (1 thread)", 1e4 / ms);
+    let mut out32 = vec![0u64; us.len()];
+    let ms = median_ms(|| t.sample_into(&us, &mut out32));
+    println!(
+        "AliasTable sample_into: {:.1} M/s (1 thread, prefetching)",
+        1e4 / ms
+    );
 }
 
 /// Times of the build phases (copy, running sums, checks) on fresh memory.

@@ -6,13 +6,54 @@
 //! Large buffers are therefore anonymous memory maps advised to use huge
 //! pages (2 MiB, where the OS offers them, as numpy does for its arrays),
 //! which cut the faults by a factor of 512. Small ones stay on the heap.
+//!
+//! Even so, touching fresh memory costs more than writing it again (the
+//! kernel zeroes each page on its first fault): a dropped map is therefore
+//! kept for the next large buffer of about its size, as Dr.Jit's allocator
+//! keeps its arrays, up to [`RECYCLE_MAX_BYTES`] in all. A buffer that its
+//! maker overwrites whole ([`Buffer::for_overwrite`]) reuses one as it is.
 
 use bytemuck::Pod;
 use memmap2::MmapMut;
 use std::ops::{Deref, DerefMut};
+use std::sync::Mutex;
 
 /// Buffers of at least this many bytes are memory maps.
 const MAP_MIN_BYTES: usize = 1 << 20;
+
+/// The most bytes of dropped maps kept for reuse.
+const RECYCLE_MAX_BYTES: usize = 256 << 20;
+
+/// Dropped maps, oldest first.
+static RECYCLED: Mutex<Vec<MmapMut>> = Mutex::new(Vec::new());
+
+/// A kept map of at least `bytes` and at most twice that, the smallest.
+fn take_recycled(bytes: usize) -> Option<MmapMut> {
+    let mut kept = RECYCLED.lock().unwrap_or_else(|p| p.into_inner());
+    let fits = |m: &MmapMut| (bytes..=2 * bytes).contains(&m.len());
+    let best = (0..kept.len())
+        .filter(|&i| fits(&kept[i]))
+        .min_by_key(|&i| kept[i].len())?;
+    Some(kept.swap_remove(best))
+}
+
+/// Keeps `map` for reuse, dropping the oldest maps beyond the cap.
+fn recycle(map: MmapMut) {
+    let mut kept = RECYCLED.lock().unwrap_or_else(|p| p.into_inner());
+    kept.push(map);
+    while kept.iter().map(|m| m.len()).sum::<usize>() > RECYCLE_MAX_BYTES {
+        kept.remove(0);
+    }
+}
+
+/// A fresh anonymous map of `bytes` (zeros), advised to use huge pages.
+fn fresh_map(bytes: usize) -> Option<MmapMut> {
+    let map = MmapMut::map_anon(bytes).ok()?;
+    // Advice only: without huge pages the map still works.
+    #[cfg(target_os = "linux")]
+    let _ = map.advise(memmap2::Advice::HugePage);
+    Some(map)
+}
 
 enum Storage<T> {
     Heap(Vec<T>),
@@ -28,28 +69,54 @@ pub struct Buffer<T: Pod> {
 impl<T: Pod> Buffer<T> {
     /// `len` zeros.
     pub fn zeroed(len: usize) -> Self {
-        let bytes = len.saturating_mul(size_of::<T>());
-        let storage = if bytes >= MAP_MIN_BYTES {
-            match MmapMut::map_anon(bytes) {
-                Ok(map) => {
-                    // Advice only: without huge pages the map still works.
-                    #[cfg(target_os = "linux")]
-                    let _ = map.advise(memmap2::Advice::HugePage);
-                    Storage::Mapped(map)
-                }
-                Err(_) => Storage::Heap(vec![T::zeroed(); len]),
-            }
-        } else {
-            Storage::Heap(vec![T::zeroed(); len])
-        };
-        Buffer { storage, len }
+        let (storage, recycled) = allocate::<T>(len);
+        let mut buffer = Buffer { storage, len };
+        if recycled {
+            buffer.fill(T::zeroed());
+        }
+        buffer
+    }
+
+    /// `len` values that the caller overwrites before reading them: a
+    /// recycled map keeps what its last buffer held (any bit pattern is a
+    /// valid `T`), which saves zeroing it.
+    pub fn for_overwrite(len: usize) -> Self {
+        Buffer {
+            storage: allocate::<T>(len).0,
+            len,
+        }
     }
 
     /// A copy of `values`.
     pub fn from_slice(values: &[T]) -> Self {
-        let mut buffer = Self::zeroed(values.len());
+        let mut buffer = Self::for_overwrite(values.len());
         buffer.copy_from_slice(values);
         buffer
+    }
+}
+
+/// Storage for `len` values of `T`, and whether it is a recycled map (which
+/// holds old values; fresh storage holds zeros).
+fn allocate<T: Pod>(len: usize) -> (Storage<T>, bool) {
+    let bytes = len.saturating_mul(size_of::<T>());
+    if bytes >= MAP_MIN_BYTES {
+        if let Some(map) = take_recycled(bytes) {
+            return (Storage::Mapped(map), true);
+        }
+        if let Some(map) = fresh_map(bytes) {
+            return (Storage::Mapped(map), false);
+        }
+    }
+    (Storage::Heap(vec![T::zeroed(); len]), false)
+}
+
+impl<T: Pod> Drop for Buffer<T> {
+    fn drop(&mut self) {
+        if let Storage::Mapped(map) =
+            std::mem::replace(&mut self.storage, Storage::Heap(Vec::new()))
+        {
+            recycle(map);
+        }
     }
 }
 
@@ -101,6 +168,9 @@ mod tests {
             let c = b.clone();
             assert!(c.iter().enumerate().all(|(i, &x)| x == i as f64));
         }
+        // A recycled map comes back as zeros.
+        drop(Buffer::<f64>::from_slice(&[7.0; 1 << 18]));
+        assert!(Buffer::<f64>::zeroed(1 << 18).iter().all(|&x| x == 0.0));
         let u = Buffer::from_slice(&[1u32, 2, 3]);
         assert_eq!(&u[..], &[1, 2, 3]);
     }

@@ -6,7 +6,8 @@
 //! This module holds the crate's only `unsafe`: calling a function compiled
 //! for an instruction set, which is sound because the CPU was just checked
 //! to have it, and the non-temporal stores of large outputs (raw-pointer
-//! intrinsics, bounds and alignment argued at each use). Results do not
+//! intrinsics, bounds and alignment argued at each use), and cache prefetch
+//! hints. Results do not
 //! depend on the path taken: no floating-point contraction is enabled, so
 //! each operation rounds the same way.
 
@@ -82,6 +83,23 @@ fn avx512<R>(f: impl FnOnce() -> R) -> R {
 #[target_feature(enable = "avx2,fma")]
 fn avx2_fma<R>(f: impl FnOnce() -> R) -> R {
     f()
+}
+
+/// Asks the CPU to bring `data[index]` into the caches ahead of its use. A
+/// hint: it never faults (an index out of bounds is harmless) and does
+/// nothing on targets without the instruction.
+#[inline(always)]
+pub fn prefetch<T>(data: &[T], index: usize) {
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    // SAFETY: a prefetch reads nothing the program can observe and never
+    // faults, whatever the address.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>(data.as_ptr().wrapping_add(index).cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (data, index);
 }
 
 /// Rows per block of [`map_rows`].

@@ -1,113 +1,360 @@
 //! [`AliasTable`]: O(1) sampling of a discrete distribution (Walker's alias
-//! method, built by sweeping).
+//! method, built by a sweep that runs in parallel).
 
 use super::check_weights;
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
+use crate::{parallel, simd};
+use rayon::prelude::*;
+use std::hint::select_unpredictable;
+
+/// Entries per block of the parallel build. Fixed, so that the table does
+/// not depend on the number of threads.
+const BLOCK: usize = 1 << 16;
+
+/// Draws per group of [`AliasTable::sample_into`]: their cells are located
+/// and prefetched before any is read.
+const GROUP: usize = 64;
+
+/// Steps per piece of the build's merge.
+const PIECE: usize = 1 << 14;
+
+/// `2^32`: thresholds are 32-bit fixed-point fractions of a cell.
+const ONE: f64 = 4_294_967_296.0;
 
 /// A discrete distribution over `0..n` with probabilities proportional to
 /// non-negative weights, sampled in O(1) with one uniform number.
 ///
 /// # Probability
 /// `P(i) = w_i / Σw`, the same as [`super::Discrete1D`] (a different map
-/// from `u` to indices).
+/// from `u` to indices). Each cell's threshold is rounded to 32 bits, so the
+/// probability a draw realises is within `2^-32/n` per cell of it.
 ///
 /// # Sampling
-/// With `t = u·n`, cell `c = ⌊t⌋` keeps its own index when `t − c` is below
-/// the cell's threshold, and otherwise returns the cell's alias. Every cell
-/// holds mass `1/n`: its own share `w_c·n/Σw`, topped up from one donor.
-/// An entry of weight 0 has threshold 0 and is never returned.
+/// With `t = u·n`, cell `c = ⌊t⌋` keeps its own index when the fraction
+/// `t − c` is below the cell's threshold, and otherwise returns the cell's
+/// alias. Every cell holds mass `1/n`: its own share `s_c = w_c·n/Σw`,
+/// topped up from one donor. An entry of weight 0 has threshold 0 and is
+/// never returned. The fraction has `52 − log₂n` bits for `f64` input and
+/// only `23 − log₂n` for `f32` input, which coarsens the thresholds: use
+/// `f64` numbers for large tables.
+///
+/// # Construction
+/// Entries with `s < 1` are light, the others heavy, each kept in index
+/// order. The sweep of Hübschle-Schneider and Sanders lets the current heavy
+/// entry top up light cells in order while its residual exceeds 1, and then
+/// closes it as a cell of its own, topped up by the next heavy entry. With
+/// the deficits `σ_L(k) = Σ_{k'<k} (1 − s_{L_k'})` of the first `k` light
+/// entries and the surpluses `σ_H(j) = Σ_{j'<j} (s_{H_j'} − 1)` of the first
+/// `j` heavy ones, that sweep is a merge:
+/// - light `k` takes as alias the heavy `j` with `σ_H(j) ≤ σ_L(k) < σ_H(j+1)`
+///   (the last heavy when there is none);
+/// - heavy `j` closes after the `i` light entries with `σ_L(k) < σ_H(j+1)`,
+///   keeping `1 − (σ_L(i) − σ_H(j+1))` of its cell, and takes heavy `j+1` as
+///   alias (the last heavy keeps its whole cell).
+///
+/// The build runs in parallel: the classification and prefix sums by
+/// blocks of entries, the merge by pieces of its path (each started by a
+/// binary search on its diagonal, as in a parallel merge sort), the cells
+/// again by blocks. Thresholds come from the prefix sums directly, so they
+/// carry no round-off accumulated along the sweep, and the table is the
+/// same whatever the number of threads.
 ///
 /// # References
 /// M. D. Vose, "A linear algorithm for generating random numbers with a
 /// given distribution", IEEE Transactions on Software Engineering 17(9),
 /// 1991. L. Hübschle-Schneider, P. Sanders, "Parallel Weighted Random
-/// Sampling", ACM Transactions on Mathematical Software 48(3), 2022 (the
-/// sweeping construction used here).
+/// Sampling", ACM Transactions on Mathematical Software 48(3), 2022.
 #[derive(Clone, Debug)]
 pub struct AliasTable {
-    /// Cell `c` keeps its own index when the fractional part of `u·n` is
-    /// below its threshold, else returns its alias: `[threshold bits,
-    /// alias]` side by side, so a draw touches one cache line.
-    cells: Buffer<[u64; 2]>,
+    /// `[threshold, alias]` of each cell: cell `c` keeps `c` when the
+    /// fraction of `u·n` past `c`, in 32-bit fixed point, is below the
+    /// threshold, else returns the alias. A full cell is its own alias.
+    cells: Buffer<[u32; 2]>,
     pmf: Buffer<f64>,
     sum: f64,
 }
 
+/// What the first pass learns of a block of entries: the number of light
+/// entries, the sum of their deficits `1 − s` and that of the heavy
+/// entries' surpluses `s − 1`.
+#[derive(Clone, Copy, Default)]
+struct BlockSums {
+    lights: usize,
+    deficit: f64,
+    surplus: f64,
+}
+
+/// The cell of entry `index` that keeps it with probability `keep` and
+/// otherwise returns `alias`: a full cell (`keep ≥ 1`) is its own alias, and
+/// an entry of positive weight keeps at least the smallest threshold, so
+/// that round-off cannot make it unreachable. Branch-free.
+#[inline(always)]
+fn cell(index: usize, keep: f64, alias: u32, positive: bool) -> [u32; 2] {
+    // `keep·2^32` rounded to the nearest integer by adding 2^52, where the
+    // spacing of doubles is 1: no conversion, whose range checks branch.
+    const SHIFT: f64 = 4_503_599_627_370_496.0;
+    let scaled = keep.clamp(0.0, 1.0) * ONE + SHIFT;
+    let bits = (scaled.to_bits() - SHIFT.to_bits()).max(u64::from(positive));
+    let full = bits > u64::from(u32::MAX);
+    [
+        select_unpredictable(full, u32::MAX, bits as u32),
+        select_unpredictable(full, index as u32, alias),
+    ]
+}
+
+/// The light and heavy orders of pass 2 of [`AliasTable::new`]'s build:
+/// `σ_L(k)` for `k = 0..=n_light`, `σ_H(j+1)` for each heavy `j` (+∞ for the
+/// last heavy, which never closes), and the heavy entries' indices.
+///
+/// The sweep is their merge: light `k` is swept before heavy `j` closes iff
+/// `σ_L(k) < σ_H(j+1)`. A light step gives light `k` heavy `j` as its
+/// alias; a closing step leaves heavy `j` the share `1 − (σ_L(k) −
+/// σ_H(j+1))` of its own cell.
+struct Orders<'a> {
+    deficit_before: &'a [f64],
+    surplus_through: &'a [f64],
+    heavy_index: &'a [u32],
+}
+
+/// A piece of the merge: where it starts, its number of steps and the
+/// outputs of its lights and heavies.
+struct Piece<'a> {
+    k0: usize,
+    j0: usize,
+    steps: usize,
+    alias: &'a mut [u32],
+    keep: &'a mut [f64],
+}
+
+impl Orders<'_> {
+    /// The point `(k, j)` of the merge path after `d` steps: the largest
+    /// `k` such that light `k − 1` precedes close `d − k` (binary search).
+    fn corner(&self, d: usize) -> (usize, usize) {
+        let n_light = self.deficit_before.len() - 1;
+        let closes = self.surplus_through.len() - 1;
+        let (mut lo, mut hi) = (d.saturating_sub(closes), d.min(n_light));
+        while lo < hi {
+            let mid = (lo + hi).div_ceil(2);
+            if self.deficit_before[mid - 1] < self.surplus_through[d - mid] {
+                lo = mid;
+            } else {
+                hi = mid - 1;
+            }
+        }
+        (lo, d - lo)
+    }
+
+    /// Runs `piece`. Both outputs of a step are written (no unpredictable
+    /// branch): a slot written early is written again by its own step.
+    fn run(&self, piece: &mut Piece) {
+        let n_light = self.deficit_before.len() - 1;
+        let (mut k, mut j) = (piece.k0, piece.j0);
+        for _ in 0..piece.steps {
+            let (deficit, surplus) = (self.deficit_before[k], self.surplus_through[j]);
+            let light = (k < n_light) & (deficit < surplus);
+            if let Some(a) = piece.alias.get_mut(k - piece.k0) {
+                *a = self.heavy_index[j];
+            }
+            if let Some(x) = piece.keep.get_mut(j - piece.j0) {
+                *x = 1.0 - (deficit - surplus);
+            }
+            k += light as usize;
+            j += !light as usize;
+        }
+    }
+}
+
+/// `Σ values` in eight interleaved partial sums, so that the additions
+/// pipeline; the same bits on every run.
+fn lane_sum(values: &[f64]) -> f64 {
+    let (lanes, rest) = values.as_chunks::<8>();
+    let mut acc = [0.0; 8];
+    for lane in lanes {
+        for (a, &v) in acc.iter_mut().zip(lane) {
+            *a += v;
+        }
+    }
+    acc.iter().sum::<f64>() + rest.iter().sum::<f64>()
+}
+
 impl AliasTable {
-    /// An alias table proportional to `weights`.
+    /// An alias table proportional to `weights`, built on mcsample's thread
+    /// pool.
     ///
     /// # Errors
     /// As [`super::Discrete1D::new`].
     pub fn new(weights: &[f64]) -> Result<Self> {
         check_weights("weights", weights, |i| format!("[{i}]"))?;
-        let sum: f64 = weights.iter().sum();
+        parallel::install(|| Self::build(weights))?
+    }
+
+    fn build(weights: &[f64]) -> Result<Self> {
+        let block_totals: Vec<f64> = weights.par_chunks(BLOCK).map(lane_sum).collect();
+        let sum: f64 = block_totals.iter().sum();
         if !(sum > 0.0 && sum.is_finite()) {
             return Err(Error::AllZero { arg: "weights" });
         }
         let n = weights.len();
-        let mut pmf = Buffer::zeroed(n);
-        for (p, &w) in pmf.iter_mut().zip(weights) {
-            *p = w / sum;
-        }
-        let share = |i: usize| pmf[i] * n as f64;
+        let to_share = n as f64 / sum;
 
-        // Entries below their 1/n share ("light") in increasing order from
-        // the front of `order`, the others ("heavy") from the back, written
-        // branch-free (the order of the weights is random to the predictor).
-        let mut order = Buffer::<u32>::zeroed(n);
-        let (mut n_light, mut n_heavy) = (0usize, 0usize);
-        for i in 0..n {
-            let light = (share(i) < 1.0) as usize;
-            order[n_light] = i as u32;
-            order[n - 1 - n_heavy] = i as u32;
-            n_light += light;
-            n_heavy += 1 - light;
+        // Pass 1: the probabilities, and in each block of `key` and `pos`
+        // its light entries in order from the front (with the deficit of
+        // the block's lights before each) and its heavy entries from the
+        // back (with the surplus of the block's heavies through each).
+        // Branch-free: every entry is written to both ends with the same
+        // value; the slot not taken is overwritten by a later entry of that
+        // kind, or is the other kind's last slot, written last.
+        let mut pmf = Buffer::<f64>::for_overwrite(n);
+        let mut key = Buffer::<f64>::for_overwrite(n);
+        let mut pos = Buffer::<u32>::for_overwrite(n);
+        let blocks: Vec<BlockSums> = (
+            pmf.par_chunks_mut(BLOCK),
+            key.par_chunks_mut(BLOCK),
+            pos.par_chunks_mut(BLOCK),
+            weights.par_chunks(BLOCK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .map(|(b, (pmf, key, pos, w))| {
+                let (last, sum, to_share) = (w.len() - 1, sum, to_share);
+                let mut sums = BlockSums::default();
+                for (i, (p, &w)) in pmf.iter_mut().zip(w).enumerate() {
+                    *p = w / sum;
+                    let s = w * to_share;
+                    let light = s < 1.0;
+                    // Selections by arithmetic (exact for 0/1 factors), which
+                    // compilers do not turn into branches.
+                    let is_light = f64::from(u8::from(light));
+                    sums.surplus += (s - 1.0).max(0.0);
+                    let value = is_light * sums.deficit + (1.0 - is_light) * sums.surplus;
+                    let heavies = i - sums.lights;
+                    let index = (b * BLOCK + i) as u32;
+                    (key[sums.lights], key[last - heavies]) = (value, value);
+                    (pos[sums.lights], pos[last - heavies]) = (index, index);
+                    sums.deficit += (1.0 - s).max(0.0);
+                    sums.lights += light as usize;
+                }
+                sums
+            })
+            .collect();
+        let n_light: usize = blocks.iter().map(|b| b.lights).sum();
+        let n_heavy = n - n_light;
+        let mut cells = Buffer::<[u32; 2]>::for_overwrite(n);
+        if n_heavy == 0 {
+            // Only round-off leaves no entry at or above its share (all
+            // weights then nearly equal and positive): every cell is full.
+            cells
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(i, c)| *c = [u32::MAX, i as u32]);
+            return Ok(AliasTable { cells, pmf, sum });
         }
-        let light = |k: usize| order[k] as usize;
-        let heavy = |k: usize| order[n - 1 - k] as usize;
 
-        // Sweep (Hübschle-Schneider and Sanders): the current heavy entry
-        // tops up light entries in order while its residual `w` exceeds one
-        // share; once it drops to one share or less it is itself a light
-        // cell, topped up by the next heavy entry. Both cursors only move
-        // forward, and each step is a select, not a branch.
-        let mut cells = Buffer::<[u64; 2]>::zeroed(n);
-        let (mut i, mut j) = (0usize, 0usize);
-        let mut w = if n_heavy > 0 { share(heavy(0)) } else { 0.0 };
-        while n_heavy > 0 && (i < n_light || j + 1 < n_heavy) {
-            let can_light = i < n_light;
-            let can_heavy = j + 1 < n_heavy;
-            let light_step = can_light & ((w > 1.0) | !can_heavy);
-            let l = light(i.min(n_light.saturating_sub(1)));
-            let next = heavy((j + 1).min(n_heavy - 1));
-            let (cell, threshold, alias) = if light_step {
-                (l, share(l), heavy(j))
-            } else {
-                (heavy(j), w, next)
-            };
-            cells[cell] = [threshold.to_bits(), alias as u64];
-            w = if light_step {
-                w + share(l) - 1.0
-            } else {
-                share(next) + w - 1.0
-            };
-            i += light_step as usize;
-            j += (!light_step) as usize;
+        // Pass 2: the two orders over all blocks: σ_L(k) for k = 0..=n_light
+        // (σ_L(n_light) the total deficit) and σ_H(j+1) for each heavy j
+        // (+∞ for the last, which never closes), with the heavies' indices.
+        let mut deficit_before = Buffer::<f64>::for_overwrite(n_light + 1);
+        let mut surplus_through = Buffer::<f64>::for_overwrite(n_heavy);
+        let mut heavy_index = Buffer::<u32>::for_overwrite(n_heavy);
+        let total_deficit = {
+            let mut parts = Vec::with_capacity(blocks.len());
+            let (mut lights, mut heavies, mut indices) = (
+                &mut deficit_before[..n_light],
+                &mut surplus_through[..],
+                &mut heavy_index[..],
+            );
+            let (mut deficit, mut surplus) = (0.0, 0.0);
+            for (b, sums) in blocks.iter().enumerate() {
+                let n_h = (n - b * BLOCK).min(BLOCK) - sums.lights;
+                let (l, rest_l) = lights.split_at_mut(sums.lights);
+                let (h, rest_h) = heavies.split_at_mut(n_h);
+                let (x, rest_x) = indices.split_at_mut(n_h);
+                parts.push((l, h, x, deficit, surplus));
+                (lights, heavies, indices) = (rest_l, rest_h, rest_x);
+                deficit += sums.deficit;
+                surplus += sums.surplus;
+            }
+            parts
+                .into_par_iter()
+                .zip(key.par_chunks(BLOCK).zip(pos.par_chunks(BLOCK)))
+                .for_each(|((l, h, x, deficit, surplus), (key, pos))| {
+                    for (d, &k) in l.iter_mut().zip(key) {
+                        *d = deficit + k;
+                    }
+                    let back = key.iter().zip(pos).rev();
+                    for ((s, i), (&k, &p)) in h.iter_mut().zip(x.iter_mut()).zip(back) {
+                        (*s, *i) = (surplus + k, p);
+                    }
+                });
+            deficit
+        };
+        deficit_before[n_light] = total_deficit;
+        surplus_through[n_heavy - 1] = f64::INFINITY;
+
+        // Pass 3: the sweep as a merge (see [`Orders`]), cut into pieces of
+        // [`PIECE`] steps (fixed, so that the table does not depend on the
+        // thread count), each starting where the merge path crosses its
+        // first step's diagonal; the pieces run in parallel.
+        // One spare alias slot: pass 4 reads a light's alias for every entry.
+        let mut light_alias = Buffer::<u32>::for_overwrite(n_light + 1);
+        let mut heavy_keep = Buffer::<f64>::for_overwrite(n_heavy);
+        let orders = Orders {
+            deficit_before: &deficit_before,
+            surplus_through: &surplus_through,
+            heavy_index: &heavy_index,
+        };
+        let steps = n_light + n_heavy - 1;
+        let corners: Vec<(usize, usize)> = (0..=steps.div_ceil(PIECE))
+            .map(|p| orders.corner((p * PIECE).min(steps)))
+            .collect();
+        let mut pieces = Vec::with_capacity(corners.len());
+        let (mut aliases, mut keeps) = (&mut light_alias[..], &mut heavy_keep[..]);
+        for corner in corners.windows(2) {
+            let [(k0, j0), (k1, j1)] = [corner[0], corner[1]];
+            let (alias, rest_a) = aliases.split_at_mut(k1 - k0);
+            let (keep, rest_k) = keeps.split_at_mut(j1 - j0);
+            (aliases, keeps) = (rest_a, rest_k);
+            pieces.push(Piece {
+                k0,
+                j0,
+                steps: k1 - k0 + j1 - j0,
+                alias,
+                keep,
+            });
         }
-        // What is left holds (up to round-off) exactly one share each: the
-        // last heavy entry and any light entries. An entry of weight 0 left
-        // over points at the most likely entry instead.
-        let donor = (0..n).fold(0, |best, k| if pmf[k] > pmf[best] { k } else { best });
-        let rest = (i..n_light).map(light).chain((j..n_heavy).map(heavy));
-        for k in rest {
-            cells[k] = if pmf[k] > 0.0 {
-                [1.0f64.to_bits(), k as u64]
-            } else {
-                [0.0f64.to_bits(), donor as u64]
-            };
+        pieces.par_iter_mut().for_each(|piece| orders.run(piece));
+        heavy_keep[n_heavy - 1] = 1.0;
+
+        // Pass 4: each block's cells from the two orders; heavy j's alias is
+        // heavy j+1.
+        let (light_alias, heavy_keep) = (&light_alias[..], &heavy_keep[..]);
+        let heavy_index = &heavy_index[..];
+        let mut starts = Vec::with_capacity(blocks.len());
+        let mut light_start = 0;
+        for (b, sums) in blocks.iter().enumerate() {
+            starts.push((light_start, b * BLOCK - light_start));
+            light_start += sums.lights;
         }
+        cells
+            .par_chunks_mut(BLOCK)
+            .zip(weights.par_chunks(BLOCK))
+            .zip(starts)
+            .enumerate()
+            .for_each(|(b, ((cells, w), (mut k, mut j)))| {
+                for (i, (c, &w)) in cells.iter_mut().zip(w).enumerate() {
+                    let s = w * to_share;
+                    let light = s < 1.0;
+                    let heavy = j.min(n_heavy - 1);
+                    let keep = select_unpredictable(light, s, heavy_keep[heavy]);
+                    let next = heavy_index[(heavy + 1).min(n_heavy - 1)];
+                    let alias = select_unpredictable(light, light_alias[k], next);
+                    *c = cell(b * BLOCK + i, keep, alias, w > 0.0);
+                    k += light as usize;
+                    j += !light as usize;
+                }
+            });
         Ok(AliasTable { cells, pmf, sum })
     }
 
@@ -131,17 +378,47 @@ impl AliasTable {
         self.pmf.get(i).copied().unwrap_or(0.0)
     }
 
+    /// The cell of `u` and the fraction of `u·n` past it, in 32-bit fixed
+    /// point (saturating at `u = 1`, where the cell's alias answers).
+    #[inline(always)]
+    fn locate<F: Real>(&self, u: F) -> (usize, u32) {
+        let n = self.cells.len();
+        let t = u.f64() * n as f64;
+        let c = (t as usize).min(n - 1);
+        (c, ((t - c as f64) * ONE) as u32)
+    }
+
+    /// Cell `c`'s answer for the fraction `fraction`. A select, not a
+    /// branch: the outcome is random, and a mispredicted branch would stall
+    /// the other draws' memory loads.
+    #[inline(always)]
+    fn answer(&self, c: usize, fraction: u32) -> u32 {
+        let [threshold, alias] = self.cells[c];
+        select_unpredictable(fraction < threshold, c as u32, alias)
+    }
+
     /// An index drawn with probability `pmf(i)`; `u` in `[0, 1]`.
     #[inline]
     pub fn sample<F: Real>(&self, u: F) -> usize {
-        let n = self.pmf.len();
-        let t = u.f64() * n as f64;
-        let c = (t as usize).min(n - 1);
-        let [threshold, alias] = self.cells[c];
-        // A select, not a branch: the outcome is random, and a mispredicted
-        // branch would stall the other draws' memory loads.
-        let keep = t - (c as f64) < f64::from_bits(threshold);
-        if keep { c } else { alias as usize }
+        let (c, fraction) = self.locate(u);
+        self.answer(c, fraction) as usize
+    }
+
+    /// `out[i] = sample(us[i])` for a batch. Groups of draws first locate
+    /// their cells and prefetch them, then read them, so that the cache
+    /// misses of a group overlap (on tables larger than the cache, 3–4×
+    /// the speed of one draw after another).
+    pub fn sample_into<F: Real, I: From<u32>>(&self, us: &[F], out: &mut [I]) {
+        for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
+            let mut located = [(0, 0); GROUP];
+            for (l, &u) in located.iter_mut().zip(us) {
+                *l = self.locate(u);
+                simd::prefetch(&self.cells, l.0);
+            }
+            for (o, &(c, fraction)) in out.iter_mut().zip(&located) {
+                *o = I::from(self.answer(c, fraction));
+            }
+        }
     }
 }
 
@@ -157,7 +434,7 @@ mod tests {
         let mut p = vec![0.0; n];
         for i in 0..n {
             let [threshold, alias] = t.cells[i];
-            let keep = f64::from_bits(threshold).min(1.0);
+            let keep = f64::from(threshold) / ONE;
             p[i] += keep / n as f64;
             p[alias as usize] += (1.0 - keep) / n as f64;
         }
@@ -172,6 +449,35 @@ mod tests {
             assert!((p - w[i] / 16.0).abs() < 1e-12, "index {i}: {p}");
         }
         assert_eq!(t.sample(1.0), t.sample(f64::ONE_MINUS_EPSILON));
+    }
+
+    #[test]
+    fn blocks_built_apart_make_one_table() {
+        // Several build blocks, runs of zeros and spikes, so that light and
+        // heavy entries pair up across block boundaries.
+        let n = 3 * BLOCK + 1234;
+        let w: Vec<f64> = (0..n)
+            .map(|i| match i % 97 {
+                0 => 500.0,
+                1..=40 => 0.0,
+                k => (k % 13) as f64 * 0.1,
+            })
+            .collect();
+        let t = AliasTable::new(&w).unwrap();
+        for (i, p) in table_pmf(&t).into_iter().enumerate() {
+            let want = t.pmf(i);
+            assert!(
+                (p - want).abs() <= 1e-9 * want + 1e-15,
+                "index {i}: {p} vs {want}"
+            );
+        }
+        let us: Vec<f64> = (0..=100_000).map(|k| k as f64 / 100_000.0).collect();
+        let mut batch = vec![0u64; us.len()];
+        t.sample_into(&us, &mut batch);
+        for (&u, &i) in us.iter().zip(&batch) {
+            assert_eq!(i as usize, t.sample(u));
+            assert!(w[i as usize] > 0.0, "u = {u} gave zero-weight index {i}");
+        }
     }
 
     #[test]

@@ -4,6 +4,8 @@ use super::check_weights;
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
+use crate::parallel;
+use rayon::prelude::*;
 
 /// Tables shorter than this are searched without a guide table: a binary
 /// search over a cache line or two is as fast. (Above it, even a table of a
@@ -11,12 +13,18 @@ use crate::math::Real;
 /// binary search is a chain of dependent loads.)
 const GUIDE_MIN_LEN: usize = 64;
 
+/// Entries per block of the running sums of a long table: each block is
+/// summed from 0 and then offset by the blocks before it, in parallel. Fixed,
+/// so that the sums do not depend on the thread count (a table of at most
+/// one block is summed strictly in order, as Mitsuba does).
+const SUM_BLOCK: usize = 1 << 16;
+
 /// A discrete distribution over the indices `0..n`, with probabilities
 /// proportional to non-negative weights `w`.
 ///
 /// # Probability
 /// `P(i) = w_i / Σ w`. The running sums `C_i = w_0 + … + w_i` are
-/// accumulated in `f64`.
+/// accumulated in `f64` (by blocks of [`SUM_BLOCK`] entries).
 ///
 /// # Sampling
 /// `sample(u)` returns the index `i` with `C_{i−1} < u·Σw ≤ C_i` (as
@@ -50,21 +58,43 @@ impl Discrete1D {
     /// [`Error::TooLarge`] above [`super::MAX_ENTRIES`] entries.
     pub fn new(weights: &[f64]) -> Result<Self> {
         check_weights("weights", weights, |i| format!("[{i}]"))?;
-        Self::from_checked(weights).ok_or(Error::AllZero { arg: "weights" })
+        parallel::install(|| Self::from_checked(weights))?.ok_or(Error::AllZero { arg: "weights" })
     }
 
     /// A distribution from weights already checked to be finite and
-    /// `>= 0`; `None` when they are empty or sum to 0.
+    /// `>= 0`; `None` when they are empty or sum to 0. Tables longer than
+    /// [`SUM_BLOCK`] are summed in parallel (on the current rayon pool).
     pub(crate) fn from_checked(weights: &[f64]) -> Option<Self> {
-        // One pass: the copy of the weights and their running sums.
-        let mut copy = Buffer::zeroed(weights.len());
-        let mut cdf = Buffer::zeroed(weights.len());
+        // The copy of the weights and each block's running sums from 0, in
+        // parallel; then to each block the sum of the blocks before it.
+        let mut copy = Buffer::for_overwrite(weights.len());
+        let mut cdf = Buffer::for_overwrite(weights.len());
+        let totals: Vec<f64> = (
+            cdf.par_chunks_mut(SUM_BLOCK),
+            copy.par_chunks_mut(SUM_BLOCK),
+            weights.par_chunks(SUM_BLOCK),
+        )
+            .into_par_iter()
+            .map(|(cdf, copy, weights)| {
+                let mut acc = 0.0;
+                for ((c, w_copy), &w) in cdf.iter_mut().zip(copy.iter_mut()).zip(weights) {
+                    acc += w;
+                    *c = acc;
+                    *w_copy = w;
+                }
+                acc
+            })
+            .collect();
+        let mut offsets = Vec::with_capacity(totals.len());
         let mut acc = 0.0;
-        for ((c, w_copy), &w) in cdf.iter_mut().zip(copy.iter_mut()).zip(weights) {
-            acc += w;
-            *c = acc;
-            *w_copy = w;
+        for total in &totals {
+            offsets.push(acc);
+            acc += total;
         }
+        cdf.par_chunks_mut(SUM_BLOCK)
+            .zip(offsets)
+            .skip(1)
+            .for_each(|(cdf, offset)| cdf.iter_mut().for_each(|c| *c += offset));
         let first = weights.iter().position(|&w| w > 0.0)?;
         let last = weights.iter().rposition(|&w| w > 0.0)?;
         if !(acc > 0.0 && acc.is_finite()) {
@@ -262,6 +292,23 @@ mod tests {
         for i in 0..n {
             let u = d.cdf[i] / d.sum;
             assert_eq!(d.sample(u), linear(&d, u), "u = C_{i}");
+        }
+    }
+
+    #[test]
+    fn long_tables_are_summed_by_blocks_consistently() {
+        let n = 3 * SUM_BLOCK + 7;
+        let weights: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64).collect();
+        let d = Discrete1D::new(&weights).unwrap();
+        let exact: f64 = weights.iter().sum();
+        assert!((d.sum() - exact).abs() <= 1e-12 * exact);
+        assert!(d.cdf.windows(2).all(|c| c[0] <= c[1]));
+        assert_eq!(d.cdf[n - 1], d.sum());
+        for k in 0..=500 {
+            let u = k as f64 / 500.0;
+            let i = d.sample(u);
+            assert_eq!(i, linear(&d, u), "u = {u}");
+            assert!(weights[i] > 0.0);
         }
     }
 

@@ -24,6 +24,8 @@ pub use discrete2d::Discrete2D;
 pub use piecewise::{PiecewiseConstant1D, PiecewiseConstant2D};
 
 use crate::error::{Error, Result};
+use crate::parallel;
+use rayon::prelude::*;
 
 /// The largest number of entries a table may have (indices are `u32`).
 pub const MAX_ENTRIES: usize = u32::MAX as usize;
@@ -43,9 +45,14 @@ fn check_weights(
         });
     }
     // One branch-free pass for the common case (NaN and ±∞ fail both
-    // comparisons); find the index only on failure.
+    // comparisons), in parallel; find the index only on failure.
     let ok = |w: f64| (0.0..=f64::MAX).contains(&w);
-    if weights.iter().fold(true, |all, &w| all & ok(w)) {
+    let all_ok = parallel::install(|| {
+        weights
+            .par_chunks(1 << 16)
+            .all(|chunk| chunk.iter().fold(true, |all, &w| all & ok(w)))
+    })?;
+    if all_ok {
         return Ok(());
     }
     match weights.iter().position(|&w| !ok(w)) {

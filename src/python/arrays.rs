@@ -298,6 +298,39 @@ where
     finish(out)
 }
 
+/// [`map`] for kernels that take a whole chunk of points at once and
+/// write one value per point (for work shared across points, such as
+/// prefetching table cells): every input value is checked first, and the
+/// kernel runs only on chunks that pass.
+pub fn map_chunks<'py, F, T, const K: usize>(
+    py: Python<'py>,
+    x: &Points<'py, F, K>,
+    check: Check,
+    kernel: impl Fn(&[[F; K]], &mut [T]) + Sync + Send,
+) -> PyResult<Bound<'py, PyAny>>
+where
+    F: PyFloat,
+    T: Element + Copy + Default + Send,
+{
+    let out = zeros::<T>(py, &x.out_shape(1));
+    {
+        let mut guard = out.readwrite();
+        let in_rows = x.rows();
+        let valid = run_batch(py, x.n, guard.as_slice_mut()?, |range, chunk: &mut [T]| {
+            let inputs = &in_rows[range];
+            let ok = inputs.iter().fold(true, |ok, p| ok & check.holds_all(p));
+            if ok {
+                kernel(inputs, chunk);
+            }
+            ok
+        })?;
+        if !valid {
+            return Err(x.invalid(check));
+        }
+    }
+    finish(out)
+}
+
 /// The array results go to: `out` when given (checked to be a writeable,
 /// C-ordered array of `shape` and of dtype `T`, as numpy's ufuncs check
 /// theirs), else a fresh one.

@@ -3,7 +3,7 @@
 //! are built with the GIL released; every `u` is checked to lie in [0, 1]
 //! in the sampling pass.
 
-use super::arrays::{Check, Indices, Points, Table, map, map2, with_precision};
+use super::arrays::{Check, Indices, Points, Table, map, map_chunks, map2, with_precision};
 use super::parallel::detached;
 use crate::distr;
 use crate::math::Real;
@@ -24,6 +24,12 @@ trait IndexTable: Sync {
     fn size(&self) -> usize;
     fn probability(&self, i: usize) -> f64;
     fn draw<F: Real>(&self, u: F) -> usize;
+    /// `out[i] = draw(us[i])` for a batch.
+    fn draw_into<F: Real>(&self, us: &[F], out: &mut [i64]) {
+        for (o, &u) in out.iter_mut().zip(us) {
+            *o = self.draw(u) as i64;
+        }
+    }
 }
 
 impl IndexTable for distr::Discrete1D {
@@ -48,6 +54,9 @@ impl IndexTable for distr::AliasTable {
     fn draw<F: Real>(&self, u: F) -> usize {
         self.sample(u)
     }
+    fn draw_into<F: Real>(&self, us: &[F], out: &mut [i64]) {
+        self.sample_into(us, out);
+    }
 }
 
 /// Indices drawn from `table` for every u (int64, (N,) or a scalar).
@@ -58,7 +67,7 @@ fn sample_indices<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     with_precision!(u, F => {
         let u = Points::<F, 1>::extract(u, "u")?;
-        map(py, &u, Check::Unit, |u| [table.draw(u[0]) as i64])
+        map_chunks(py, &u, Check::Unit, |u, out| table.draw_into(u.as_flattened(), out))
     })
 }
 
@@ -78,7 +87,8 @@ fn pmf_of<'py>(
 
 /// A discrete distribution over 0..n-1 proportional to ``weights``,
 /// sampled by inverting its CDF (binary search on running sums accumulated
-/// in float64, narrowed by a guide table).
+/// in float64, in order within blocks of 65536 entries, narrowed by a guide
+/// table).
 ///
 /// ``sample(u)`` returns the index i with C[i-1] < u * sum <= C[i], as
 /// Mitsuba 3's ``DiscreteDistribution``; an entry of weight 0 is never
@@ -172,10 +182,13 @@ impl PyDiscrete1D {
     }
 }
 
-/// An alias table (Walker's method, built by sweeping): O(1) sampling over
-/// 0..n-1 proportional to ``weights``, with one uniform number per sample.
-/// Same probabilities as ``Discrete1D``, a different map from u to indices;
-/// an entry of weight 0 is never returned.
+/// An alias table (Walker's method, built by a parallel sweep): O(1)
+/// sampling over 0..n-1 proportional to ``weights``, with one uniform number
+/// per sample. Same probabilities as ``Discrete1D`` (each cell's threshold
+/// is rounded to 32 bits), a different map from u to indices; an entry of
+/// weight 0 is never returned. The part of u·n past its cell decides between
+/// the cell and its alias: pass float64 u for large tables (float32 leaves
+/// it 23 - log2(n) bits).
 ///
 /// Parameters
 /// ----------
