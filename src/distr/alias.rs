@@ -296,8 +296,8 @@ impl AliasTable {
         // Pass 3: the sweep as a merge (see [`Orders`]), cut into pieces of
         // [`PIECE`] steps (fixed, so that the table does not depend on the
         // thread count), each starting where the merge path crosses its
-        // first step's diagonal; the pieces run in parallel.
-        // One spare alias slot: pass 4 reads a light's alias for every entry.
+        // first step's diagonal; the pieces run in parallel. `light_alias`
+        // has one spare slot: pass 4 reads a light's alias for every entry.
         let mut light_alias = Buffer::<u32>::for_overwrite(n_light + 1);
         let mut heavy_keep = Buffer::<f64>::for_overwrite(n_heavy);
         let orders = Orders {
