@@ -1,7 +1,7 @@
 //! [`AliasTable`]: O(1) sampling of a discrete distribution (Walker's alias
 //! method, built by a sweep that runs in parallel).
 
-use super::check_weights;
+use super::{GROUP, check_weights};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
@@ -12,10 +12,6 @@ use std::hint::select_unpredictable;
 /// Entries per block of the parallel build. Fixed, so that the table does
 /// not depend on the number of threads.
 const BLOCK: usize = 1 << 16;
-
-/// Draws per group of [`AliasTable::sample_into`]: their cells are located
-/// and prefetched before any is read.
-const GROUP: usize = 64;
 
 /// Steps per piece of the build's merge.
 const PIECE: usize = 1 << 14;

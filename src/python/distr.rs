@@ -23,13 +23,8 @@ fn per_index<'py>(
 trait IndexTable: Sync {
     fn size(&self) -> usize;
     fn probability(&self, i: usize) -> f64;
-    fn draw<F: Real>(&self, u: F) -> usize;
-    /// `out[i] = draw(us[i])` for a batch.
-    fn draw_into<F: Real>(&self, us: &[F], out: &mut [i64]) {
-        for (o, &u) in out.iter_mut().zip(us) {
-            *o = self.draw(u) as i64;
-        }
-    }
+    /// `out[i]`: the index drawn for `us[i]`, for a batch.
+    fn draw_into<F: Real>(&self, us: &[F], out: &mut [i64]);
 }
 
 impl IndexTable for distr::Discrete1D {
@@ -39,8 +34,8 @@ impl IndexTable for distr::Discrete1D {
     fn probability(&self, i: usize) -> f64 {
         self.pmf(i)
     }
-    fn draw<F: Real>(&self, u: F) -> usize {
-        self.sample(u)
+    fn draw_into<F: Real>(&self, us: &[F], out: &mut [i64]) {
+        self.sample_into(us, out);
     }
 }
 
@@ -50,9 +45,6 @@ impl IndexTable for distr::AliasTable {
     }
     fn probability(&self, i: usize) -> f64 {
         self.pmf(i)
-    }
-    fn draw<F: Real>(&self, u: F) -> usize {
-        self.sample(u)
     }
     fn draw_into<F: Real>(&self, us: &[F], out: &mut [i64]) {
         self.sample_into(us, out);
