@@ -185,29 +185,26 @@ impl Discrete1D {
     /// weight. `u` in `[0, 1]`.
     #[inline]
     pub fn sample<F: Real>(&self, u: F) -> usize {
-        self.search(u.f64(), self.guide_cell(u.f64()))
+        let search = self.search();
+        search.index(u.f64(), search.guide_cell(u.f64()))
     }
 
     /// `out[i] = sample(us[i])` for a batch. Groups of draws go in three
-    /// sweeps: locate and prefetch their guide cells, read them and
-    /// prefetch the two ends of each bracket in the running sums, then
-    /// search; so the cache misses of a group overlap rather than queue.
+    /// sweeps: locate their guide cells (prefetched), prefetch both ends of
+    /// each bracket, then search; so the cache misses of a group overlap
+    /// rather than queue.
     pub fn sample_into<F: Real, I: From<u32>>(&self, us: &[F], out: &mut [I]) {
-        let (guide, cdf) = (&self.guide[..], &self.cdf[..]);
+        let search = self.search();
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
             let mut cells = [0; GROUP];
             for (k, &u) in cells.iter_mut().zip(us) {
-                *k = self.guide_cell(u.f64());
-                simd::prefetch(guide, *k);
+                *k = search.locate(u.f64());
             }
             for &k in &cells[..us.len()] {
-                if let Some(&[lo, hi]) = guide.get(k..k + 2).and_then(|g| g.as_array()) {
-                    simd::prefetch(cdf, (lo as usize).saturating_sub(1));
-                    simd::prefetch(cdf, hi as usize);
-                }
+                search.prefetch_bracket(k);
             }
             for ((o, &u), &k) in out.iter_mut().zip(us).zip(&cells) {
-                *o = I::from(self.search(u.f64(), k) as u32);
+                *o = I::from(search.index(u.f64(), k) as u32);
             }
         }
     }
@@ -217,12 +214,39 @@ impl Discrete1D {
     /// number for a second decision.
     #[inline]
     pub fn sample_reuse<F: Real>(&self, u: F) -> (usize, F) {
-        let i = self.sample(u);
-        let value = u.f64() * self.sum;
-        let rescaled = (value - self.sum_before(i)) / self.weights[i];
-        (i, F::c(rescaled.clamp(0.0, f64::ONE_MINUS_EPSILON)))
+        let search = self.search();
+        search.index_reuse(u, search.guide_cell(u.f64()))
     }
 
+    /// The tables as slices, for the steps of a draw.
+    #[inline(always)]
+    pub(crate) fn search(&self) -> Search<'_> {
+        Search {
+            weights: &self.weights,
+            cdf: &self.cdf,
+            guide: &self.guide,
+            sum: self.sum,
+            first: self.first,
+            last: self.last,
+        }
+    }
+}
+
+/// A [`Discrete1D`]'s tables as plain slices, and a draw in steps that a
+/// batch can interleave: [`Search::locate`] the guide cell (prefetched),
+/// [`Search::prefetch_bracket`], then [`Search::index`] or
+/// [`Search::index_reuse`].
+#[derive(Clone, Copy)]
+pub(crate) struct Search<'a> {
+    weights: &'a [f64],
+    cdf: &'a [f64],
+    guide: &'a [u32],
+    sum: f64,
+    first: usize,
+    last: usize,
+}
+
+impl Search<'_> {
     /// The guide cell `⌊u·G⌋` of `u` (clamped to the last cell; 0 without a
     /// guide table).
     #[inline(always)]
@@ -231,13 +255,42 @@ impl Discrete1D {
         ((u * cells as f64) as usize).min(cells.saturating_sub(1))
     }
 
-    /// The index for `u` by binary search within the bracket of guide cell
-    /// `k` (see [`Discrete1D::bracket`]).
+    /// Step 1: the guide cell of `u`, prefetched.
     #[inline(always)]
-    fn search(&self, u: f64, k: usize) -> usize {
+    pub(crate) fn locate(&self, u: f64) -> usize {
+        let k = self.guide_cell(u);
+        simd::prefetch(self.guide, k);
+        k
+    }
+
+    /// Step 2: prefetches the running sums at both ends of guide cell `k`'s
+    /// bracket and the weight at its start.
+    #[inline(always)]
+    pub(crate) fn prefetch_bracket(&self, k: usize) {
+        if let Some(&[lo, hi]) = self.guide.get(k..k + 2) {
+            simd::prefetch(self.cdf, (lo as usize).saturating_sub(1));
+            simd::prefetch(self.cdf, hi as usize);
+            simd::prefetch(self.weights, lo as usize);
+        }
+    }
+
+    /// Step 3: the index for `u` by binary search within the bracket of
+    /// guide cell `k` (see [`Search::bracket`]).
+    #[inline(always)]
+    pub(crate) fn index(&self, u: f64, k: usize) -> usize {
         let value = u * self.sum;
         let (lo, hi) = self.bracket(k, value);
         lo + self.cdf[lo..hi].partition_point(|&c| c < value)
+    }
+
+    /// Step 3 of [`Discrete1D::sample_reuse`]: the index and the rescaled
+    /// `u`.
+    #[inline(always)]
+    pub(crate) fn index_reuse<F: Real>(&self, u: F, k: usize) -> (usize, F) {
+        let i = self.index(u.f64(), k);
+        let before = if i == 0 { 0.0 } else { self.cdf[i - 1] };
+        let rescaled = (u.f64() * self.sum - before) / self.weights[i];
+        (i, F::c(rescaled.clamp(0.0, f64::ONE_MINUS_EPSILON)))
     }
 
     /// The range `[lo, hi]` (inclusive) that holds the answer for `value`:
@@ -246,7 +299,7 @@ impl Discrete1D {
     #[inline(always)]
     fn bracket(&self, k: usize, value: f64) -> (usize, usize) {
         let full = (self.first, self.last);
-        let Some(&[lo, hi]) = self.guide.get(k..k + 2).and_then(|g| g.as_array()) else {
+        let Some(&[lo, hi]) = self.guide.get(k..k + 2) else {
             return full;
         };
         let (lo, hi) = (lo as usize, hi as usize);

@@ -30,7 +30,7 @@ use rayon::prelude::*;
 /// Draws per group of the batch samplers (`sample_into`): each group first
 /// locates and prefetches the table entries its draws will read, then reads
 /// them, so that the cache misses of a group overlap.
-const GROUP: usize = 64;
+pub(crate) const GROUP: usize = 64;
 
 /// The largest number of entries a table may have (indices are `u32`).
 pub const MAX_ENTRIES: usize = u32::MAX as usize;

@@ -1,7 +1,7 @@
 //! Piecewise-constant densities on an interval and on a rectangle, sampled
 //! by inverting their piecewise-linear CDFs.
 
-use super::{Discrete1D, Discrete2D};
+use super::{Discrete1D, Discrete2D, GROUP};
 use crate::error::{Error, Result};
 use crate::math::Real;
 
@@ -239,7 +239,26 @@ impl PiecewiseConstant2D {
     /// `((x, y), p(x, y))` for `u` in `[0, 1]²`.
     #[inline]
     pub fn sample<F: Real>(&self, u: [F; 2]) -> ([F; 2], F) {
-        let ((row, col), r) = self.table.sample_reuse(u);
+        self.place(self.table.sample_reuse(u))
+    }
+
+    /// `out[i] = sample(us[i])` for a batch, drawing the cells with
+    /// [`Discrete2D::sample_reuse_into`] (whose cache misses overlap).
+    pub fn sample_into<F: Real>(&self, us: &[[F; 2]], out: &mut [([F; 2], F)]) {
+        let mut cells = [((0, 0), [F::zero(); 2]); GROUP];
+        for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
+            let cells = &mut cells[..us.len()];
+            self.table.sample_reuse_into(us, cells);
+            for (o, &cell) in out.iter_mut().zip(cells.iter()) {
+                *o = self.place(cell);
+            }
+        }
+    }
+
+    /// The point that the rescaled `r` places in cell `(row, col)`, and
+    /// the density there.
+    #[inline(always)]
+    fn place<F: Real>(&self, ((row, col), r): ((usize, usize), [F; 2])) -> ([F; 2], F) {
         let p = [self.x.point(col, r[0].f64()), self.y.point(row, r[1].f64())];
         (p, F::c(self.cell_pdf(row, col)))
     }

@@ -2,8 +2,9 @@
 //! on a grid of vertices, the form of Mitsuba 3's `Hierarchical2D` (which
 //! its `envmap` emitter samples).
 
-use crate::distr::Discrete2D;
+use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;
+use crate::simd;
 
 /// The bilinear interpolant of `cols × rows` non-negative vertex values,
 /// vertex `(x, y)` at `(x/(cols − 1), y/(rows − 1))`, normalised to a
@@ -73,7 +74,32 @@ impl BilinearGrid {
     /// `(q, p(q))` for `u` in `[0, 1]²`.
     #[inline]
     pub fn sample(&self, u: [f64; 2]) -> ([f64; 2], f64) {
-        let ((row, col), r) = self.patches.sample_reuse(u);
+        self.place(self.patches.sample_reuse(u))
+    }
+
+    /// `out[i] = sample(us[i])` for a batch: the patches by
+    /// [`Discrete2D::sample_reuse_into`], then their corners prefetched
+    /// before any is read.
+    pub fn sample_into(&self, us: &[[f64; 2]], out: &mut [([f64; 2], f64)]) {
+        let mut patches = [((0, 0), [0.0; 2]); GROUP];
+        for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
+            let patches = &mut patches[..us.len()];
+            self.patches.sample_reuse_into(us, patches);
+            for &((row, col), _) in patches.iter() {
+                let i = row * self.cols + col;
+                simd::prefetch(&self.values, i);
+                simd::prefetch(&self.values, i + self.cols);
+            }
+            for (o, &patch) in out.iter_mut().zip(patches.iter()) {
+                *o = self.place(patch);
+            }
+        }
+    }
+
+    /// The point that the rescaled `r` places in patch `(row, col)` by the
+    /// bilinear warp, and the density there.
+    #[inline(always)]
+    fn place(&self, ((row, col), r): ((usize, usize), [f64; 2])) -> ([f64; 2], f64) {
         let c = self.corners(row, col);
         let fy = sample_linear(r[1], c[0] + c[1], c[2] + c[3]);
         let fx = sample_linear(r[0], lerp(fy, c[0], c[2]), lerp(fy, c[1], c[3]));

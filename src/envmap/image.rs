@@ -13,6 +13,7 @@
 use super::mapping::Mapping;
 use crate::error::{Error, Result};
 use crate::math::luminance;
+use crate::simd;
 
 /// RGB texels, row-major, row 0 at the top; a cube map stores its six
 /// `R × R` faces one below the other (`height = 6R`).
@@ -160,6 +161,14 @@ impl Image {
                 }
                 c
             }
+        }
+    }
+
+    /// Prefetches the texels that [`Image::lookup`] reads at `p`.
+    #[inline(always)]
+    pub fn prefetch(&self, mapping: Mapping, p: [f64; 2]) {
+        for i in self.corners(mapping, p).0 {
+            simd::prefetch(&self.texels, i);
         }
     }
 

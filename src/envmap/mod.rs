@@ -41,7 +41,7 @@ pub use image::Image;
 pub use mapping::{Mapping, normalized, polar_angle};
 
 use crate::buffer::Buffer;
-use crate::distr::PiecewiseConstant2D;
+use crate::distr::{GROUP, PiecewiseConstant2D};
 use crate::error::{Error, Result};
 use crate::math::{Real, atan2, sin_cos_turn};
 use crate::parallel;
@@ -241,7 +241,7 @@ pub struct PdfQuery {
 }
 
 /// One sample of [`EnvMap::sample`].
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct EnvSample {
     /// World direction toward the environment (unit length).
     pub direction: V3<f64>,
@@ -407,16 +407,53 @@ impl EnvMap {
         let (q, pdf_q) = match &self.distribution {
             Distribution::Piecewise(table) => table.sample(u),
             Distribution::Bilinear(grid) => grid.sample(u),
-            Distribution::Black => {
-                let d = warp::square_to_uniform_sphere(u);
-                return EnvSample {
-                    direction: self.to_world(d),
-                    pdf: 0.0,
-                    weight: [0.0; 3],
-                };
-            }
+            Distribution::Black => return self.sample_black(u),
         };
-        let p = self.table_to_uv(q);
+        self.sample_at(self.table_to_uv(q), pdf_q)
+    }
+
+    /// `out[i] = sample(us[i])` for a batch, in groups: the table points by
+    /// the tables' batch samplers (whose cache misses overlap), then the
+    /// texels under them prefetched, then the directions, densities and
+    /// radiance.
+    pub fn sample_into(&self, us: &[[f64; 2]], out: &mut [EnvSample]) {
+        let mut drawn = [([0.0; 2], 0.0); GROUP];
+        for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
+            let drawn = &mut drawn[..us.len()];
+            match &self.distribution {
+                Distribution::Piecewise(table) => table.sample_into(us, drawn),
+                Distribution::Bilinear(grid) => grid.sample_into(us, drawn),
+                Distribution::Black => {
+                    for (o, &u) in out.iter_mut().zip(us) {
+                        *o = self.sample_black(u);
+                    }
+                    continue;
+                }
+            }
+            for (q, _) in drawn.iter_mut() {
+                *q = self.table_to_uv(*q);
+                self.image.prefetch(self.options.mapping, *q);
+            }
+            for (o, &(p, pdf_q)) in out.iter_mut().zip(drawn.iter()) {
+                *o = self.sample_at(p, pdf_q);
+            }
+        }
+    }
+
+    /// The sample of an all-black map: a uniform direction that carries no
+    /// light (pdf 0, weight 0).
+    fn sample_black(&self, u: [f64; 2]) -> EnvSample {
+        EnvSample {
+            direction: self.to_world(warp::square_to_uniform_sphere(u)),
+            pdf: 0.0,
+            weight: [0.0; 3],
+        }
+    }
+
+    /// The sample at domain point `p`, drawn with density `pdf_q` per unit
+    /// area of the sampling table.
+    #[inline(always)]
+    fn sample_at(&self, p: [f64; 2], pdf_q: f64) -> EnvSample {
         let local = self.options.mapping.to_dir(p);
         let pdf = pdf_q / self.table_jacobian(local);
         let radiance = self.radiance_at(p);

@@ -115,6 +115,22 @@ fn samples_carry_their_own_pdf_and_weight() {
 }
 
 #[test]
+fn batch_sampling_agrees_with_single_draws() {
+    let black = EnvMap::new(2, 2, &[0.0; 12], Options::default()).unwrap();
+    for m in all_maps().into_iter().chain([black]) {
+        // Not a multiple of the batch group; u = 0 and 1 included.
+        let us: Vec<[f64; 2]> = (0..=300)
+            .map(|k| [(k as f64 * 0.618_033_988_749_895).fract(), k as f64 / 300.0])
+            .collect();
+        let mut out = vec![EnvSample::default(); us.len()];
+        m.sample_into(&us, &mut out);
+        for (&u, o) in us.iter().zip(&out) {
+            assert_eq!(*o, m.sample(u), "{:?}: u = {u:?}", m.options());
+        }
+    }
+}
+
+#[test]
 fn polar_tables_give_the_table_pdf() {
     // The branch-free polar query (f64 and f32) against the table's own
     // density at the same point, on random directions.

@@ -3,10 +3,8 @@
 
 use super::arrays::{Check, Points, PyFloat, finish, map, map_each, with_precision, zeros};
 use super::parallel::{detached, run_batch};
-use crate::envmap::{EnvMap, Mapping, Matrix3, Options, PdfQuery, Sampling};
-
-/// Directions per block of `EnvMap.pdf` (see `pdf_as`).
-const PDF_BLOCK: usize = 256;
+use crate::distr::GROUP;
+use crate::envmap::{EnvMap, EnvSample, Mapping, Matrix3, Options, PdfQuery, Sampling};
 use crate::error::{Error, shape_str};
 use crate::io;
 use crate::simd;
@@ -14,6 +12,9 @@ use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntyped
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
+
+/// Directions per block of `EnvMap.pdf` (see `pdf_as`).
+const PDF_BLOCK: usize = 256;
 
 fn mapping_arg(name: &str) -> PyResult<Mapping> {
     Mapping::from_name(name).ok_or_else(|| {
@@ -337,11 +338,18 @@ impl PyEnvMap {
             let env = &self.0;
             let valid = run_batch(py, u.n, outputs, |range, (o_d, o_p, o_w)| {
                 let mut ok = true;
-                for (k, x) in rows[range].iter().enumerate() {
-                    ok &= Check::Unit.holds_all(x);
-                    let s = env.sample(x.map(|v| v.f64().clamp(0.0, 1.0)));
-                    (o_d[k], o_p[k], o_w[k]) =
-                        (s.direction.map(F::c), F::c(s.pdf), s.weight.map(F::c));
+                let (mut us, mut samples) = ([[0.0; 2]; GROUP], [EnvSample::default(); GROUP]);
+                for (g, rows) in rows[range].chunks(GROUP).enumerate() {
+                    let (us, samples) = (&mut us[..rows.len()], &mut samples[..rows.len()]);
+                    for (u, x) in us.iter_mut().zip(rows) {
+                        ok &= Check::Unit.holds_all(x);
+                        *u = x.map(|v| v.f64().clamp(0.0, 1.0));
+                    }
+                    env.sample_into(us, samples);
+                    for (k, s) in (g * GROUP..).zip(samples.iter()) {
+                        (o_d[k], o_p[k], o_w[k]) =
+                            (s.direction.map(F::c), F::c(s.pdf), s.weight.map(F::c));
+                    }
                 }
                 ok
             })?;
