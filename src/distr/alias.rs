@@ -16,6 +16,9 @@ const BLOCK: usize = 1 << 16;
 /// Steps per piece of the build's merge.
 const PIECE: usize = 1 << 14;
 
+/// Pieces of the merge that one task runs interleaved (see [`Orders::run`]).
+const LANES: usize = 8;
+
 /// `2^32`: thresholds are 32-bit fixed-point fractions of a cell.
 const ONE: f64 = 4_294_967_296.0;
 
@@ -68,7 +71,8 @@ pub struct AliasTable {
     /// fraction of `u·n` past `c`, in 32-bit fixed point, is below the
     /// threshold, else returns the alias. A full cell is its own alias.
     cells: Buffer<[u32; 2]>,
-    pmf: Buffer<f64>,
+    /// The weights as given: `pmf(i) = w_i / Σw`, computed when asked.
+    weights: Buffer<f64>,
     sum: f64,
 }
 
@@ -114,12 +118,11 @@ struct Orders<'a> {
     heavy_index: &'a [u32],
 }
 
-/// A piece of the merge: where it starts, its number of steps and the
-/// outputs of its lights and heavies.
-struct Piece<'a> {
-    k0: usize,
-    j0: usize,
-    steps: usize,
+/// A task of the merge: up to [`LANES`] consecutive pieces, which start at
+/// `corners[..LANES]` and end at the next corner, and the outputs of their
+/// lights (from the first corner's `k`) and heavies (from its `j`).
+struct Task<'a> {
+    corners: &'a [(usize, usize)],
     alias: &'a mut [u32],
     keep: &'a mut [f64],
 }
@@ -142,22 +145,66 @@ impl Orders<'_> {
         (lo, d - lo)
     }
 
-    /// Runs `piece`. Both outputs of a step are written (no unpredictable
-    /// branch): a slot written early is written again by its own step.
-    fn run(&self, piece: &mut Piece) {
-        let n_light = self.deficit_before.len() - 1;
-        let (mut k, mut j) = (piece.k0, piece.j0);
-        for _ in 0..piece.steps {
-            let (deficit, surplus) = (self.deficit_before[k], self.surplus_through[j]);
-            let light = (k < n_light) & (deficit < surplus);
-            if let Some(a) = piece.alias.get_mut(k - piece.k0) {
-                *a = self.heavy_index[j];
+    /// The step from `(k, j)`: whether light `k` goes before heavy `j`
+    /// closes, and the two outputs it would write (light `k`'s alias, heavy
+    /// `j`'s share of its cell).
+    #[inline(always)]
+    fn step(&self, k: usize, j: usize) -> (bool, u32, f64) {
+        let (deficit, surplus) = (self.deficit_before[k], self.surplus_through[j]);
+        let light = (k + 1 < self.deficit_before.len()) & (deficit < surplus);
+        (light, self.heavy_index[j], 1.0 - (deficit - surplus))
+    }
+
+    /// Runs `task`. A piece's steps form a chain of dependent loads, so its
+    /// pieces run interleaved, one step of each in turn (twice the speed of
+    /// one after another). Both outputs of a step are written (no
+    /// unpredictable branch), so a slot may be written early and is written
+    /// again by its own step; but the last steps of a piece also write the
+    /// first slots of the next one, which are therefore written again after
+    /// the interleaved run.
+    fn run(&self, task: &mut Task) {
+        let (k_base, j_base) = task.corners[0];
+        let pieces = task.corners.len() - 1;
+        let steps = |p: usize| {
+            let [(k0, j0), (k1, j1)] = [task.corners[p], task.corners[p + 1]];
+            k1 - k0 + j1 - j0
+        };
+        let interleaved = pieces == LANES && (0..LANES).all(|p| steps(p) == PIECE);
+        if interleaved {
+            let mut at: [(usize, usize); LANES] = std::array::from_fn(|p| task.corners[p]);
+            for _ in 0..PIECE {
+                for (k, j) in &mut at {
+                    let (light, alias, keep) = self.step(*k, *j);
+                    if let Some(a) = task.alias.get_mut(*k - k_base) {
+                        *a = alias;
+                    }
+                    if let Some(x) = task.keep.get_mut(*j - j_base) {
+                        *x = keep;
+                    }
+                    *k += light as usize;
+                    *j += !light as usize;
+                }
             }
-            if let Some(x) = piece.keep.get_mut(j - piece.j0) {
-                *x = 1.0 - (deficit - surplus);
+        }
+        // The pieces not run interleaved, and the first light and first
+        // heavy of each interleaved piece after the first: step by step,
+        // each slot written by its own step only.
+        for p in usize::from(interleaved)..pieces {
+            let (mut k, mut j) = task.corners[p];
+            let (mut lights, mut heavies) = (0, 0);
+            for _ in 0..steps(p) {
+                if interleaved && lights > 0 && heavies > 0 {
+                    break;
+                }
+                let (light, alias, keep) = self.step(k, j);
+                if light {
+                    task.alias[k - k_base] = alias;
+                    (k, lights) = (k + 1, lights + 1);
+                } else {
+                    task.keep[j - j_base] = keep;
+                    (j, heavies) = (j + 1, heavies + 1);
+                }
             }
-            k += light as usize;
-            j += !light as usize;
         }
     }
 }
@@ -187,7 +234,18 @@ impl AliasTable {
     }
 
     fn build(weights: &[f64]) -> Result<Self> {
-        let block_totals: Vec<f64> = weights.par_chunks(BLOCK).map(lane_sum).collect();
+        // The sum, by blocks, and the copy of the weights that `pmf` reads
+        // (dividing by the sum only when asked keeps divisions out of the
+        // build).
+        let mut copy = Buffer::<f64>::for_overwrite(weights.len());
+        let block_totals: Vec<f64> = copy
+            .par_chunks_mut(BLOCK)
+            .zip(weights.par_chunks(BLOCK))
+            .map(|(copy, w)| {
+                copy.copy_from_slice(w);
+                lane_sum(w)
+            })
+            .collect();
         let sum: f64 = block_totals.iter().sum();
         if !(sum > 0.0 && sum.is_finite()) {
             return Err(Error::AllZero { arg: "weights" });
@@ -195,29 +253,26 @@ impl AliasTable {
         let n = weights.len();
         let to_share = n as f64 / sum;
 
-        // Pass 1: the probabilities, and in each block of `key` and `pos`
-        // its light entries in order from the front (with the deficit of
-        // the block's lights before each) and its heavy entries from the
-        // back (with the surplus of the block's heavies through each).
+        // Pass 1: in each block of `key` and `pos` its light entries in
+        // order from the front (with the deficit of the block's lights
+        // before each) and its heavy entries from the back (with the surplus
+        // of the block's heavies through each).
         // Branch-free: every entry is written to both ends with the same
         // value; the slot not taken is overwritten by a later entry of that
         // kind, or is the other kind's last slot, written last.
-        let mut pmf = Buffer::<f64>::for_overwrite(n);
         let mut key = Buffer::<f64>::for_overwrite(n);
         let mut pos = Buffer::<u32>::for_overwrite(n);
         let blocks: Vec<BlockSums> = (
-            pmf.par_chunks_mut(BLOCK),
             key.par_chunks_mut(BLOCK),
             pos.par_chunks_mut(BLOCK),
             weights.par_chunks(BLOCK),
         )
             .into_par_iter()
             .enumerate()
-            .map(|(b, (pmf, key, pos, w))| {
-                let (last, sum, to_share) = (w.len() - 1, sum, to_share);
+            .map(|(b, (key, pos, w))| {
+                let (last, to_share) = (w.len() - 1, to_share);
                 let mut sums = BlockSums::default();
-                for (i, (p, &w)) in pmf.iter_mut().zip(w).enumerate() {
-                    *p = w / sum;
+                for (i, &w) in w.iter().enumerate() {
                     let s = w * to_share;
                     let light = s < 1.0;
                     // Selections by arithmetic (exact for 0/1 factors), which
@@ -245,7 +300,11 @@ impl AliasTable {
                 .par_iter_mut()
                 .enumerate()
                 .for_each(|(i, c)| *c = [u32::MAX, i as u32]);
-            return Ok(AliasTable { cells, pmf, sum });
+            return Ok(AliasTable {
+                cells,
+                weights: copy,
+                sum,
+            });
         }
 
         // Pass 2: the two orders over all blocks: σ_L(k) for k = 0..=n_light
@@ -305,22 +364,21 @@ impl AliasTable {
         let corners: Vec<(usize, usize)> = (0..=steps.div_ceil(PIECE))
             .map(|p| orders.corner((p * PIECE).min(steps)))
             .collect();
-        let mut pieces = Vec::with_capacity(corners.len());
+        let mut tasks = Vec::with_capacity(corners.len() / LANES + 1);
         let (mut aliases, mut keeps) = (&mut light_alias[..], &mut heavy_keep[..]);
-        for corner in corners.windows(2) {
-            let [(k0, j0), (k1, j1)] = [corner[0], corner[1]];
+        for start in (0..corners.len() - 1).step_by(LANES) {
+            let corners = &corners[start..=(start + LANES).min(corners.len() - 1)];
+            let [(k0, j0), (k1, j1)] = [corners[0], corners[corners.len() - 1]];
             let (alias, rest_a) = aliases.split_at_mut(k1 - k0);
             let (keep, rest_k) = keeps.split_at_mut(j1 - j0);
             (aliases, keeps) = (rest_a, rest_k);
-            pieces.push(Piece {
-                k0,
-                j0,
-                steps: k1 - k0 + j1 - j0,
+            tasks.push(Task {
+                corners,
                 alias,
                 keep,
             });
         }
-        pieces.par_iter_mut().for_each(|piece| orders.run(piece));
+        tasks.par_iter_mut().for_each(|task| orders.run(task));
         heavy_keep[n_heavy - 1] = 1.0;
 
         // Pass 4: each block's cells from the two orders; heavy j's alias is
@@ -351,17 +409,21 @@ impl AliasTable {
                     j += !light as usize;
                 }
             });
-        Ok(AliasTable { cells, pmf, sum })
+        Ok(AliasTable {
+            cells,
+            weights: copy,
+            sum,
+        })
     }
 
     /// Number of entries.
     pub fn len(&self) -> usize {
-        self.pmf.len()
+        self.weights.len()
     }
 
     /// Whether the table has no entries (never true for a built table).
     pub fn is_empty(&self) -> bool {
-        self.pmf.is_empty()
+        self.weights.is_empty()
     }
 
     /// The sum of the weights.
@@ -371,7 +433,7 @@ impl AliasTable {
 
     /// Probability of index `i`: `w_i / Σw` (0 outside the table).
     pub fn pmf(&self, i: usize) -> f64 {
-        self.pmf.get(i).copied().unwrap_or(0.0)
+        self.weights.get(i).map_or(0.0, |&w| w / self.sum)
     }
 
     /// The cell of `u` and the fraction of `u·n` past it, in 32-bit fixed
@@ -450,8 +512,10 @@ mod tests {
     #[test]
     fn blocks_built_apart_make_one_table() {
         // Several build blocks, runs of zeros and spikes, so that light and
-        // heavy entries pair up across block boundaries.
+        // heavy entries pair up across block boundaries; the merge has one
+        // task of interleaved pieces and one of fewer pieces, run in turn.
         let n = 3 * BLOCK + 1234;
+        assert!(n > (LANES + 1) * PIECE && n < 2 * LANES * PIECE);
         let w: Vec<f64> = (0..n)
             .map(|i| match i % 97 {
                 0 => 500.0,
