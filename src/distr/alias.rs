@@ -1,7 +1,7 @@
 //! [`AliasTable`]: O(1) sampling of a discrete distribution (Walker's alias
 //! method, built by a sweep that runs in parallel).
 
-use super::{GROUP, check_weights};
+use super::{GROUP, check_len, find_invalid, is_weight};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
@@ -229,23 +229,26 @@ impl AliasTable {
     /// # Errors
     /// As [`super::Discrete1D::new`].
     pub fn new(weights: &[f64]) -> Result<Self> {
-        check_weights("weights", weights, |i| format!("[{i}]"))?;
+        check_len("weights", weights.len())?;
         parallel::install(|| Self::build(weights))?
     }
 
     fn build(weights: &[f64]) -> Result<Self> {
         // The sum, by blocks, and the copy of the weights that `pmf` reads
         // (dividing by the sum only when asked keeps divisions out of the
-        // build).
+        // build); the weights are checked on the way.
         let mut copy = Buffer::<f64>::for_overwrite(weights.len());
-        let block_totals: Vec<f64> = copy
+        let (block_totals, valid): (Vec<f64>, Vec<bool>) = copy
             .par_chunks_mut(BLOCK)
             .zip(weights.par_chunks(BLOCK))
             .map(|(copy, w)| {
                 copy.copy_from_slice(w);
-                lane_sum(w)
+                (lane_sum(w), w.iter().fold(true, |all, &w| all & is_weight(w)))
             })
-            .collect();
+            .unzip();
+        if !valid.into_iter().all(|v| v) {
+            find_invalid("weights", weights, |i| format!("[{i}]"))?;
+        }
         let sum: f64 = block_totals.iter().sum();
         if !(sum > 0.0 && sum.is_finite()) {
             return Err(Error::AllZero { arg: "weights" });

@@ -1,6 +1,6 @@
 //! [`Discrete1D`]: a discrete distribution sampled by inverting its CDF.
 
-use super::{GROUP, check_weights};
+use super::{GROUP, check_len, find_invalid, is_weight};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
@@ -57,49 +57,68 @@ impl Discrete1D {
     /// [`Error::AllZero`] if the table is empty or sums to 0,
     /// [`Error::TooLarge`] above [`super::MAX_ENTRIES`] entries.
     pub fn new(weights: &[f64]) -> Result<Self> {
-        check_weights("weights", weights, |i| format!("[{i}]"))?;
-        parallel::install(|| Self::from_checked(weights))?.ok_or(Error::AllZero { arg: "weights" })
+        check_len("weights", weights.len())?;
+        let (table, valid) = parallel::install(|| Self::build(weights))?;
+        if !valid {
+            find_invalid("weights", weights, |i| format!("[{i}]"))?;
+        }
+        table.ok_or(Error::AllZero { arg: "weights" })
     }
 
     /// A distribution from weights already checked to be finite and
-    /// `>= 0`; `None` when they are empty or sum to 0. Tables longer than
-    /// [`SUM_BLOCK`] are summed in parallel (on the current rayon pool).
+    /// `>= 0`; `None` when they are empty or sum to 0.
     pub(crate) fn from_checked(weights: &[f64]) -> Option<Self> {
+        Self::build(weights).0
+    }
+
+    /// The distribution of `weights` (`None` when they are empty or do not
+    /// sum to a positive finite number), and whether every weight is finite
+    /// and `>= 0` (checked on the way; a table from invalid weights is
+    /// meaningless). Tables longer than [`SUM_BLOCK`] are summed in
+    /// parallel (on the current rayon pool).
+    fn build(weights: &[f64]) -> (Option<Self>, bool) {
         // The copy of the weights and each block's running sums from 0, in
         // parallel; then to each block the sum of the blocks before it.
         let mut copy = Buffer::for_overwrite(weights.len());
         let mut cdf = Buffer::for_overwrite(weights.len());
-        let totals: Vec<f64> = (
+        let (totals, valid): (Vec<f64>, Vec<bool>) = (
             cdf.par_chunks_mut(SUM_BLOCK),
             copy.par_chunks_mut(SUM_BLOCK),
             weights.par_chunks(SUM_BLOCK),
         )
             .into_par_iter()
             .map(|(cdf, copy, weights)| {
-                let mut acc = 0.0;
+                let (mut acc, mut valid) = (0.0, true);
                 for ((c, w_copy), &w) in cdf.iter_mut().zip(copy.iter_mut()).zip(weights) {
                     acc += w;
                     *c = acc;
                     *w_copy = w;
+                    valid &= is_weight(w);
                 }
-                acc
+                (acc, valid)
             })
-            .collect();
+            .unzip();
+        let valid = valid.into_iter().all(|v| v);
         let mut offsets = Vec::with_capacity(totals.len());
         let mut acc = 0.0;
         for total in &totals {
             offsets.push(acc);
             acc += total;
         }
+        let positive = |w: &f64| *w > 0.0;
+        let (Some(first), Some(last)) = (
+            weights.iter().position(positive),
+            weights.iter().rposition(positive),
+        ) else {
+            return (None, valid);
+        };
+        if !(valid && acc > 0.0 && acc.is_finite()) {
+            return (None, valid);
+        }
         cdf.par_chunks_mut(SUM_BLOCK)
             .zip(offsets)
             .skip(1)
             .for_each(|(cdf, offset)| cdf.iter_mut().for_each(|c| *c += offset));
-        let first = weights.iter().position(|&w| w > 0.0)?;
-        let last = weights.iter().rposition(|&w| w > 0.0)?;
-        if !(acc > 0.0 && acc.is_finite()) {
-            return None;
-        }
         let mut table = Discrete1D {
             weights: copy,
             cdf,
@@ -109,7 +128,7 @@ impl Discrete1D {
             guide: Buffer::zeroed(0),
         };
         table.guide = table.build_guide();
-        Some(table)
+        (Some(table), valid)
     }
 
     fn build_guide(&self) -> Buffer<u32> {

@@ -35,32 +35,31 @@ pub(crate) const GROUP: usize = 64;
 /// The largest number of entries a table may have (indices are `u32`).
 pub const MAX_ENTRIES: usize = u32::MAX as usize;
 
-/// Checks that every weight is finite and `>= 0` and that there are at most
-/// [`MAX_ENTRIES`]; `index` formats the position of an offending entry.
-fn check_weights(
-    arg: &'static str,
-    weights: &[f64],
-    index: impl Fn(usize) -> String,
-) -> Result<()> {
-    if weights.len() > MAX_ENTRIES {
+/// Whether `w` may be a weight: finite and `>= 0` (NaN and ±∞ fail both
+/// comparisons). Branch-free.
+#[inline(always)]
+fn is_weight(w: f64) -> bool {
+    (0.0..=f64::MAX).contains(&w)
+}
+
+/// Checks that a table of `len` entries has at most [`MAX_ENTRIES`].
+fn check_len(arg: &'static str, len: usize) -> Result<()> {
+    if len > MAX_ENTRIES {
         return Err(Error::TooLarge {
             arg,
-            len: weights.len(),
+            len,
             max: MAX_ENTRIES,
         });
     }
-    // One branch-free pass for the common case (NaN and ±∞ fail both
-    // comparisons), in parallel; find the index only on failure.
-    let ok = |w: f64| (0.0..=f64::MAX).contains(&w);
-    let all_ok = parallel::install(|| {
-        weights
-            .par_chunks(1 << 16)
-            .all(|chunk| chunk.iter().fold(true, |all, &w| all & ok(w)))
-    })?;
-    if all_ok {
-        return Ok(());
-    }
-    match weights.iter().position(|&w| !ok(w)) {
+    Ok(())
+}
+
+/// The error for the first entry of `weights` that is not a weight (see
+/// [`is_weight`]; `index` formats its position), or `Ok` if there is none.
+/// For builders that check their weights in their first pass and look for
+/// the culprit only on failure.
+fn find_invalid(arg: &'static str, weights: &[f64], index: impl Fn(usize) -> String) -> Result<()> {
+    match weights.iter().position(|&w| !is_weight(w)) {
         Some(i) => Err(Error::InvalidWeight {
             arg,
             index: index(i),
@@ -68,4 +67,25 @@ fn check_weights(
         }),
         None => Ok(()),
     }
+}
+
+/// Checks that every weight is finite and `>= 0` and that there are at most
+/// [`MAX_ENTRIES`]; `index` formats the position of an offending entry.
+fn check_weights(
+    arg: &'static str,
+    weights: &[f64],
+    index: impl Fn(usize) -> String,
+) -> Result<()> {
+    check_len(arg, weights.len())?;
+    // One branch-free pass for the common case, in parallel; find the index
+    // only on failure.
+    let all_ok = parallel::install(|| {
+        weights
+            .par_chunks(1 << 16)
+            .all(|chunk| chunk.iter().fold(true, |all, &w| all & is_weight(w)))
+    })?;
+    if all_ok {
+        return Ok(());
+    }
+    find_invalid(arg, weights, index)
 }
