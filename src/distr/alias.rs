@@ -243,7 +243,10 @@ impl AliasTable {
             .zip(weights.par_chunks(BLOCK))
             .map(|(copy, w)| {
                 copy.copy_from_slice(w);
-                (lane_sum(w), w.iter().fold(true, |all, &w| all & is_weight(w)))
+                (
+                    lane_sum(w),
+                    w.iter().fold(true, |all, &w| all & is_weight(w)),
+                )
             })
             .unzip();
         if !valid.into_iter().all(|v| v) {
