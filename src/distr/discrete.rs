@@ -189,10 +189,7 @@ impl Discrete1D {
 
     /// Running sum of the weights before entry `i`: `C_{i−1}` (0 for i = 0).
     pub fn sum_before(&self, i: usize) -> f64 {
-        match i {
-            0 => 0.0,
-            _ => self.cdf.get(i - 1).copied().unwrap_or(self.sum),
-        }
+        self.search().sum_before(i)
     }
 
     /// Cumulative probability `P(index ≤ i) = C_i / Σw` (1 past the end).
@@ -307,9 +304,17 @@ impl Search<'_> {
     #[inline(always)]
     pub(crate) fn index_reuse<F: Real>(&self, u: F, k: usize) -> (usize, F) {
         let i = self.index(u.f64(), k);
-        let before = if i == 0 { 0.0 } else { self.cdf[i - 1] };
-        let rescaled = (u.f64() * self.sum - before) / self.weights[i];
+        let rescaled = (u.f64() * self.sum - self.sum_before(i)) / self.weights[i];
         (i, F::c(rescaled.clamp(0.0, f64::ONE_MINUS_EPSILON)))
+    }
+
+    /// `C_{i−1}` (0 for i = 0, Σw past the end).
+    #[inline(always)]
+    fn sum_before(&self, i: usize) -> f64 {
+        match i {
+            0 => 0.0,
+            _ => self.cdf.get(i - 1).copied().unwrap_or(self.sum),
+        }
     }
 
     /// The range `[lo, hi]` (inclusive) that holds the answer for `value`:

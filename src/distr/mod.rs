@@ -42,6 +42,12 @@ fn is_weight(w: f64) -> bool {
     (0.0..=f64::MAX).contains(&w)
 }
 
+/// Whether every entry of `weights` is a weight (see [`is_weight`]), in one
+/// branch-free pass.
+fn all_weights(weights: &[f64]) -> bool {
+    weights.iter().fold(true, |all, &w| all & is_weight(w))
+}
+
 /// Checks that a table of `len` entries has at most [`MAX_ENTRIES`].
 fn check_len(arg: &'static str, len: usize) -> Result<()> {
     if len > MAX_ENTRIES {
@@ -79,11 +85,7 @@ fn check_weights(
     check_len(arg, weights.len())?;
     // One branch-free pass for the common case, in parallel; find the index
     // only on failure.
-    let all_ok = parallel::install(|| {
-        weights
-            .par_chunks(1 << 16)
-            .all(|chunk| chunk.iter().fold(true, |all, &w| all & is_weight(w)))
-    })?;
+    let all_ok = parallel::install(|| weights.par_chunks(1 << 16).all(all_weights))?;
     if all_ok {
         return Ok(());
     }
