@@ -1,5 +1,5 @@
 //! [`AliasTable`]: O(1) sampling of a discrete distribution (Walker's alias
-//! method, built by a sweep that runs in parallel).
+//! method, built block by block in parallel).
 
 use super::{GROUP, all_weights, check_len, find_invalid};
 use crate::buffer::Buffer;
@@ -9,15 +9,12 @@ use crate::{parallel, simd};
 use rayon::prelude::*;
 use std::hint::select_unpredictable;
 
-/// Entries per block of the parallel build. Fixed, so that the table does
-/// not depend on the number of threads.
-const BLOCK: usize = 1 << 16;
+/// Entries per block of the build: a block's sweep runs in the core's own
+/// cache. Fixed, so that the table does not depend on the number of threads.
+const BLOCK: usize = 1 << 13;
 
-/// Steps per piece of the build's merge.
-const PIECE: usize = 1 << 14;
-
-/// Pieces of the merge that one task runs interleaved (see [`Orders::run`]).
-const LANES: usize = 8;
+/// Pieces of a merge, run interleaved (see [`Orders::run`]).
+const LANES: usize = 4;
 
 /// `2^32`: thresholds are 32-bit fixed-point fractions of a cell.
 const ONE: f64 = 4_294_967_296.0;
@@ -40,25 +37,31 @@ const ONE: f64 = 4_294_967_296.0;
 /// `f64` numbers for large tables.
 ///
 /// # Construction
-/// Entries with `s < 1` are light, the others heavy, each kept in index
-/// order. The sweep of Hübschle-Schneider and Sanders lets the current heavy
-/// entry top up light cells in order while its residual exceeds 1, and then
+/// Entries with `s < 1` are light, the others heavy, each kept in order.
+/// The sweep of Hübschle-Schneider and Sanders lets the current heavy entry
+/// top up light cells in order while its residual exceeds 1, and then
 /// closes it as a cell of its own, topped up by the next heavy entry. With
 /// the deficits `σ_L(k) = Σ_{k'<k} (1 − s_{L_k'})` of the first `k` light
 /// entries and the surpluses `σ_H(j) = Σ_{j'<j} (s_{H_j'} − 1)` of the first
-/// `j` heavy ones, that sweep is a merge:
-/// - light `k` takes as alias the heavy `j` with `σ_H(j) ≤ σ_L(k) < σ_H(j+1)`
-///   (the last heavy when there is none);
+/// `j` heavy ones, that sweep is a merge (see [`Orders`]):
+/// - light `k` takes as alias the heavy `j` with `σ_H(j) ≤ σ_L(k) < σ_H(j+1)`;
 /// - heavy `j` closes after the `i` light entries with `σ_L(k) < σ_H(j+1)`,
 ///   keeping `1 − (σ_L(i) − σ_H(j+1))` of its cell, and takes heavy `j+1` as
-///   alias (the last heavy keeps its whole cell).
+///   alias.
 ///
-/// The build runs in parallel: the classification and prefix sums by
-/// blocks of entries, the merge by pieces of its path (each started by a
-/// binary search on its diagonal, as in a parallel merge sort), the cells
-/// again by blocks. Thresholds come from the prefix sums directly, so they
-/// carry no round-off accumulated along the sweep, and the table is the
-/// same whatever the number of threads.
+/// The build sweeps each block of [`BLOCK`] entries on its own, in parallel
+/// and in cache, and leaves over what the block cannot settle: when its
+/// heavies' surplus `S` exceeds its lights' deficit `D`, the heavies from
+/// the first with `σ_H(j+1) > D` on (the first with its residual surplus
+/// `σ_H(j+1) − D`); otherwise its last heavy, whose cell keeps
+/// `1 − (σ_L(i) − S)` (`i` the first light with `σ_L(i) ≥ S`), and the
+/// lights from `i` on. One last sweep of the leftovers of all blocks, in
+/// block order, settles them; its last heavy keeps its whole cell. Random
+/// weights leave a few percent of the entries over; weights sorted by size
+/// leave most of them, and the build then takes about twice as long.
+/// Thresholds come from prefix sums over one block (or over the
+/// leftovers), never from a residual carried along the sweep, and the
+/// table is the same whatever the number of threads.
 ///
 /// # References
 /// M. D. Vose, "A linear algorithm for generating random numbers with a
@@ -76,22 +79,12 @@ pub struct AliasTable {
     sum: f64,
 }
 
-/// What the first pass learns of a block of entries: the number of light
-/// entries, the sum of their deficits `1 − s` and that of the heavy
-/// entries' surpluses `s − 1`.
-#[derive(Clone, Copy, Default)]
-struct BlockSums {
-    lights: usize,
-    deficit: f64,
-    surplus: f64,
-}
-
 /// The cell of entry `index` that keeps it with probability `keep` and
 /// otherwise returns `alias`: a full cell (`keep ≥ 1`) is its own alias, and
-/// an entry of positive weight keeps at least the smallest threshold, so
+/// an entry of positive share keeps at least the smallest threshold, so
 /// that round-off cannot make it unreachable. Branch-free.
 #[inline(always)]
-fn cell(index: usize, keep: f64, alias: u32, positive: bool) -> [u32; 2] {
+fn cell(index: u32, keep: f64, alias: u32, positive: bool) -> [u32; 2] {
     // `keep·2^32` rounded to the nearest integer by adding 2^52, where the
     // spacing of doubles is 1: no conversion, whose range checks branch.
     const SHIFT: f64 = 4_503_599_627_370_496.0;
@@ -100,13 +93,13 @@ fn cell(index: usize, keep: f64, alias: u32, positive: bool) -> [u32; 2] {
     let full = bits > u64::from(u32::MAX);
     [
         select_unpredictable(full, u32::MAX, bits as u32),
-        select_unpredictable(full, index as u32, alias),
+        select_unpredictable(full, index, alias),
     ]
 }
 
-/// The light and heavy orders of pass 2 of [`AliasTable::new`]'s build:
-/// `σ_L(k)` for `k = 0..=n_light`, `σ_H(j+1)` for each heavy `j` (+∞ for the
-/// last heavy, which never closes), and the heavy entries' indices.
+/// The light and heavy orders of a sweep: `σ_L(k)` for `k = 0..=n_light`,
+/// `σ_H(j+1)` for each heavy `j` (+∞ for the last heavy, which never
+/// closes), and which items the heavies are (see [`Sweep`]).
 ///
 /// The sweep is their merge: light `k` is swept before heavy `j` closes iff
 /// `σ_L(k) < σ_H(j+1)`. A light step gives light `k` heavy `j` as its
@@ -115,16 +108,7 @@ fn cell(index: usize, keep: f64, alias: u32, positive: bool) -> [u32; 2] {
 struct Orders<'a> {
     deficit_before: &'a [f64],
     surplus_through: &'a [f64],
-    heavy_index: &'a [u32],
-}
-
-/// A task of the merge: up to [`LANES`] consecutive pieces, which start at
-/// `corners[..LANES]` and end at the next corner, and the outputs of their
-/// lights (from the first corner's `k`) and heavies (from its `j`).
-struct Task<'a> {
-    corners: &'a [(usize, usize)],
-    alias: &'a mut [u32],
-    keep: &'a mut [f64],
+    heavy_item: &'a [u32],
 }
 
 impl Orders<'_> {
@@ -146,67 +130,235 @@ impl Orders<'_> {
     }
 
     /// The step from `(k, j)`: whether light `k` goes before heavy `j`
-    /// closes, and the two outputs it would write (light `k`'s alias, heavy
-    /// `j`'s share of its cell).
+    /// closes, and the two outputs it would write (light `k`'s alias, the
+    /// item of heavy `j`; heavy `j`'s share of its cell).
     #[inline(always)]
     fn step(&self, k: usize, j: usize) -> (bool, u32, f64) {
         let (deficit, surplus) = (self.deficit_before[k], self.surplus_through[j]);
         let light = (k + 1 < self.deficit_before.len()) & (deficit < surplus);
-        (light, self.heavy_index[j], 1.0 - (deficit - surplus))
+        (light, self.heavy_item[j], 1.0 - (deficit - surplus))
     }
 
-    /// Runs `task`. A piece's steps form a chain of dependent loads, so its
-    /// pieces run interleaved, one step of each in turn (measured: the merge
-    /// in 1.9–2.1 ms rather than 2.7–3.0 for 10^6 entries; twice the speed
-    /// on data already in cache). Both outputs of a step are written (no
-    /// unpredictable branch), so a slot may be written early and is written
-    /// again by its own step; but the last steps of a piece also write the
-    /// first slots of the next one, which are therefore written again after
-    /// the interleaved run.
-    fn run(&self, task: &mut Task) {
-        let (k_base, j_base) = task.corners[0];
-        let pieces = task.corners.len() - 1;
+    /// Runs the merge: `alias[k]` for each light `k` (`alias` has a spare
+    /// slot past the last) and `keep[j]` for each heavy `j` but the last.
+    /// The steps form a chain of dependent loads,
+    /// so the merge runs as [`LANES`] pieces, interleaved one step of each
+    /// in turn, each started where the merge path crosses its first step's
+    /// diagonal (measured: twice the speed of one step after another). Both
+    /// outputs of a step are written (no unpredictable branch), so a slot
+    /// may be written early and is written again by its own step; but the
+    /// last steps of a piece also write the first slots of the next one,
+    /// which are therefore written again at the end.
+    fn run(&self, alias: &mut [u32], keep: &mut [f64]) {
+        let steps = self.deficit_before.len() + self.surplus_through.len() - 2;
+        let piece = steps.div_ceil(LANES);
+        let corners: [(usize, usize); LANES + 1] =
+            std::array::from_fn(|p| self.corner((p * piece).min(steps)));
         let steps = |p: usize| {
-            let [(k0, j0), (k1, j1)] = [task.corners[p], task.corners[p + 1]];
+            let [(k0, j0), (k1, j1)] = [corners[p], corners[p + 1]];
             k1 - k0 + j1 - j0
         };
-        let interleaved = pieces == LANES && (0..LANES).all(|p| steps(p) == PIECE);
-        if interleaved {
-            let mut at: [(usize, usize); LANES] = std::array::from_fn(|p| task.corners[p]);
-            for _ in 0..PIECE {
-                for (k, j) in &mut at {
-                    let (light, alias, keep) = self.step(*k, *j);
-                    if let Some(a) = task.alias.get_mut(*k - k_base) {
-                        *a = alias;
-                    }
-                    if let Some(x) = task.keep.get_mut(*j - j_base) {
-                        *x = keep;
-                    }
-                    *k += light as usize;
-                    *j += !light as usize;
-                }
+        let mut step = |(k, j): &mut (usize, usize)| {
+            let (light, a, x) = self.step(*k, *j);
+            alias[*k] = a;
+            keep[*j] = x;
+            *k += light as usize;
+            *j += !light as usize;
+        };
+        let mut at: [(usize, usize); LANES] = std::array::from_fn(|p| corners[p]);
+        let common = (0..LANES).map(steps).min().unwrap_or(0);
+        for _ in 0..common {
+            for lane in &mut at {
+                step(lane);
             }
         }
-        // The pieces not run interleaved, and the first light and first
-        // heavy of each interleaved piece after the first: step by step,
-        // each slot written by its own step only.
-        for p in usize::from(interleaved)..pieces {
-            let (mut k, mut j) = task.corners[p];
+        for (p, lane) in at.iter_mut().enumerate() {
+            for _ in common..steps(p) {
+                step(lane);
+            }
+        }
+        // The first light and first heavy of each piece after the first:
+        // step by step, each slot written by its own step only.
+        for p in 1..LANES {
+            let (mut k, mut j) = corners[p];
             let (mut lights, mut heavies) = (0, 0);
             for _ in 0..steps(p) {
-                if interleaved && lights > 0 && heavies > 0 {
+                if lights > 0 && heavies > 0 {
                     break;
                 }
-                let (light, alias, keep) = self.step(k, j);
+                let (light, a, x) = self.step(k, j);
                 if light {
-                    task.alias[k - k_base] = alias;
+                    alias[k] = a;
                     (k, lights) = (k + 1, lights + 1);
                 } else {
-                    task.keep[j - j_base] = keep;
+                    keep[j] = x;
                     (j, heavies) = (j + 1, heavies + 1);
                 }
             }
         }
+    }
+}
+
+/// The arrays of one sweep over a sequence of items `0..count` (entries
+/// and their shares), kept from block to block: the orders (see
+/// [`Orders`]), which items the lights are, and the merge's outputs. Each
+/// array is longer than the sweep needs: only the prefixes of length
+/// `n_light` (`+ 1` for the deficits) and `n_heavy` hold its values.
+#[derive(Default)]
+struct Sweep {
+    deficit_before: Vec<f64>,
+    light_item: Vec<u32>,
+    surplus_through: Vec<f64>,
+    heavy_item: Vec<u32>,
+    light_alias: Vec<u32>,
+    heavy_keep: Vec<f64>,
+    n_light: usize,
+    n_heavy: usize,
+}
+
+impl Sweep {
+    /// Sorts the items `0..count`, of shares `share(t)`, into lights and
+    /// heavies, in order, with their running deficits and surpluses.
+    /// Branch-free: every item is written to both orders at their current
+    /// ends; the slot not taken is overwritten by the next item of that
+    /// kind, or lies past its order.
+    fn classify(&mut self, count: usize, share: impl Fn(usize) -> f64) {
+        let len = count + 1;
+        for v in [
+            &mut self.deficit_before,
+            &mut self.surplus_through,
+            &mut self.heavy_keep,
+        ] {
+            v.resize(len.max(v.len()), 0.0);
+        }
+        for v in [
+            &mut self.light_item,
+            &mut self.heavy_item,
+            &mut self.light_alias,
+        ] {
+            v.resize(len.max(v.len()), 0);
+        }
+        // Slices held in locals, so that the stores cannot be taken to
+        // alias the vectors' own fields.
+        let (deficit_before, light_item) =
+            (&mut self.deficit_before[..len], &mut self.light_item[..len]);
+        let (surplus_through, heavy_item) = (
+            &mut self.surplus_through[..len],
+            &mut self.heavy_item[..len],
+        );
+        let (mut lights, mut heavies) = (0, 0);
+        let (mut deficit, mut surplus) = (0.0, 0.0);
+        for t in 0..count {
+            let s = share(t);
+            let light = s < 1.0;
+            deficit_before[lights] = deficit;
+            light_item[lights] = t as u32;
+            surplus += (s - 1.0).max(0.0);
+            surplus_through[heavies] = surplus;
+            heavy_item[heavies] = t as u32;
+            deficit += (1.0 - s).max(0.0);
+            lights += light as usize;
+            heavies += !light as usize;
+        }
+        deficit_before[lights] = deficit;
+        (self.n_light, self.n_heavy) = (lights, heavies);
+    }
+
+    /// The lights' total deficit `σ_L(n_light)`.
+    fn deficit(&self) -> f64 {
+        self.deficit_before[self.n_light]
+    }
+
+    /// The heavies' total surplus `σ_H(n_heavy)`.
+    fn surplus(&self) -> f64 {
+        self.surplus_through[self.n_heavy - 1]
+    }
+
+    /// Merges the orders (at least one heavy), the last heavy never
+    /// closing: the aliases of all lights and the shares of all heavies
+    /// (the last keeps its whole cell).
+    fn merge(&mut self) {
+        let (n_light, n_heavy) = (self.n_light, self.n_heavy);
+        let total_surplus = self.surplus();
+        self.surplus_through[n_heavy - 1] = f64::INFINITY;
+        let orders = Orders {
+            deficit_before: &self.deficit_before[..=n_light],
+            surplus_through: &self.surplus_through[..n_heavy],
+            heavy_item: &self.heavy_item[..n_heavy],
+        };
+        orders.run(
+            &mut self.light_alias[..=n_light],
+            &mut self.heavy_keep[..n_heavy],
+        );
+        self.heavy_keep[n_heavy - 1] = 1.0;
+        self.surplus_through[n_heavy - 1] = total_surplus;
+    }
+
+    /// Writes the cells of the first `lights` lights and `heavies` heavies
+    /// after [`Sweep::merge`]: item `t` is entry `entry(t)` of share
+    /// `share(t)`, at `cells[entry(t) - base]`; heavy `j`'s alias is heavy
+    /// `j + 1`.
+    fn write_cells(
+        &self,
+        (lights, heavies): (usize, usize),
+        (entry, share): (impl Fn(u32) -> u32, impl Fn(u32) -> f64),
+        cells: &mut [[u32; 2]],
+        base: usize,
+    ) {
+        for (&t, &alias) in self.light_item[..lights].iter().zip(&self.light_alias) {
+            let (e, s) = (entry(t), share(t));
+            cells[e as usize - base] = cell(e, s, entry(alias), s > 0.0);
+        }
+        let next = self.heavy_item[1..self.n_heavy]
+            .iter()
+            .chain(&self.heavy_item[self.n_heavy - 1..]);
+        for ((&t, &keep), &next) in self.heavy_item[..heavies]
+            .iter()
+            .zip(&self.heavy_keep)
+            .zip(next)
+        {
+            let e = entry(t);
+            cells[e as usize - base] = cell(e, keep, entry(next), true);
+        }
+    }
+
+    /// Sweeps the block of `weights` that starts at entry `base` into its
+    /// cells, and appends what it leaves over to `leftovers` as `(entry,
+    /// share)` (see [`AliasTable`]'s construction).
+    fn block(
+        &mut self,
+        weights: &[f64],
+        base: usize,
+        to_share: f64,
+        cells: &mut [[u32; 2]],
+        leftovers: &mut Vec<(u32, f64)>,
+    ) {
+        let entry = |t: u32| (base + t as usize) as u32;
+        let share = |t: u32| weights[t as usize] * to_share;
+        self.classify(weights.len(), |t| weights[t] * to_share);
+        let item = |t: &u32| (entry(*t), share(*t));
+        if self.n_heavy == 0 {
+            leftovers.extend(self.light_item[..self.n_light].iter().map(item));
+            return;
+        }
+        let (deficit, surplus) = (self.deficit(), self.surplus());
+        self.merge();
+        let heavies = &self.surplus_through[..self.n_heavy];
+        let settled = if surplus > deficit {
+            let first = heavies.partition_point(|&s| s <= deficit);
+            let rest = &self.heavy_item[first..self.n_heavy];
+            leftovers.push((entry(rest[0]), 1.0 + (heavies[first] - deficit)));
+            leftovers.extend(rest[1..].iter().map(item));
+            (self.n_light, first)
+        } else {
+            let first = self.deficit_before[..self.n_light].partition_point(|&d| d < surplus);
+            let last = self.n_heavy - 1;
+            let keep = 1.0 - (self.deficit_before[first] - surplus);
+            leftovers.push((entry(self.heavy_item[last]), keep));
+            leftovers.extend(self.light_item[first..self.n_light].iter().map(item));
+            (first, last)
+        };
+        self.write_cells(settled, (entry, share), cells, base);
     }
 }
 
@@ -254,165 +406,37 @@ impl AliasTable {
         if !(sum > 0.0 && sum.is_finite()) {
             return Err(Error::AllZero { arg: "weights" });
         }
-        let n = weights.len();
-        let to_share = n as f64 / sum;
+        let to_share = weights.len() as f64 / sum;
 
-        // Pass 1: in each block of `key` and `pos` its light entries in
-        // order from the front (with the deficit of the block's lights
-        // before each) and its heavy entries from the back (with the surplus
-        // of the block's heavies through each).
-        // Branch-free: every entry is written to both ends with the same
-        // value; the slot not taken is overwritten by a later entry of that
-        // kind, or is the other kind's last slot, written last.
-        let mut key = Buffer::<f64>::for_overwrite(n);
-        let mut pos = Buffer::<u32>::for_overwrite(n);
-        let blocks: Vec<BlockSums> = (
-            key.par_chunks_mut(BLOCK),
-            pos.par_chunks_mut(BLOCK),
-            weights.par_chunks(BLOCK),
-        )
-            .into_par_iter()
-            .enumerate()
-            .map(|(b, (key, pos, w))| {
-                let (last, to_share) = (w.len() - 1, to_share);
-                let mut sums = BlockSums::default();
-                for (i, &w) in w.iter().enumerate() {
-                    let s = w * to_share;
-                    let light = s < 1.0;
-                    // Selections by arithmetic (exact for 0/1 factors), which
-                    // compilers do not turn into branches.
-                    let is_light = f64::from(u8::from(light));
-                    sums.surplus += (s - 1.0).max(0.0);
-                    let value = is_light * sums.deficit + (1.0 - is_light) * sums.surplus;
-                    let heavies = i - sums.lights;
-                    let index = (b * BLOCK + i) as u32;
-                    (key[sums.lights], key[last - heavies]) = (value, value);
-                    (pos[sums.lights], pos[last - heavies]) = (index, index);
-                    sums.deficit += (1.0 - s).max(0.0);
-                    sums.lights += light as usize;
-                }
-                sums
-            })
-            .collect();
-        let n_light: usize = blocks.iter().map(|b| b.lights).sum();
-        let n_heavy = n - n_light;
-        let mut cells = Buffer::<[u32; 2]>::for_overwrite(n);
-        if n_heavy == 0 {
-            // Only round-off leaves no entry at or above its share (all
-            // weights then nearly equal and positive): every cell is full.
-            cells
-                .par_iter_mut()
-                .enumerate()
-                .for_each(|(i, c)| *c = [u32::MAX, i as u32]);
-            return Ok(AliasTable {
-                cells,
-                weights: copy,
-                sum,
-            });
-        }
-
-        // Pass 2: the two orders over all blocks: σ_L(k) for k = 0..=n_light
-        // (σ_L(n_light) the total deficit) and σ_H(j+1) for each heavy j
-        // (+∞ for the last, which never closes), with the heavies' indices.
-        let mut deficit_before = Buffer::<f64>::for_overwrite(n_light + 1);
-        let mut surplus_through = Buffer::<f64>::for_overwrite(n_heavy);
-        let mut heavy_index = Buffer::<u32>::for_overwrite(n_heavy);
-        let total_deficit = {
-            let mut parts = Vec::with_capacity(blocks.len());
-            let (mut lights, mut heavies, mut indices) = (
-                &mut deficit_before[..n_light],
-                &mut surplus_through[..],
-                &mut heavy_index[..],
-            );
-            let (mut deficit, mut surplus) = (0.0, 0.0);
-            for (b, sums) in blocks.iter().enumerate() {
-                let n_h = (n - b * BLOCK).min(BLOCK) - sums.lights;
-                let (l, rest_l) = lights.split_at_mut(sums.lights);
-                let (h, rest_h) = heavies.split_at_mut(n_h);
-                let (x, rest_x) = indices.split_at_mut(n_h);
-                parts.push((l, h, x, deficit, surplus));
-                (lights, heavies, indices) = (rest_l, rest_h, rest_x);
-                deficit += sums.deficit;
-                surplus += sums.surplus;
-            }
-            parts
-                .into_par_iter()
-                .zip(key.par_chunks(BLOCK).zip(pos.par_chunks(BLOCK)))
-                .for_each(|((l, h, x, deficit, surplus), (key, pos))| {
-                    for (d, &k) in l.iter_mut().zip(key) {
-                        *d = deficit + k;
-                    }
-                    let back = key.iter().zip(pos).rev();
-                    for ((s, i), (&k, &p)) in h.iter_mut().zip(x.iter_mut()).zip(back) {
-                        (*s, *i) = (surplus + k, p);
-                    }
-                });
-            deficit
-        };
-        deficit_before[n_light] = total_deficit;
-        surplus_through[n_heavy - 1] = f64::INFINITY;
-
-        // Pass 3: the sweep as a merge (see [`Orders`]), cut into pieces of
-        // [`PIECE`] steps (fixed, so that the table does not depend on the
-        // thread count), each starting where the merge path crosses its
-        // first step's diagonal; the pieces run in parallel. `light_alias`
-        // has one spare slot: pass 4 reads a light's alias for every entry.
-        let mut light_alias = Buffer::<u32>::for_overwrite(n_light + 1);
-        let mut heavy_keep = Buffer::<f64>::for_overwrite(n_heavy);
-        let orders = Orders {
-            deficit_before: &deficit_before,
-            surplus_through: &surplus_through,
-            heavy_index: &heavy_index,
-        };
-        let steps = n_light + n_heavy - 1;
-        let corners: Vec<(usize, usize)> = (0..=steps.div_ceil(PIECE))
-            .map(|p| orders.corner((p * PIECE).min(steps)))
-            .collect();
-        let mut tasks = Vec::with_capacity(corners.len() / LANES + 1);
-        let (mut aliases, mut keeps) = (&mut light_alias[..], &mut heavy_keep[..]);
-        for start in (0..corners.len() - 1).step_by(LANES) {
-            let corners = &corners[start..=(start + LANES).min(corners.len() - 1)];
-            let [(k0, j0), (k1, j1)] = [corners[0], corners[corners.len() - 1]];
-            let (alias, rest_a) = aliases.split_at_mut(k1 - k0);
-            let (keep, rest_k) = keeps.split_at_mut(j1 - j0);
-            (aliases, keeps) = (rest_a, rest_k);
-            tasks.push(Task {
-                corners,
-                alias,
-                keep,
-            });
-        }
-        tasks.par_iter_mut().for_each(|task| orders.run(task));
-        heavy_keep[n_heavy - 1] = 1.0;
-
-        // Pass 4: each block's cells from the two orders; heavy j's alias is
-        // heavy j+1.
-        let (light_alias, heavy_keep) = (&light_alias[..], &heavy_keep[..]);
-        let heavy_index = &heavy_index[..];
-        let mut starts = Vec::with_capacity(blocks.len());
-        let mut light_start = 0;
-        for (b, sums) in blocks.iter().enumerate() {
-            starts.push((light_start, b * BLOCK - light_start));
-            light_start += sums.lights;
-        }
-        cells
+        // Each block swept on its own, then the leftovers of all blocks.
+        let mut cells = Buffer::<[u32; 2]>::for_overwrite(weights.len());
+        let leftovers: Vec<Vec<(u32, f64)>> = cells
             .par_chunks_mut(BLOCK)
             .zip(weights.par_chunks(BLOCK))
-            .zip(starts)
             .enumerate()
-            .for_each(|(b, ((cells, w), (mut k, mut j)))| {
-                for (i, (c, &w)) in cells.iter_mut().zip(w).enumerate() {
-                    let s = w * to_share;
-                    let light = s < 1.0;
-                    let heavy = j.min(n_heavy - 1);
-                    let keep = select_unpredictable(light, s, heavy_keep[heavy]);
-                    let next = heavy_index[(heavy + 1).min(n_heavy - 1)];
-                    let alias = select_unpredictable(light, light_alias[k], next);
-                    *c = cell(b * BLOCK + i, keep, alias, w > 0.0);
-                    k += light as usize;
-                    j += !light as usize;
-                }
-            });
+            .map_init(Sweep::default, |sweep, (b, (cells, w))| {
+                let mut leftovers = Vec::new();
+                sweep.block(w, b * BLOCK, to_share, cells, &mut leftovers);
+                leftovers
+            })
+            .collect();
+        let leftovers: Vec<(u32, f64)> = leftovers.into_iter().flatten().collect();
+        let mut sweep = Sweep::default();
+        sweep.classify(leftovers.len(), |t| leftovers[t].1);
+        if sweep.n_heavy == 0 {
+            // Only round-off leaves no heavy entry over (the lights left
+            // over then lack almost nothing): every cell left is full.
+            for &(e, s) in &leftovers {
+                cells[e as usize] = cell(e, 1.0, e, s > 0.0);
+            }
+        } else {
+            sweep.merge();
+            let item = (
+                |t: u32| leftovers[t as usize].0,
+                |t: u32| leftovers[t as usize].1,
+            );
+            sweep.write_cells((sweep.n_light, sweep.n_heavy), item, &mut cells, 0);
+        }
         Ok(AliasTable {
             cells,
             weights: copy,
@@ -490,48 +514,43 @@ mod tests {
     use proptest::prelude::*;
 
     /// The probability of each index, read off the table: each cell gives
-    /// `threshold/n` to itself and the rest to its alias.
-    fn table_pmf(t: &AliasTable) -> Vec<f64> {
+    /// `threshold/n` to itself and the rest to its alias; and the number of
+    /// cells that give each index some probability.
+    fn table_pmf(t: &AliasTable) -> (Vec<f64>, Vec<usize>) {
         let n = t.len();
-        let mut p = vec![0.0; n];
+        let (mut p, mut cells) = (vec![0.0; n], vec![0; n]);
         for i in 0..n {
             let [threshold, alias] = t.cells[i];
             let keep = f64::from(threshold) / ONE;
             p[i] += keep / n as f64;
             p[alias as usize] += (1.0 - keep) / n as f64;
+            cells[i] += 1;
+            cells[alias as usize] += usize::from(alias as usize != i);
         }
-        p
+        (p, cells)
     }
 
     #[test]
     fn table_realises_the_pmf() {
         let w = [0.0, 1.0, 0.0, 2.0, 3.0, 0.0, 10.0];
         let t = AliasTable::new(&w).unwrap();
-        for (i, p) in table_pmf(&t).into_iter().enumerate() {
+        for (i, p) in table_pmf(&t).0.into_iter().enumerate() {
             assert!((p - w[i] / 16.0).abs() < 1e-12, "index {i}: {p}");
         }
         assert_eq!(t.sample(1.0), t.sample(f64::ONE_MINUS_EPSILON));
     }
 
-    #[test]
-    fn blocks_built_apart_make_one_table() {
-        // Several build blocks, runs of zeros and spikes, so that light and
-        // heavy entries pair up across block boundaries; the merge has one
-        // task of interleaved pieces and one of fewer pieces, run in turn.
-        let n = 3 * BLOCK + 1234;
-        assert!(n > (LANES + 1) * PIECE && n < 2 * LANES * PIECE);
-        let w: Vec<f64> = (0..n)
-            .map(|i| match i % 97 {
-                0 => 500.0,
-                1..=40 => 0.0,
-                k => (k % 13) as f64 * 0.1,
-            })
-            .collect();
-        let t = AliasTable::new(&w).unwrap();
-        for (i, p) in table_pmf(&t).into_iter().enumerate() {
+    /// Asserts that `t` realises its pmf (up to the rounding of each
+    /// threshold to 32 bits, `2^-32/n` at most in each cell that gives the
+    /// entry probability) and that batch and single draws agree and never
+    /// return an entry of weight 0.
+    fn check_table(t: &AliasTable, w: &[f64]) {
+        let n = t.len() as f64;
+        let (pmf, cells) = table_pmf(t);
+        for (i, (p, cells)) in pmf.into_iter().zip(cells).enumerate() {
             let want = t.pmf(i);
             assert!(
-                (p - want).abs() <= 1e-9 * want + 1e-15,
+                (p - want).abs() <= 1e-12 * want + cells as f64 / (ONE * n),
                 "index {i}: {p} vs {want}"
             );
         }
@@ -542,6 +561,29 @@ mod tests {
             assert_eq!(i as usize, t.sample(u));
             assert!(w[i as usize] > 0.0, "u = {u} gave zero-weight index {i}");
         }
+    }
+
+    #[test]
+    fn blocks_built_apart_make_one_table() {
+        // Several blocks and a short one, runs of zeros and spikes, so that
+        // blocks leave lights or heavies over.
+        let w: Vec<f64> = (0..3 * BLOCK + 1234)
+            .map(|i| match i % 97 {
+                0 => 500.0,
+                1..=40 => 0.0,
+                k => (k % 13) as f64 * 0.1,
+            })
+            .collect();
+        check_table(&AliasTable::new(&w).unwrap(), &w);
+    }
+
+    #[test]
+    fn sorted_weights_leave_everything_over() {
+        // Blocks of lights only, then of heavies only: the last sweep
+        // settles nearly all entries.
+        let n = 12 * BLOCK + 77;
+        let w: Vec<f64> = (0..n).map(|i| (i / 3) as f64).collect();
+        check_table(&AliasTable::new(&w).unwrap(), &w);
     }
 
     #[test]
@@ -562,7 +604,7 @@ mod tests {
                     let i = t.sample(u);
                     prop_assert!(weights[i] > 0.0, "u = {} gave zero-weight index {}", u, i);
                 }
-                for (i, p) in table_pmf(&t).into_iter().enumerate() {
+                for (i, p) in table_pmf(&t).0.into_iter().enumerate() {
                     prop_assert!((p - t.pmf(i)).abs() < 1e-9, "index {}: {} vs {}", i, p, t.pmf(i));
                 }
             }
