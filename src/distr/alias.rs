@@ -179,8 +179,7 @@ impl Orders<'_> {
         }
         // The first light and first heavy of each piece after the first:
         // step by step, each slot written by its own step only.
-        for p in 1..LANES {
-            let (mut k, mut j) = corners[p];
+        for (p, &(mut k, mut j)) in corners.iter().enumerate().take(LANES).skip(1) {
             let (mut lights, mut heavies) = (0, 0);
             for _ in 0..steps(p) {
                 if lights > 0 && heavies > 0 {
