@@ -144,7 +144,8 @@ impl Orders<'_> {
     /// The steps form a chain of dependent loads,
     /// so the merge runs as [`LANES`] pieces, interleaved one step of each
     /// in turn, each started where the merge path crosses its first step's
-    /// diagonal (measured: twice the speed of one step after another). Both
+    /// diagonal (measured: the build of 10^6 entries takes 3.9 ms rather
+    /// than 5.6 ms with one step after another). Both
     /// outputs of a step are written (no unpredictable branch), so a slot
     /// may be written early and is written again by its own step; but the
     /// last steps of a piece also write the first slots of the next one,
