@@ -127,14 +127,16 @@ impl Image {
         luminance(self.texel(i))
     }
 
-    /// The texels around `p` and their weights (see the module docs).
+    /// The texels around `p` (in the mapping's domain, lat-long `s` in
+    /// `[0, 1]`) and their weights (see the module docs).
     #[inline]
     pub fn corners(&self, mapping: Mapping, p: [f64; 2]) -> Corners {
         let (w, h) = (self.width, self.height);
         match mapping {
             Mapping::LatLong => {
+                // `p[0]` in [0, 1]: one wrap below 0 (no call to `floor`).
                 let x = p[0] - 0.5 / w as f64;
-                let x = (x - x.floor()) * w as f64;
+                let x = (x + f64::from(u8::from(x < 0.0))) * w as f64;
                 let y = p[1].clamp(0.0, 1.0) * (h - 1) as f64;
                 let (x0, y0) = ((x as usize).min(w - 1), (y as usize).min(h - 2));
                 let (fx, fy) = ((x - x0 as f64).clamp(0.0, 1.0), y - y0 as f64);

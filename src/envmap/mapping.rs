@@ -83,21 +83,31 @@ impl Mapping {
     /// give the direction at the same angle on its edge (−Z).
     #[inline]
     pub fn to_dir(self, p: [f64; 2]) -> V3<f64> {
+        self.to_dir_and_sin(p).0
+    }
+
+    /// [`Mapping::to_dir`], and the sine of the direction's angle to the
+    /// polar axis of the mapping's sampling table (+Y for lat-long, +Z for
+    /// angular; 0 for cube maps, which have none), as the direction's
+    /// formula has it (`sin(π t)`, `sin(π r)`).
+    #[inline(always)]
+    pub fn to_dir_and_sin(self, p: [f64; 2]) -> (V3<f64>, f64) {
         let [s, t] = p;
         match self {
             Mapping::LatLong => {
                 let (sin_theta, cos_theta) = sin_cos_turn(0.5 * t);
                 let (sin_phi, cos_phi) = sin_cos_turn(s);
-                [sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta]
+                let d = [sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta];
+                (d, sin_theta)
             }
             Mapping::Angular => {
                 let (a, b) = (2.0 * s - 1.0, 1.0 - 2.0 * t);
                 let r = (a * a + b * b).sqrt();
                 if r == 0.0 {
-                    return [0.0, 0.0, 1.0];
+                    return ([0.0, 0.0, 1.0], 0.0);
                 }
                 let (sin_theta, cos_theta) = sin_cos_turn(0.5 * r.min(1.0));
-                [a / r * sin_theta, b / r * sin_theta, cos_theta]
+                ([a / r * sin_theta, b / r * sin_theta, cos_theta], sin_theta)
             }
             Mapping::Cube => {
                 let face = (t.max(0.0) as usize).min(5);
@@ -106,7 +116,7 @@ impl Mapping {
                 let v: V3<f64> =
                     std::array::from_fn(|k| major[k] + sc * s_axis[k] + tc * t_axis[k]);
                 let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                v.map(|x| x / norm)
+                (v.map(|x| x / norm), 0.0)
             }
         }
     }

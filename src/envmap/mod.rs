@@ -58,6 +58,13 @@ const IDENTITY: Matrix3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// the polar tables, as in Mitsuba's envmap pdf.
 const SIN_FLOOR: f64 = 1.0 / 16_777_216.0;
 
+/// `dω/dq` of a polar sampling table at a direction `θ` from its axis:
+/// `2π² max(|sin θ|, 2⁻²⁴)` (see [`SIN_FLOOR`]).
+#[inline(always)]
+fn polar_jacobian(sin_theta: f64) -> f64 {
+    2.0 * PI * PI * sin_theta.abs().max(SIN_FLOOR)
+}
+
 /// The luminance weights of Mitsuba 3's `luminance()`, used in
 /// [`Sampling::Mitsuba`] mode so that its density is Mitsuba's.
 const MITSUBA_LUMINANCE: [f64; 3] = [0.212671, 0.715160, 0.072169];
@@ -451,20 +458,24 @@ impl EnvMap {
     }
 
     /// The sample at domain point `p`, drawn with density `pdf_q` per unit
-    /// area of the sampling table.
+    /// area of the sampling table. The Jacobian takes sin θ from the
+    /// direction's own formula (a unit vector by construction): no
+    /// normalisation, as [`EnvMap::table_jacobian`] needs for a query.
     #[inline(always)]
     fn sample_at(&self, p: [f64; 2], pdf_q: f64) -> EnvSample {
-        let local = self.options.mapping.to_dir(p);
-        let pdf = pdf_q / self.table_jacobian(local);
+        let mapping = self.options.mapping;
+        let (local, sin_theta) = mapping.to_dir_and_sin(p);
+        let jacobian = match mapping {
+            Mapping::Cube => mapping.jacobian(p),
+            _ => polar_jacobian(sin_theta),
+        };
+        let pdf = pdf_q / jacobian;
         let radiance = self.radiance_at(p);
+        let inv_pdf = if pdf > 0.0 { 1.0 / pdf } else { 0.0 };
         EnvSample {
             direction: self.to_world(local),
             pdf,
-            weight: if pdf > 0.0 {
-                radiance.map(|l| l / pdf)
-            } else {
-                [0.0; 3]
-            },
+            weight: radiance.map(|l| l * inv_pdf),
         }
     }
 
@@ -511,7 +522,7 @@ impl EnvMap {
     #[inline(always)]
     fn table_jacobian(&self, d: V3<f64>) -> f64 {
         let d = normalized(d);
-        let polar = |x: f64, y: f64| 2.0 * PI * PI * (x * x + y * y).sqrt().max(SIN_FLOOR);
+        let polar = |x: f64, y: f64| polar_jacobian((x * x + y * y).sqrt());
         match self.options.mapping {
             Mapping::LatLong => polar(d[0], d[2]),
             Mapping::Angular => polar(d[0], d[1]),
