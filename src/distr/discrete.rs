@@ -304,8 +304,22 @@ impl Search<'_> {
     #[inline(always)]
     pub(crate) fn index_reuse<F: Real>(&self, u: F, k: usize) -> (usize, F) {
         let i = self.index(u.f64(), k);
+        (i, self.rescale(u, i))
+    }
+
+    /// Prefetches the weight of index `i`, which [`Search::rescale`] reads
+    /// (the running sum before it is in the bracket just searched).
+    #[inline(always)]
+    pub(crate) fn prefetch_weight(&self, i: usize) {
+        simd::prefetch(self.weights, i);
+    }
+
+    /// The leftover of `u` past the running sum before index `i`, rescaled
+    /// to `[0, 1)` by its weight.
+    #[inline(always)]
+    pub(crate) fn rescale<F: Real>(&self, u: F, i: usize) -> F {
         let rescaled = (u.f64() * self.sum - self.sum_before(i)) / self.weights[i];
-        (i, F::c(rescaled.clamp(0.0, f64::ONE_MINUS_EPSILON)))
+        F::c(rescaled.clamp(0.0, f64::ONE_MINUS_EPSILON))
     }
 
     /// `C_{i−1}` (0 for i = 0, Σw past the end).

@@ -140,8 +140,8 @@ impl Discrete2D {
     /// `out[i] = sample_reuse(us[i])` for a batch, in groups whose steps are
     /// interleaved as [`Discrete1D::sample_into`]'s: the marginal's guide
     /// cells, its brackets, the rows (and the conditionals' guide cells),
-    /// their brackets, then the columns; the cache misses of a group
-    /// overlap.
+    /// their brackets, the columns (prefetching their weights), then the
+    /// rescaled `u` of each column; the cache misses of a group overlap.
     pub fn sample_reuse_into<F: Real>(&self, us: &[[F; 2]], out: &mut [((usize, usize), [F; 2])]) {
         let marginal = self.marginal.search();
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
@@ -167,8 +167,14 @@ impl Discrete2D {
             for ((o, u), &k) in out.iter_mut().zip(us).zip(&cells) {
                 // The marginal never draws a row of weight 0.
                 if let Some(c) = &self.conditionals[o.0.0] {
-                    let (col, u_col) = c.search().index_reuse(u[0], k);
-                    (o.0.1, o.1[0]) = (col, u_col);
+                    let search = c.search();
+                    o.0.1 = search.index(u[0].f64(), k);
+                    search.prefetch_weight(o.0.1);
+                }
+            }
+            for (o, u) in out.iter_mut().zip(us) {
+                if let Some(c) = &self.conditionals[o.0.0] {
+                    o.1[0] = c.search().rescale(u[0], o.0.1);
                 }
             }
         }
