@@ -58,7 +58,9 @@ const ONE: f64 = 4_294_967_296.0;
 /// lights from `i` on. One last sweep of the leftovers of all blocks, in
 /// block order, settles them; its last heavy keeps its whole cell. Random
 /// weights leave a few percent of the entries over; weights sorted by size
-/// leave most of them, and the build then takes about twice as long.
+/// leave most of them, and the last sweep, on one thread and on freshly
+/// allocated arrays, then dominates (measured for 10^6 entries: 56–63 ms
+/// sorted, against 4.9–6.4 ms for the same weights in random order).
 /// Thresholds come from prefix sums over one block (or over the
 /// leftovers), never from a residual carried along the sweep, and the
 /// table is the same whatever the number of threads.
