@@ -337,7 +337,7 @@ impl Sweep {
     ) {
         let entry = |t: u32| (base + t as usize) as u32;
         let share = |t: u32| weights[t as usize] * to_share;
-        self.classify(weights.len(), |t| weights[t] * to_share);
+        self.classify(weights.len(), |t| share(t as u32));
         let item = |t: &u32| (entry(*t), share(*t));
         if self.n_heavy == 0 {
             leftovers.extend(self.light_item[..self.n_light].iter().map(item));
