@@ -12,7 +12,7 @@
 
 use super::mapping::Mapping;
 use crate::error::{Error, Result};
-use crate::math::luminance;
+use crate::math::{Real, luminance};
 use crate::simd;
 
 /// RGB texels, row-major, row 0 at the top; a cube map stores its six
@@ -25,8 +25,8 @@ pub struct Image {
 }
 
 /// The four texels around a point and their bilinear weights (all 0
-/// where the map has no light).
-pub type Corners = ([usize; 4], [f64; 4]);
+/// where the map has no light), in the float type of the point.
+pub type Corners<F> = ([usize; 4], [F; 4]);
 
 impl Image {
     /// An image of `width × height` RGB texels (`data` row-major, 3 floats
@@ -128,18 +128,20 @@ impl Image {
     }
 
     /// The texels around `p` (in the mapping's domain, lat-long `s` in
-    /// `[0, 1]`) and their weights (see the module docs).
+    /// `[0, 1]`) and their weights (see the module docs), computed in `F`.
     #[inline]
-    pub fn corners(&self, mapping: Mapping, p: [f64; 2]) -> Corners {
+    pub fn corners<F: Real>(&self, mapping: Mapping, p: [F; 2]) -> Corners<F> {
         let (w, h) = (self.width, self.height);
+        let (zero, one) = (F::zero(), F::one());
         match mapping {
             Mapping::LatLong => {
                 // `p[0]` in [0, 1]: one wrap below 0 (no call to `floor`).
-                let x = p[0] - 0.5 / w as f64;
-                let x = (x + f64::from(u8::from(x < 0.0))) * w as f64;
-                let y = p[1].clamp(0.0, 1.0) * (h - 1) as f64;
-                let (x0, y0) = ((x as usize).min(w - 1), (y as usize).min(h - 2));
-                let (fx, fy) = ((x - x0 as f64).clamp(0.0, 1.0), y - y0 as f64);
+                let x = p[0] - F::c(0.5 / w as f64);
+                let x = (x + if x < zero { one } else { zero }) * F::c(w as f64);
+                let y = p[1].max(zero).min(one) * F::c((h - 1) as f64);
+                let (x0, y0) = ((x.f64() as usize).min(w - 1), (y.f64() as usize).min(h - 2));
+                let fx = (x - F::c(x0 as f64)).max(zero).min(one);
+                let fy = y - F::c(y0 as f64);
                 let x1 = if x0 + 1 == w { 0 } else { x0 + 1 };
                 quad([x0, x1], [y0, y0 + 1], w, fx, fy)
             }
@@ -147,8 +149,8 @@ impl Image {
                 let face_rows = w;
                 let (face, t) = match mapping {
                     Mapping::Cube => {
-                        let face = (p[1].max(0.0) as usize).min(5);
-                        (face, p[1] - face as f64)
+                        let face = (p[1].max(zero).f64() as usize).min(5);
+                        (face, p[1] - F::c(face as f64))
                     }
                     _ => (0, p[1]),
                 };
@@ -156,9 +158,10 @@ impl Image {
                 let (ys, fy) = clamped_axis(t, face_rows);
                 let mut c = quad(xs, ys.map(|y| y + face * face_rows), w, fx, fy);
                 if mapping == Mapping::Angular {
-                    let (a, b) = (2.0 * p[0] - 1.0, 1.0 - 2.0 * p[1]);
-                    if a * a + b * b > 1.0 {
-                        c.1 = [0.0; 4];
+                    let two = F::c(2.0);
+                    let (a, b) = (two * p[0] - one, one - two * p[1]);
+                    if a * a + b * b > one {
+                        c.1 = [zero; 4];
                     }
                 }
                 c
@@ -168,21 +171,21 @@ impl Image {
 
     /// Prefetches the texels that [`Image::lookup`] reads at `p`.
     #[inline(always)]
-    pub fn prefetch(&self, mapping: Mapping, p: [f64; 2]) {
+    pub fn prefetch<F: Real>(&self, mapping: Mapping, p: [F; 2]) {
         for i in self.corners(mapping, p).0 {
             simd::prefetch(&self.texels, i);
         }
     }
 
-    /// The bilinearly interpolated RGB value at `p`.
+    /// The bilinearly interpolated RGB value at `p`, computed in `F`.
     #[inline]
-    pub fn lookup(&self, mapping: Mapping, p: [f64; 2]) -> [f64; 3] {
+    pub fn lookup<F: Real>(&self, mapping: Mapping, p: [F; 2]) -> [F; 3] {
         let (idx, wt) = self.corners(mapping, p);
-        let mut rgb = [0.0; 3];
+        let mut rgb = [F::zero(); 3];
         for (i, w) in idx.into_iter().zip(wt) {
-            let t = self.texel(i);
+            let t = self.texels[i];
             for k in 0..3 {
-                rgb[k] += w * t[k];
+                rgb[k] = rgb[k] + w * F::c(f64::from(t[k]));
             }
         }
         rgb
@@ -192,15 +195,18 @@ impl Image {
 /// Texel indices `[x0, x1]` and the fraction toward `x1` along an axis of
 /// `n` texels centred at `(x + ½)/n`, clamped at both ends.
 #[inline(always)]
-fn clamped_axis(s: f64, n: usize) -> ([usize; 2], f64) {
-    let x = (s * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
-    let x0 = (x as usize).min(n.saturating_sub(2));
+fn clamped_axis<F: Real>(s: F, n: usize) -> ([usize; 2], F) {
+    let x = (s * F::c(n as f64) - F::c(0.5))
+        .max(F::zero())
+        .min(F::c((n - 1) as f64));
+    let x0 = (x.f64() as usize).min(n.saturating_sub(2));
     let x1 = (x0 + 1).min(n - 1);
-    ([x0, x1], x - x0 as f64)
+    ([x0, x1], x - F::c(x0 as f64))
 }
 
 #[inline(always)]
-fn quad(xs: [usize; 2], ys: [usize; 2], width: usize, fx: f64, fy: f64) -> Corners {
+fn quad<F: Real>(xs: [usize; 2], ys: [usize; 2], width: usize, fx: F, fy: F) -> Corners<F> {
+    let one = F::one();
     (
         [
             ys[0] * width + xs[0],
@@ -209,9 +215,9 @@ fn quad(xs: [usize; 2], ys: [usize; 2], width: usize, fx: f64, fy: f64) -> Corne
             ys[1] * width + xs[1],
         ],
         [
-            (1.0 - fx) * (1.0 - fy),
-            fx * (1.0 - fy),
-            (1.0 - fx) * fy,
+            (one - fx) * (one - fy),
+            fx * (one - fy),
+            (one - fx) * fy,
             fx * fy,
         ],
     )

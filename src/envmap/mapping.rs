@@ -11,7 +11,7 @@
 //! `jacobian(p)` is `dω/dp`, the solid angle per unit area of the domain, so
 //! that a density `p_p` on the domain is `p_p / jacobian` per steradian.
 
-use crate::math::{atan2, sin_cos_turn};
+use crate::math::{Real, atan2, sin_cos_turn};
 use crate::warp::V3;
 use std::f64::consts::PI;
 
@@ -123,31 +123,33 @@ impl Mapping {
 
     /// The point of the domain that looks along `d` (a unit vector; other
     /// lengths are accepted and normalised, the zero vector gives a valid
-    /// point).
-    #[inline]
-    pub fn from_dir(self, d: V3<f64>) -> [f64; 2] {
+    /// point), computed in `F`.
+    #[inline(always)]
+    pub fn from_dir<F: Real>(self, d: V3<F>) -> [F; 2] {
         let d = normalized(d);
+        let (zero, one) = (F::zero(), F::one());
         match self {
             Mapping::LatLong => {
-                let s = atan2(d[0], -d[2]) * (0.5 / PI);
-                let s = if s < 0.0 { s + 1.0 } else { s };
+                let s = atan2(d[0], -d[2]) * F::c(0.5 / PI);
+                let s = if s < zero { s + one } else { s };
                 // -0.0 and s + 1 rounding up to 1 both mean the start of the turn.
-                let s = if s >= 1.0 { 0.0 } else { s.abs() };
-                [s, polar_angle(d[1], d[0], d[2]) / PI]
+                let s = if s >= one { zero } else { s.abs() };
+                [s, polar_angle(d[1], d[0], d[2]) / F::PI()]
             }
             Mapping::Angular => {
                 let rho = (d[0] * d[0] + d[1] * d[1]).sqrt();
-                let r = polar_angle(d[2], d[0], d[1]) / PI;
-                let (a, b) = if rho > 0.0 {
+                let r = polar_angle(d[2], d[0], d[1]) / F::PI();
+                let (a, b) = if rho > zero {
                     (d[0] * r / rho, d[1] * r / rho)
                 } else {
                     // +Z at the centre; −Z anywhere on the edge (take +X's side).
-                    (r, 0.0)
+                    (r, zero)
                 };
-                [(a + 1.0) * 0.5, (1.0 - b) * 0.5]
+                let half = F::c(0.5);
+                [(a + one) * half, (one - b) * half]
             }
             Mapping::Cube => {
-                let abs = d.map(f64::abs);
+                let abs = d.map(F::abs);
                 let axis = if abs[0] >= abs[1] && abs[0] >= abs[2] {
                     0
                 } else if abs[1] >= abs[2] {
@@ -155,13 +157,14 @@ impl Mapping {
                 } else {
                     2
                 };
-                let face = 2 * axis + usize::from(d[axis] < 0.0);
+                let face = 2 * axis + usize::from(d[axis] < zero);
                 let (_, s_axis, t_axis) = CUBE_FACES[face];
-                let ma = abs[axis].max(f64::MIN_POSITIVE);
-                let dot = |e: V3<f64>| (e[0] * d[0] + e[1] * d[1] + e[2] * d[2]) / ma;
-                let s = ((dot(s_axis) + 1.0) * 0.5).clamp(0.0, 1.0);
-                let t = ((dot(t_axis) + 1.0) * 0.5).clamp(0.0, 1.0);
-                [s, face as f64 + t.min(1.0 - f64::EPSILON / 2.0)]
+                let ma = abs[axis].max(F::min_positive_value());
+                let dot =
+                    |e: V3<f64>| (F::c(e[0]) * d[0] + F::c(e[1]) * d[1] + F::c(e[2]) * d[2]) / ma;
+                let unit = |x: F| ((x + one) * F::c(0.5)).max(zero).min(one);
+                let (s, t) = (unit(dot(s_axis)), unit(dot(t_axis)));
+                [s, F::c(face as f64) + t.min(F::ONE_MINUS_EPSILON)]
             }
         }
     }
@@ -197,16 +200,16 @@ impl Mapping {
 /// along the axis and the two others: `atan2(√(a² + b²), c)`, which unlike
 /// `acos(c)` keeps its precision near the poles.
 #[inline(always)]
-pub fn polar_angle(c: f64, a: f64, b: f64) -> f64 {
+pub fn polar_angle<F: Real>(c: F, a: F, b: F) -> F {
     atan2((a * a + b * b).sqrt(), c)
 }
 
 /// `d/|d|`, or `d` itself when it has length 0.
-#[inline]
-pub fn normalized(d: V3<f64>) -> V3<f64> {
+#[inline(always)]
+pub fn normalized<F: Real>(d: V3<F>) -> V3<F> {
     let norm2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    if norm2 > 0.0 {
-        let inv = 1.0 / norm2.sqrt();
+    if norm2 > F::zero() {
+        let inv = F::one() / norm2.sqrt();
         d.map(|x| x * inv)
     } else {
         d

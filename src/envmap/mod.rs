@@ -45,6 +45,7 @@ use crate::distr::{GROUP, PiecewiseConstant2D};
 use crate::error::{Error, Result};
 use crate::math::{Real, atan2, sin_cos_turn};
 use crate::parallel;
+use crate::simd;
 use crate::warp::{self, V3};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -57,6 +58,9 @@ const IDENTITY: Matrix3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// Mitsuba's `Epsilon<float>` (2⁻²⁴): the floor of sin θ in the density of
 /// the polar tables, as in Mitsuba's envmap pdf.
 const SIN_FLOOR: f64 = 1.0 / 16_777_216.0;
+
+/// Directions per block of [`EnvMap::eval_into`] and [`EnvMap::pdf_into`].
+const BATCH_BLOCK: usize = 256;
 
 /// `dω/dq` of a polar sampling table at a direction `θ` from its axis:
 /// `2π² max(|sin θ|, 2⁻²⁴)` (see [`SIN_FLOOR`]).
@@ -323,9 +327,9 @@ impl EnvMap {
 
     /// The local direction of the world direction `d`: `to_worldᵀ·d`.
     #[inline(always)]
-    fn to_local(&self, d: V3<f64>) -> V3<f64> {
+    fn to_local<F: Real>(&self, d: V3<F>) -> V3<F> {
         let m = &self.options.to_world;
-        std::array::from_fn(|k| m[0][k] * d[0] + m[1][k] * d[1] + m[2][k] * d[2])
+        std::array::from_fn(|k| F::c(m[0][k]) * d[0] + F::c(m[1][k]) * d[1] + F::c(m[2][k]) * d[2])
     }
 
     #[inline(always)]
@@ -348,17 +352,20 @@ impl EnvMap {
 
     /// Radiance at domain point `p`: the bilinear image value times scale.
     #[inline(always)]
-    fn radiance_at(&self, p: [f64; 2]) -> V3<f64> {
-        let scale = self.options.scale;
+    fn radiance_at<F: Real>(&self, p: [F; 2]) -> V3<F> {
+        let scale = F::c(self.options.scale);
         self.image
             .lookup(self.options.mapping, p)
             .map(|v| v * scale)
     }
 
-    /// Radiance arriving from the world direction `d`, per RGB channel.
+    /// Radiance arriving from the world direction `d`, per RGB channel,
+    /// computed in `F` (in `f32`, the place on the map is good to a few
+    /// `f32` ulps, a ten-thousandth of a texel on a 1024-wide map).
     #[inline]
-    pub fn eval(&self, d: V3<f64>) -> V3<f64> {
-        self.radiance_at(self.dir_to_uv(d))
+    pub fn eval<F: Real>(&self, d: V3<F>) -> V3<F> {
+        let mapping = self.options.mapping;
+        self.radiance_at(mapping.from_dir(self.to_local(d)))
     }
 
     /// The density of [`EnvMap::sample`] at the world direction `d`, per
@@ -369,6 +376,91 @@ impl EnvMap {
             Some(table) => table.pdf(table.query(d)),
             None => self.pdf_at(self.pdf_query(d)),
         }
+    }
+
+    /// `out[i] = eval(d[i])` for a batch, in `F`: every direction's place on
+    /// the map by one loop (which vectorises for lat-long maps), then the
+    /// texel reads of the whole block, which overlap.
+    pub fn eval_into<F: Real>(&self, d: &[[F; 3]], out: &mut [[F; 3]]) {
+        // One loop per mapping, each with its own from_dir inlined: a
+        // match inside the loop would keep it from vectorising.
+        macro_rules! place {
+            ($mapping:expr) => {{
+                #[inline(always)]
+                |x: [F; 3]| $mapping.from_dir(self.to_local(x))
+            }};
+        }
+        match self.options.mapping {
+            Mapping::LatLong => self.eval_blocks(d, out, &place!(Mapping::LatLong)),
+            Mapping::Angular => self.eval_blocks(d, out, &place!(Mapping::Angular)),
+            Mapping::Cube => self.eval_blocks(d, out, &place!(Mapping::Cube)),
+        }
+    }
+
+    /// [`EnvMap::eval_into`] with `place` the mapping's `from_dir`.
+    #[inline(always)]
+    fn eval_blocks<F: Real>(
+        &self,
+        d: &[[F; 3]],
+        out: &mut [[F; 3]],
+        place: &impl Fn([F; 3]) -> [F; 2],
+    ) {
+        let mut points = [[F::zero(); 2]; BATCH_BLOCK];
+        for (d, out) in d.chunks(BATCH_BLOCK).zip(out.chunks_mut(BATCH_BLOCK)) {
+            let points = &mut points[..d.len()];
+            simd::map_rows(points, d, place, |_| true, false);
+            for (o, &p) in out.iter_mut().zip(points.iter()) {
+                *o = self.radiance_at(p);
+            }
+        }
+    }
+
+    /// `out[i] = pdf(d[i])` for a batch, in `F`, in blocks of
+    /// [`BATCH_BLOCK`]: for polar tables, every direction's cell by the
+    /// branch-free [`PolarTable::query`] at full SIMD width, then the table
+    /// reads of the block, which overlap; for the others [`EnvMap::pdf_query`]
+    /// then [`EnvMap::pdf_at`]. Returns whether `valid` held for every
+    /// direction (it is checked in the same pass).
+    pub fn pdf_into<F: Real>(
+        &self,
+        d: &[[F; 3]],
+        out: &mut [F],
+        valid: impl Fn(&[F; 3]) -> bool,
+    ) -> bool {
+        let mut ok = true;
+        let blocks = out.chunks_mut(BATCH_BLOCK).zip(d.chunks(BATCH_BLOCK));
+        if let Some(table) = &self.polar {
+            let mut queries = [[F::zero(); 3]; BATCH_BLOCK];
+            let mut cells = [0usize; BATCH_BLOCK];
+            let query = {
+                #[inline(always)]
+                |x| table.query(x)
+            };
+            for (o, x) in blocks {
+                let q = &mut queries[..x.len()];
+                ok &= simd::map_rows(q, x, &query, &valid, false);
+                // Indices first, then a short loop of loads, so that many
+                // table reads are in flight at once.
+                for (c, q) in cells.iter_mut().zip(q.iter()) {
+                    *c = table.cell(*q);
+                }
+                for ((o, q), &c) in o.iter_mut().zip(q.iter()).zip(&cells) {
+                    *o = F::c(table.density.get(c).copied().unwrap_or(0.0) * q[2].f64());
+                }
+            }
+        } else {
+            let mut queries = [PdfQuery::default(); BATCH_BLOCK];
+            for (o, x) in blocks {
+                for (q, x) in queries.iter_mut().zip(x) {
+                    ok &= valid(x);
+                    *q = self.pdf_query(x.map(F::f64));
+                }
+                for (o, q) in o.iter_mut().zip(&queries) {
+                    *o = F::c(self.pdf_at(*q));
+                }
+            }
+        }
+        ok
     }
 
     /// The polar table behind [`EnvMap::pdf`] (piecewise lat-long and

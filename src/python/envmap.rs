@@ -4,17 +4,13 @@
 use super::arrays::{Check, Points, PyFloat, finish, map, map_each, with_precision, zeros};
 use super::parallel::{detached, run_batch};
 use crate::distr::GROUP;
-use crate::envmap::{EnvMap, EnvSample, Mapping, Matrix3, Options, PdfQuery, Sampling};
+use crate::envmap::{EnvMap, EnvSample, Mapping, Matrix3, Options, Sampling};
 use crate::error::{Error, shape_str};
 use crate::io;
-use crate::simd;
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
-
-/// Directions per block of `EnvMap.pdf` (see `pdf_as`).
-const PDF_BLOCK: usize = 256;
 
 fn mapping_arg(name: &str) -> PyResult<Mapping> {
     Mapping::from_name(name).ok_or_else(|| {
@@ -255,9 +251,8 @@ impl PyEnvMap {
         })
     }
 
-    /// `pdf` in blocks of [`PDF_BLOCK`] directions: first every direction's
-    /// place in the table (for polar tables a branch-free kernel, run at
-    /// full SIMD width), then the table reads, which then overlap.
+    /// `pdf` by [`EnvMap::pdf_into`], which checks that every direction is
+    /// finite in the same pass.
     fn pdf_as<'py, F: PyFloat>(
         &self,
         py: Python<'py>,
@@ -271,43 +266,7 @@ impl PyEnvMap {
             let env = &self.0;
             let finite = |x: &[F; 3]| Check::Finite.holds_all(x);
             let valid = run_batch(py, d.n, guard.as_slice_mut()?, |range, chunk: &mut [F]| {
-                let blocks = chunk
-                    .chunks_mut(PDF_BLOCK)
-                    .zip(rows[range].chunks(PDF_BLOCK));
-                let mut ok = true;
-                if let Some(table) = env.polar_table() {
-                    let mut queries = [[F::zero(); 3]; PDF_BLOCK];
-                    let mut cells = [0usize; PDF_BLOCK];
-                    let density = table.density();
-                    let query = {
-                        #[inline(always)]
-                        |x| table.query(x)
-                    };
-                    for (o, x) in blocks {
-                        let q = &mut queries[..x.len()];
-                        ok &= simd::map_rows(q, x, &query, finite, false);
-                        // Indices first, then a short loop of loads, so that
-                        // many table reads are in flight at once.
-                        for (c, q) in cells.iter_mut().zip(q.iter()) {
-                            *c = table.cell(*q);
-                        }
-                        for ((o, q), &c) in o.iter_mut().zip(q.iter()).zip(&cells) {
-                            *o = F::c(density.get(c).copied().unwrap_or(0.0) * q[2].f64());
-                        }
-                    }
-                } else {
-                    let mut queries = [PdfQuery::default(); PDF_BLOCK];
-                    for (o, x) in blocks {
-                        for (q, x) in queries.iter_mut().zip(x) {
-                            ok &= finite(x);
-                            *q = env.pdf_query(x.map(F::f64));
-                        }
-                        for (o, q) in o.iter_mut().zip(&queries) {
-                            *o = F::c(env.pdf_at(*q));
-                        }
-                    }
-                }
-                ok
+                env.pdf_into(&rows[range], chunk, finite)
             })?;
             if !valid {
                 return Err(d.invalid(Check::Finite));

@@ -6,6 +6,7 @@ use glam::{Affine3A, Vec2, Vec3A};
 
 use super::shape::Ray;
 use crate::error::{Error, Result};
+use crate::simd;
 use crate::warp;
 
 /// Which image axis `fov` spans (Mitsuba's `fov_axis`).
@@ -121,35 +122,65 @@ impl Camera {
     /// The ray through the film position `film ∈ [0, 1]²` (x right, y down),
     /// through the lens point `lens ∈ [0, 1]²` (concentric disk) for a thin
     /// lens. In camera space the pinhole ray's direction is
-    /// `((1 − 2x) tan(fov_x/2), (1 − 2y) tan(fov_y/2), 1)`; the ray starts at
-    /// the near clip plane and ends at the far one, as in Mitsuba.
-    #[inline]
+    /// `v = ((1 − 2x) tan(fov_x/2), (1 − 2y) tan(fov_y/2), 1)`; the thin lens
+    /// aims from the aperture point `a` at `v·focus_distance`. The ray starts
+    /// where it crosses the near clip plane and ends at the far one, as in
+    /// Mitsuba. Branch-free (both the pinhole and the lens are computed),
+    /// so that [`Camera::rays_into`] vectorises.
+    #[inline(always)]
     pub fn ray(&self, film: [f32; 2], lens: [f32; 2]) -> Ray {
-        let d = Vec3A::new(
+        let v = Vec3A::new(
             (1.0 - 2.0 * film[0]) * self.tan_half.x,
             (1.0 - 2.0 * film[1]) * self.tan_half.y,
             1.0,
-        )
-        .normalize();
-        let (o, d) = if self.aperture_radius > 0.0 {
-            let [x, y] = warp::square_to_uniform_disk_concentric(lens);
-            let aperture = Vec3A::new(x, y, 0.0) * self.aperture_radius;
-            let focus = d * (self.focus_distance / d.z);
-            (aperture, (focus - aperture).normalize())
+        );
+        let [x, y] = warp::square_to_uniform_disk_concentric(lens);
+        let aperture = Vec3A::new(x, y, 0.0) * self.aperture_radius;
+        let thin = self.aperture_radius > 0.0;
+        let (o, d) = if thin {
+            (aperture, v * self.focus_distance - aperture)
         } else {
-            (Vec3A::ZERO, d)
+            (Vec3A::ZERO, v)
         };
         // Mitsuba clips along the final direction: the ray starts where it
-        // crosses the near plane `z = near_clip` (in camera space).
+        // crosses the near plane `z = near_clip` (in camera space), which is
+        // `near/d.z` along `d` (`d.z > 0`), or `|d|·near/d.z` along `d/|d|`.
         let inv_z = 1.0 / d.z;
         let o = o + d * (self.near_clip * inv_z);
         Ray {
             o: self.to_world.transform_point3a(o),
             d: self.to_world.transform_vector3a(d).normalize(),
-            tmax: (self.far_clip - self.near_clip) * inv_z,
+            tmax: (self.far_clip - self.near_clip) * d.length() * inv_z,
+        }
+    }
+
+    /// `out[i]` the ray of `u[i] = (film x, film y, lens x, lens y)` (see
+    /// [`Camera::ray`]) for a batch, at full SIMD width.
+    pub fn rays_into(&self, u: &[[f32; 4]], out: &mut [Ray]) {
+        let mut rows = [[0.0f32; 7]; BLOCK];
+        let kernel = {
+            #[inline(always)]
+            |u: [f32; 4]| {
+                let r = self.ray([u[0], u[1]], [u[2], u[3]]);
+                [r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.tmax]
+            }
+        };
+        for (u, out) in u.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+            let rows = &mut rows[..u.len()];
+            simd::map_rows(rows, u, &kernel, |_| true, false);
+            for (o, r) in out.iter_mut().zip(rows.iter()) {
+                *o = Ray {
+                    o: Vec3A::new(r[0], r[1], r[2]),
+                    d: Vec3A::new(r[3], r[4], r[5]),
+                    tmax: r[6],
+                };
+            }
         }
     }
 }
+
+/// Rays per block of [`Camera::rays_into`].
+const BLOCK: usize = 256;
 
 #[cfg(test)]
 mod tests {

@@ -17,6 +17,7 @@
 
 use glam::Vec3A;
 
+use super::accel::Hit;
 use super::scene::Scene;
 use super::shape::Ray;
 use crate::frame::Frame;
@@ -108,25 +109,115 @@ fn add_scaled(acc: &mut [f32; 3], a: [f32; 3], b: [f32; 3], s: f32) {
     }
 }
 
+/// Rays that left the scene, whose environment light is looked up for a
+/// whole batch of samples at once ([`add_escaped`]): those lookups (the
+/// most frequent work in an environment-lit scene) then run in vectorised
+/// loops whose texel and table reads overlap.
+#[derive(Debug, Default)]
+pub struct Escaped {
+    /// The sample (index in the batch) each ray belongs to.
+    slot: Vec<u32>,
+    /// World directions.
+    dir: Vec<[f32; 3]>,
+    /// The path throughput `β` times the MIS weight known so far.
+    beta: Vec<[f32; 3]>,
+    /// The BSDF density that drew the ray, where the MIS weight against
+    /// environment sampling remains to be applied.
+    bsdf_pdf: Vec<Option<f32>>,
+    /// Scratch for the batch: radiance and environment densities.
+    radiance: Vec<[f32; 3]>,
+    light_pdf: Vec<f32>,
+}
+
+impl Escaped {
+    /// Forgets every ray (keeping the memory).
+    pub fn clear(&mut self) {
+        self.slot.clear();
+        self.dir.clear();
+        self.beta.clear();
+        self.bsdf_pdf.clear();
+    }
+
+    /// Records a ray that left the scene with throughput `beta`; `bsdf_pdf`
+    /// when its MIS weight against environment sampling remains to apply.
+    #[inline]
+    fn push(&mut self, slot: u32, d: Vec3A, beta: [f32; 3], bsdf_pdf: Option<f32>) {
+        self.slot.push(slot);
+        self.dir.push(d.to_array());
+        self.beta.push(beta);
+        self.bsdf_pdf.push(bsdf_pdf);
+    }
+}
+
+/// Adds the environment light of every ray in `escaped` to the radiance of
+/// its sample, `l[slot]`.
+pub fn add_escaped(scene: &Scene, settings: &Settings, escaped: &mut Escaped, l: &mut [[f32; 3]]) {
+    let Some(env) = scene.environment() else {
+        return;
+    };
+    let n = escaped.dir.len();
+    escaped.radiance.resize(n, [0.0; 3]);
+    env.eval_into(&escaped.dir, &mut escaped.radiance);
+    if escaped.bsdf_pdf.iter().any(Option::is_some) {
+        escaped.light_pdf.resize(n, 0.0);
+        scene.environment_pdf_into(&escaped.dir, &mut escaped.light_pdf);
+    }
+    for i in 0..n {
+        let w = escaped.bsdf_pdf[i].map_or(1.0, |p| settings.weight(p, escaped.light_pdf[i]));
+        add_scaled(
+            &mut l[escaped.slot[i] as usize],
+            escaped.beta[i],
+            escaped.radiance[i],
+            w,
+        );
+    }
+}
+
 /// The radiance arriving at the camera along `ray`: one sample of the
-/// estimator above, drawing its random numbers from `rng`.
-pub fn radiance(scene: &Scene, mut ray: Ray, rng: &mut Rng, settings: &Settings) -> [f32; 3] {
+/// estimator above, drawing its random numbers from `rng`. Light from the
+/// environment is not included: rays that escape are added to `escaped`
+/// under `slot`, and [`add_escaped`] adds their light.
+#[inline]
+pub fn radiance(
+    scene: &Scene,
+    ray: Ray,
+    rng: &mut Rng,
+    settings: &Settings,
+    escaped: &mut Escaped,
+    slot: u32,
+) -> [f32; 3] {
+    if settings.max_depth() == 0 {
+        return [0.0; 3];
+    }
+    match scene.accel().intersect(&ray) {
+        Some(hit) => path(scene, ray, hit, rng, settings, escaped, slot),
+        None => {
+            if scene.environment().is_some() {
+                escaped.push(slot, ray.d, [1.0; 3], None);
+            }
+            [0.0; 3]
+        }
+    }
+}
+
+/// The rest of [`radiance`] once `ray` (from the camera) has hit the
+/// scene at `hit`.
+#[inline(never)]
+fn path(
+    scene: &Scene,
+    mut ray: Ray,
+    mut hit: Hit,
+    rng: &mut Rng,
+    settings: &Settings,
+    escaped: &mut Escaped,
+    slot: u32,
+) -> [f32; 3] {
     let max_depth = settings.max_depth();
     let mut l = [0.0f32; 3];
-    if max_depth == 0 {
-        return l;
-    }
     let mut beta = [1.0f32; 3];
     let mut bsdf_pdf = 0.0f32;
     let mut depth = 0u32;
     loop {
-        let Some(hit) = scene.accel().intersect(&ray) else {
-            if let Some(env) = scene.environment() {
-                let w = emission_weight(settings, depth, bsdf_pdf, || scene.environment_pdf(ray.d));
-                add_scaled(&mut l, beta, env.eval(ray.d), w);
-            }
-            break;
-        };
         let shape = scene.accel().shape_of(hit.primitive);
         let primitive = &scene.accel().primitives()[hit.primitive as usize];
         let sp = primitive.point(ray.o + ray.d * hit.t, hit.bary);
@@ -205,6 +296,16 @@ pub fn radiance(scene: &Scene, mut ray: Ray, rng: &mut Rng, settings: &Settings)
             }
             beta = beta.map(|b| b / q);
         }
+        hit = match scene.accel().intersect(&ray) {
+            Some(hit) => hit,
+            None => {
+                if scene.environment().is_some() && settings.strategy != Strategy::Emitter {
+                    let mis = settings.strategy == Strategy::Mis;
+                    escaped.push(slot, ray.d, beta, mis.then_some(bsdf_pdf));
+                }
+                break;
+            }
+        };
     }
     l
 }

@@ -21,13 +21,14 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-pub use integrator::{Heuristic, Integrator, Settings, Strategy};
+pub use integrator::{Escaped, Heuristic, Integrator, Settings, Strategy};
 pub use scene::Scene;
 
 use crate::error::Result;
 use crate::math::luminance;
 use crate::parallel;
 use crate::rng::Rng;
+use shape::Ray;
 
 /// A finished (or stopped) render.
 #[derive(Clone, Debug)]
@@ -57,6 +58,110 @@ pub struct Progress {
     pub cancel: AtomicBool,
 }
 
+/// Camera samples per batch: their escaped rays' environment light is
+/// looked up together ([`integrator::add_escaped`]).
+const BATCH: usize = 256;
+
+/// One thread's buffers for a batch of camera samples (reused from batch
+/// to batch).
+#[derive(Default)]
+struct Batch {
+    escaped: Escaped,
+    /// Radiance of each sample, pixel after pixel.
+    radiance: Vec<[f32; 3]>,
+    /// Film and lens positions of each sample.
+    camera_u: Vec<[f32; 4]>,
+    rays: Vec<Ray>,
+}
+
+impl Batch {
+    /// The `spp` samples of each pixel `(x, y)`, `x` in `pixels`, into
+    /// [`Batch::radiance`]: film and lens positions first (from the pixel's
+    /// own stream, which then drives its paths), the camera rays of the
+    /// whole batch at SIMD width, the paths one by one, and last the light
+    /// of every ray that left the scene, looked up together.
+    fn run(
+        &mut self,
+        scene: &Scene,
+        settings: &Settings,
+        seed: u64,
+        spp: u32,
+        y: usize,
+        pixels: std::ops::Range<usize>,
+    ) {
+        let (width, height) = scene.film();
+        let (inv_width, inv_height) = (1.0 / width as f32, 1.0 / height as f32);
+        self.escaped.clear();
+        self.radiance.clear();
+        self.camera_u.clear();
+        let mut rngs = Vec::with_capacity(pixels.len());
+        for x in pixels {
+            let pixel = (y * width + x) as u64;
+            let mut rng = Rng::new(mix(seed, pixel), pixel);
+            for _ in 0..spp {
+                let film_x = (x as f32 + rng.next_float::<f32>()) * inv_width;
+                let film_y = (y as f32 + rng.next_float::<f32>()) * inv_height;
+                let lens = [rng.next_float(), rng.next_float()];
+                self.camera_u.push([film_x, film_y, lens[0], lens[1]]);
+            }
+            rngs.push(rng);
+        }
+        self.rays.resize(self.camera_u.len(), Ray::default());
+        scene.camera().rays_into(&self.camera_u, &mut self.rays);
+        let per_pixel = self.rays.chunks(spp.max(1) as usize);
+        for (mut rng, rays) in rngs.into_iter().zip(per_pixel) {
+            for ray in rays {
+                let slot = self.radiance.len() as u32;
+                let l =
+                    integrator::radiance(scene, *ray, &mut rng, settings, &mut self.escaped, slot);
+                self.radiance.push(l);
+            }
+        }
+        integrator::add_escaped(scene, settings, &mut self.escaped, &mut self.radiance);
+    }
+}
+
+/// A pixel's estimate from its samples.
+struct Moments {
+    /// Mean per channel.
+    mean: [f32; 3],
+    /// Variance of the mean per channel, `s²/n` (infinite for fewer than 2
+    /// samples).
+    variance: [f32; 3],
+    /// Variance of the mean luminance.
+    luminance_variance: f32,
+}
+
+/// Mean and variances of a pixel's `samples`, accumulated in `f64`.
+fn moments(samples: &[[f32; 3]]) -> Moments {
+    let n = samples.len() as f64;
+    let variance_of_mean = |sum: f64, sum_sq: f64| -> f32 {
+        if samples.len() > 1 {
+            (((sum_sq - sum * sum / n) / (n - 1.0)).max(0.0) / n) as f32
+        } else {
+            f32::INFINITY
+        }
+    };
+    let mut sum = [0.0f64; 3];
+    let mut sum_sq = [0.0f64; 3];
+    let (mut sum_y, mut sum_y_sq) = (0.0f64, 0.0f64);
+    for l in samples {
+        let l = l.map(f64::from);
+        for k in 0..3 {
+            sum[k] += l[k];
+            sum_sq[k] += l[k] * l[k];
+        }
+        let y = luminance(l);
+        sum_y += y;
+        sum_y_sq += y * y;
+    }
+    Moments {
+        mean: sum.map(|s| (s / n.max(1.0)) as f32),
+        variance: std::array::from_fn(|k| variance_of_mean(sum[k], sum_sq[k])),
+        luminance_variance: variance_of_mean(sum_y, sum_y_sq),
+    }
+}
+
 /// SplitMix64's finaliser: a well-mixed 64-bit state from the seed and the
 /// pixel index.
 fn mix(seed: u64, pixel: u64) -> u64 {
@@ -83,56 +188,36 @@ pub fn render(
     let mut mean = vec![0.0f32; width * height * 3];
     let mut variance = vec![0.0f32; width * height * 3];
     let mut luminance_variance = vec![0.0f32; width * height];
-    let n = f64::from(spp.max(1));
-    let variance_of_mean = |sum: f64, sum_sq: f64| -> f32 {
-        if spp > 1 {
-            (((sum_sq - sum * sum / n) / (n - 1.0)).max(0.0) / n) as f32
-        } else {
-            f32::INFINITY
-        }
-    };
+    // Pixels per batch: about BATCH samples, at least one pixel.
+    let group = (BATCH / spp.max(1) as usize).max(1);
     parallel::install(|| {
         mean.par_chunks_mut(width * 3)
             .zip(variance.par_chunks_mut(width * 3))
             .zip(luminance_variance.par_chunks_mut(width))
             .enumerate()
-            .for_each(|(y, ((mean_row, var_row), lum_row))| {
-                for x in 0..width {
-                    if progress.cancel.load(Ordering::Relaxed) {
-                        return;
-                    }
-                    let pixel = (y * width + x) as u64;
-                    let mut rng = Rng::new(mix(seed, pixel), pixel);
-                    let mut sum = [0.0f64; 3];
-                    let mut sum_sq = [0.0f64; 3];
-                    let (mut sum_y, mut sum_y_sq) = (0.0f64, 0.0f64);
-                    for _ in 0..spp {
-                        let film = [
-                            (x as f32 + rng.next_float::<f32>()) / width as f32,
-                            (y as f32 + rng.next_float::<f32>()) / height as f32,
-                        ];
-                        let lens = [rng.next_float(), rng.next_float()];
-                        let ray = scene.camera().ray(film, lens);
-                        let l = integrator::radiance(scene, ray, &mut rng, settings);
-                        let l = l.map(f64::from);
-                        for k in 0..3 {
-                            sum[k] += l[k];
-                            sum_sq[k] += l[k] * l[k];
+            .for_each_init(
+                Batch::default,
+                |batch, (y, ((mean_row, var_row), lum_row))| {
+                    for x0 in (0..width).step_by(group) {
+                        if progress.cancel.load(Ordering::Relaxed) {
+                            return;
                         }
-                        let y = luminance(l);
-                        sum_y += y;
-                        sum_y_sq += y * y;
+                        let pixels = x0..(x0 + group).min(width);
+                        batch.run(scene, settings, seed, spp, y, pixels.clone());
+                        let per_pixel = batch.radiance.chunks(spp.max(1) as usize);
+                        for (x, samples) in pixels.zip(per_pixel.chain(std::iter::repeat(&[][..])))
+                        {
+                            let m = moments(samples);
+                            mean_row[3 * x..3 * x + 3].copy_from_slice(&m.mean);
+                            var_row[3 * x..3 * x + 3].copy_from_slice(&m.variance);
+                            lum_row[x] = m.luminance_variance;
+                        }
                     }
-                    for k in 0..3 {
-                        mean_row[3 * x + k] = (sum[k] / n) as f32;
-                        var_row[3 * x + k] = variance_of_mean(sum[k], sum_sq[k]);
-                    }
-                    lum_row[x] = variance_of_mean(sum_y, sum_y_sq);
-                }
-                progress
-                    .samples
-                    .fetch_add(width as u64 * u64::from(spp), Ordering::Relaxed);
-            });
+                    progress
+                        .samples
+                        .fetch_add(width as u64 * u64::from(spp), Ordering::Relaxed);
+                },
+            );
     })?;
     Ok(Image {
         width,

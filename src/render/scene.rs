@@ -63,8 +63,16 @@ impl Environment {
     #[inline]
     pub fn eval(&self, d: Vec3A) -> [f32; 3] {
         match self {
-            Environment::Map(env) => env.eval(d.as_dvec3().to_array()).map(|v| v as f32),
+            Environment::Map(env) => env.eval(d.to_array()),
             Environment::Constant(l) => l.map(|v| v as f32),
+        }
+    }
+
+    /// [`Environment::eval`] for a batch of directions.
+    pub fn eval_into(&self, d: &[[f32; 3]], out: &mut [[f32; 3]]) {
+        match self {
+            Environment::Map(env) => env.eval_into(d, out),
+            Environment::Constant(l) => out.fill(l.map(|v| v as f32)),
         }
     }
 
@@ -319,6 +327,19 @@ impl Scene {
         match &self.environment {
             Some(env) => self.choice_pmf(self.env_light) * env.pdf(d),
             None => 0.0,
+        }
+    }
+
+    /// [`Scene::environment_pdf`] for a batch of directions.
+    pub fn environment_pdf_into(&self, d: &[[f32; 3]], out: &mut [f32]) {
+        let pmf = self.choice_pmf(self.env_light);
+        match &self.environment {
+            Some(Environment::Map(env)) => {
+                env.pdf_into(d, out, |_| true);
+                out.iter_mut().for_each(|p| *p *= pmf);
+            }
+            Some(env) => out.fill(pmf * env.pdf(Vec3A::Z)),
+            None => out.fill(0.0),
         }
     }
 

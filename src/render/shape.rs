@@ -10,7 +10,7 @@ use glam::{Affine3A, DVec3, Vec3A};
 use crate::warp;
 
 /// A ray `o + t d` for `t` in `(0, tmax)`.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct Ray {
     /// Origin.
     pub o: Vec3A,
