@@ -241,7 +241,13 @@ impl<F: Real> PhongView<F> {
         let local = warp::square_to_cosine_power_hemisphere([u[0], u[1]], self.exponent);
         let g = self.mirror_frame.to_world(local);
         let wo = if diffuse { d } else { g };
-        let lobe = self.lobe(wo);
+        self.finish_sample(wo, self.lobe(wo), diffuse)
+    }
+
+    /// The sample at `wo`, drawn by the diffuse part or not, where the lobe
+    /// is `lobe`: its mixture density and weight.
+    #[inline(always)]
+    fn finish_sample(&self, wo: V3<F>, lobe: F, diffuse: bool) -> PhongSample<F> {
         let pdf = self.pdf_with_lobe(wo, lobe);
         let f = self.eval_with_lobe(wo, lobe);
         let scale = if pdf > F::zero() {
@@ -255,6 +261,45 @@ impl<F: Real> PhongView<F> {
             weight: f.map(|v| v * scale),
             component: u8::from(!diffuse),
         }
+    }
+}
+
+/// One sample at a time, as the renderer draws them: the same densities and
+/// values as [`PhongView::sample`], [`PhongView::eval`] and
+/// [`PhongView::pdf`], with branches where those are branch-free for
+/// vectorised batches. Only the chosen part's direction is drawn, and a BRDF
+/// without a glossy part (`ρs = 0`, so `p_s = 0`) skips its lobe, a power.
+impl<F: Real> PhongView<F> {
+    /// [`PhongView::lobe`], or 0 without looking when there is no glossy
+    /// part (whose terms it would multiply by 0).
+    #[inline(always)]
+    fn lobe_if_glossy(&self, wo: V3<F>) -> F {
+        if self.diffuse_probability < F::one() {
+            self.lobe(wo)
+        } else {
+            F::zero()
+        }
+    }
+
+    /// `(f_r(wi, wo), pdf(wo))`, as [`PhongView::eval`] and
+    /// [`PhongView::pdf`].
+    #[inline]
+    pub fn eval_pdf_one(&self, wo: V3<F>) -> (V3<F>, F) {
+        let lobe = self.lobe_if_glossy(wo);
+        (self.eval_with_lobe(wo, lobe), self.pdf_with_lobe(wo, lobe))
+    }
+
+    /// A sample as [`PhongView::sample`].
+    #[inline]
+    pub fn sample_one(&self, u: [F; 3]) -> PhongSample<F> {
+        let diffuse = u[2] < self.diffuse_probability;
+        let wo = if diffuse {
+            warp::square_to_cosine_hemisphere([u[0], u[1]])
+        } else {
+            let local = warp::square_to_cosine_power_hemisphere([u[0], u[1]], self.exponent);
+            self.mirror_frame.to_world(local)
+        };
+        self.finish_sample(wo, self.lobe_if_glossy(wo), diffuse)
     }
 }
 
@@ -303,6 +348,32 @@ mod tests {
         assert!(Phong::new([-0.1, 0.0, 0.0], [0.5; 3], 1.0, Selection::Max).is_err());
         assert!(Phong::new([0.1; 3], [0.5; 3], -1.0, Selection::Max).is_err());
         assert!(Phong::new([0.1; 3], [0.5; 3], f64::NAN, Selection::Max).is_err());
+    }
+
+    /// The one-at-a-time forms give what the batch forms give, with a
+    /// glossy part and without one.
+    #[test]
+    fn one_at_a_time_matches_the_batch_forms() {
+        let diffuse_only = Phong::new([0.5, 0.4, 0.3], [0.0; 3], 1.0, Selection::Max).unwrap();
+        for p in [phong(20.0), diffuse_only] {
+            let view = p.view([0.3f64, -0.2, 0.932_737_905_308_881_5]);
+            for k in 0..500 {
+                let u = [
+                    (k as f64 * 0.618_034) % 1.0,
+                    (k as f64 * 0.414_214) % 1.0,
+                    (k as f64 * 0.732_051) % 1.0,
+                ];
+                let (a, b) = (view.sample(u), view.sample_one(u));
+                assert_eq!(a.wo, b.wo);
+                assert_eq!(a.component, b.component);
+                assert!((a.pdf - b.pdf).abs() <= 1e-12 * a.pdf);
+                for c in 0..3 {
+                    assert!((a.weight[c] - b.weight[c]).abs() <= 1e-12 * a.weight[c]);
+                }
+                let (f, pdf) = view.eval_pdf_one(a.wo);
+                assert_eq!((f, pdf), (view.eval(a.wo), view.pdf(a.wo)));
+            }
+        }
     }
 
     #[test]

@@ -244,7 +244,7 @@ fn path(
             let u = [rng.next_float(), rng.next_float(), rng.next_float()];
             if let Some(ls) = scene.sample_light(sp.p, u) {
                 let wo = frame.to_local(ls.d.to_array());
-                let f = view.eval(wo);
+                let (f, pdf_wo) = view.eval_pdf_one(wo);
                 if f.iter().any(|&v| v > 0.0) {
                     let origin = offset(sp.p, sp.ng, ls.d);
                     let tmax = if ls.dist.is_finite() {
@@ -259,7 +259,7 @@ fn path(
                     };
                     if !scene.accel().occluded(&shadow) {
                         let w = if settings.strategy == Strategy::Mis {
-                            settings.weight(ls.pdf, view.pdf(wo))
+                            settings.weight(ls.pdf, pdf_wo)
                         } else {
                             1.0
                         };
@@ -276,7 +276,7 @@ fn path(
         }
 
         let u = [rng.next_float(), rng.next_float(), rng.next_float()];
-        let s = view.sample(u);
+        let s = view.sample_one(u);
         if s.weight.iter().all(|&v| v <= 0.0) {
             break;
         }

@@ -56,27 +56,29 @@ pub struct Triangle {
 
 impl Triangle {
     /// Möller–Trumbore: the distance and barycentrics of the hit in
-    /// `(0, tmax)`, if any.
+    /// `(0, tmax)`, if any. The tests run on the barycentrics and distance
+    /// scaled by the determinant (made positive), so that a miss costs no
+    /// division.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Candidate> {
         let pvec = ray.d.cross(self.e2);
         let det = self.e1.dot(pvec);
-        if det == 0.0 || !det.is_finite() {
+        if !(det != 0.0 && det.is_finite()) {
+            return None;
+        }
+        let tvec = ray.o - self.p0;
+        let qvec = tvec.cross(self.e1);
+        let sign = det.signum();
+        let (det, b1, b2) = (det.abs(), sign * tvec.dot(pvec), sign * ray.d.dot(qvec));
+        if !(b1 >= 0.0 && b1 <= det && b2 >= 0.0 && b1 + b2 <= det) {
             return None;
         }
         let inv = 1.0 / det;
-        let tvec = ray.o - self.p0;
-        let b1 = tvec.dot(pvec) * inv;
-        if !(0.0..=1.0).contains(&b1) {
-            return None;
-        }
-        let qvec = tvec.cross(self.e1);
-        let b2 = ray.d.dot(qvec) * inv;
-        if b2 < 0.0 || b1 + b2 > 1.0 {
-            return None;
-        }
-        let t = self.e2.dot(qvec) * inv;
-        (t > 0.0 && t < ray.tmax).then_some(Candidate { t, bary: [b1, b2] })
+        let t = sign * self.e2.dot(qvec) * inv;
+        (t > 0.0 && t < ray.tmax).then_some(Candidate {
+            t,
+            bary: [b1 * inv, b2 * inv],
+        })
     }
 
     /// Area, `|e1 × e2| / 2`.
@@ -125,17 +127,20 @@ impl Sphere {
         let o = ray.o.as_dvec3() - self.center;
         let d = ray.d.as_dvec3();
         let a = d.length_squared();
-        let b = 2.0 * o.dot(d);
-        let c = o.length_squared() - self.radius * self.radius;
+        let inv_a = 1.0 / a;
+        let od = o.dot(d);
         // The discriminant as b² − 4ac = 4a(r² − |o − (o·d/a) d|²), which
         // stays accurate for rays far from the sphere.
-        let f = o - (o.dot(d) / a) * d;
-        let disc = 4.0 * a * (self.radius * self.radius - f.length_squared());
+        let f = o - (od * inv_a) * d;
+        let r2 = self.radius * self.radius;
+        let disc = 4.0 * a * (r2 - f.length_squared());
         if disc < 0.0 {
             return None;
         }
+        let b = 2.0 * od;
+        let c = o.length_squared() - r2;
         let q = -0.5 * (b + b.signum() * disc.sqrt());
-        let (mut t0, mut t1) = (q / a, c / q);
+        let (mut t0, mut t1) = (q * inv_a, c / q);
         if t0 > t1 {
             std::mem::swap(&mut t0, &mut t1);
         }
