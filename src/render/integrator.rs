@@ -119,7 +119,7 @@ pub struct Escaped {
     slot: Vec<u32>,
     /// World directions.
     dir: Vec<[f32; 3]>,
-    /// The path throughput `β` times the MIS weight known so far.
+    /// The path throughput `β`.
     beta: Vec<[f32; 3]>,
     /// The BSDF density that drew the ray, where the MIS weight against
     /// environment sampling remains to be applied.

@@ -28,13 +28,14 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-pub use integrator::{Escaped, Heuristic, Integrator, Settings, Strategy};
+pub use integrator::{Heuristic, Integrator, Settings, Strategy};
 pub use scene::Scene;
 
 use crate::error::Result;
 use crate::math::luminance;
 use crate::parallel;
 use crate::rng::Rng;
+use integrator::Escaped;
 use shape::Ray;
 
 /// A finished (or stopped) render.

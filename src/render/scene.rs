@@ -320,17 +320,9 @@ impl Scene {
         self.choice_pmf(light) * dist * dist / (cos * total_area)
     }
 
-    /// Density per steradian with which emitter sampling draws the
-    /// environment direction `d`.
-    #[inline]
-    pub fn environment_pdf(&self, d: Vec3A) -> f32 {
-        match &self.environment {
-            Some(env) => self.choice_pmf(self.env_light) * env.pdf(d),
-            None => 0.0,
-        }
-    }
-
-    /// [`Scene::environment_pdf`] for a batch of directions.
+    /// `out[i]`: the density per steradian with which emitter sampling
+    /// draws the environment direction `d[i]` (the choice of the
+    /// environment among the lights included).
     pub fn environment_pdf_into(&self, d: &[[f32; 3]], out: &mut [f32]) {
         let pmf = self.choice_pmf(self.env_light);
         match &self.environment {
