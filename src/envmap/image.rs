@@ -169,10 +169,10 @@ impl Image {
         }
     }
 
-    /// Prefetches the texels that [`Image::lookup`] reads at `p`.
+    /// Prefetches the texels of `corners`.
     #[inline(always)]
-    pub fn prefetch<F: Real>(&self, mapping: Mapping, p: [F; 2]) {
-        for i in self.corners(mapping, p).0 {
+    pub fn prefetch<F: Real>(&self, corners: &Corners<F>) {
+        for &i in &corners.0 {
             simd::prefetch(&self.texels, i);
         }
     }
@@ -180,9 +180,14 @@ impl Image {
     /// The bilinearly interpolated RGB value at `p`, computed in `F`.
     #[inline]
     pub fn lookup<F: Real>(&self, mapping: Mapping, p: [F; 2]) -> [F; 3] {
-        let (idx, wt) = self.corners(mapping, p);
+        self.blend(&self.corners(mapping, p))
+    }
+
+    /// The texels of `corners` blended by their weights, in `F`.
+    #[inline(always)]
+    pub fn blend<F: Real>(&self, (idx, wt): &Corners<F>) -> [F; 3] {
         let mut rgb = [F::zero(); 3];
-        for (i, w) in idx.into_iter().zip(wt) {
+        for (&i, &w) in idx.iter().zip(wt) {
             let t = self.texels[i];
             for k in 0..3 {
                 rgb[k] = rgb[k] + w * F::c(f64::from(t[k]));

@@ -37,7 +37,7 @@ mod image;
 mod mapping;
 
 pub use bilinear::BilinearGrid;
-pub use image::Image;
+pub use image::{Corners, Image};
 pub use mapping::{Mapping, normalized, polar_angle};
 
 use crate::buffer::Buffer;
@@ -158,6 +158,28 @@ pub struct PolarTable {
     rows: usize,
     cols: usize,
     density: Buffer<f64>,
+    /// `density` rounded to `f32`, for batches in `f32`: half the bytes, so
+    /// more of the table stays in the caches.
+    density_f32: Buffer<f32>,
+}
+
+/// The float types in which [`EnvMap::pdf_into`] reads a [`PolarTable`]'s
+/// densities: each from its own copy of the table.
+pub trait TableFloat: Real {
+    /// The densities of `table` in this type.
+    fn densities(table: &PolarTable) -> &[Self];
+}
+
+impl TableFloat for f32 {
+    fn densities(table: &PolarTable) -> &[f32] {
+        &table.density_f32
+    }
+}
+
+impl TableFloat for f64 {
+    fn densities(table: &PolarTable) -> &[f64] {
+        &table.density
+    }
 }
 
 /// Where a direction falls in a [`PolarTable`]: the cell's row and column
@@ -198,12 +220,19 @@ impl PolarTable {
         let integral = table.integral();
         parallel::install(|| weights.par_iter_mut().for_each(|w| *w /= integral))?;
         let density = weights;
+        let mut density_f32 = Buffer::for_overwrite(density.len());
+        parallel::install(|| {
+            (density_f32.par_iter_mut(), density.par_iter())
+                .into_par_iter()
+                .for_each(|(single, &double)| *single = double as f32);
+        })?;
         Ok(Some(PolarTable {
             axes,
             shift,
             rows,
             cols,
             density,
+            density_f32,
         }))
     }
 
@@ -380,8 +409,14 @@ impl EnvMap {
 
     /// `out[i] = eval(d[i])` for a batch, in `F`: every direction's place on
     /// the map by one loop (which vectorises for lat-long maps), then the
-    /// texel reads of the whole block, which overlap.
-    pub fn eval_into<F: Real>(&self, d: &[[F; 3]], out: &mut [[F; 3]]) {
+    /// texel reads of the whole block, which overlap. Returns whether
+    /// `valid` held for every direction (it is checked in the same pass).
+    pub fn eval_into<F: Real>(
+        &self,
+        d: &[[F; 3]],
+        out: &mut [[F; 3]],
+        valid: impl Fn(&[F; 3]) -> bool,
+    ) -> bool {
         // One loop per mapping, each with its own from_dir inlined: a
         // match inside the loop would keep it from vectorising.
         macro_rules! place {
@@ -391,9 +426,9 @@ impl EnvMap {
             }};
         }
         match self.options.mapping {
-            Mapping::LatLong => self.eval_blocks(d, out, &place!(Mapping::LatLong)),
-            Mapping::Angular => self.eval_blocks(d, out, &place!(Mapping::Angular)),
-            Mapping::Cube => self.eval_blocks(d, out, &place!(Mapping::Cube)),
+            Mapping::LatLong => self.eval_blocks(d, out, &place!(Mapping::LatLong), valid),
+            Mapping::Angular => self.eval_blocks(d, out, &place!(Mapping::Angular), valid),
+            Mapping::Cube => self.eval_blocks(d, out, &place!(Mapping::Cube), valid),
         }
     }
 
@@ -404,15 +439,18 @@ impl EnvMap {
         d: &[[F; 3]],
         out: &mut [[F; 3]],
         place: &impl Fn([F; 3]) -> [F; 2],
-    ) {
+        valid: impl Fn(&[F; 3]) -> bool,
+    ) -> bool {
+        let mut ok = true;
         let mut points = [[F::zero(); 2]; BATCH_BLOCK];
         for (d, out) in d.chunks(BATCH_BLOCK).zip(out.chunks_mut(BATCH_BLOCK)) {
             let points = &mut points[..d.len()];
-            simd::map_rows(points, d, place, |_| true, false);
+            ok &= simd::map_rows(points, d, place, &valid, false);
             for (o, &p) in out.iter_mut().zip(points.iter()) {
                 *o = self.radiance_at(p);
             }
         }
+        ok
     }
 
     /// `out[i] = pdf(d[i])` for a batch, in `F`, in blocks of
@@ -421,7 +459,7 @@ impl EnvMap {
     /// reads of the block, which overlap; for the others [`EnvMap::pdf_query`]
     /// then [`EnvMap::pdf_at`]. Returns whether `valid` held for every
     /// direction (it is checked in the same pass).
-    pub fn pdf_into<F: Real>(
+    pub fn pdf_into<F: TableFloat>(
         &self,
         d: &[[F; 3]],
         out: &mut [F],
@@ -432,6 +470,7 @@ impl EnvMap {
         if let Some(table) = &self.polar {
             let mut queries = [[F::zero(); 3]; BATCH_BLOCK];
             let mut cells = [0usize; BATCH_BLOCK];
+            let densities = F::densities(table);
             let query = {
                 #[inline(always)]
                 |x| table.query(x)
@@ -445,7 +484,7 @@ impl EnvMap {
                     *c = table.cell(*q);
                 }
                 for ((o, q), &c) in o.iter_mut().zip(q.iter()).zip(&cells) {
-                    *o = F::c(table.density.get(c).copied().unwrap_or(0.0) * q[2].f64());
+                    *o = densities.get(c).copied().unwrap_or(F::zero()) * q[2];
                 }
             }
         } else {
@@ -513,12 +552,26 @@ impl EnvMap {
 
     /// `out[i] = sample(us[i])` for a batch, in groups: the table points by
     /// the tables' batch samplers (whose cache misses overlap), then the
-    /// texels under them prefetched, then the directions, densities and
-    /// radiance.
+    /// texels under them located and prefetched, the directions and
+    /// densities of the group in one loop at SIMD width, and last the
+    /// radiance. The same bits as [`EnvMap::sample`].
     pub fn sample_into(&self, us: &[[f64; 2]], out: &mut [EnvSample]) {
+        // One loop per mapping, each with its own formulas inlined (see
+        // `eval_into`).
+        macro_rules! frame {
+            ($mapping:expr) => {{
+                #[inline(always)]
+                |[s, t, pdf_q]: [f64; 3]| self.frame_at($mapping, [s, t], pdf_q)
+            }};
+        }
         let mut drawn = [([0.0; 2], 0.0); GROUP];
+        let mut points = [[0.0; 3]; GROUP];
+        let mut frames = [[0.0; 5]; GROUP];
+        let mut corners = [([0; 4], [0.0; 4]); GROUP];
+        let mapping = self.options.mapping;
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
-            let drawn = &mut drawn[..us.len()];
+            let n = us.len();
+            let drawn = &mut drawn[..n];
             match &self.distribution {
                 Distribution::Piecewise(table) => table.sample_into(us, drawn),
                 Distribution::Bilinear(grid) => grid.sample_into(us, drawn),
@@ -529,12 +582,26 @@ impl EnvMap {
                     continue;
                 }
             }
-            for (q, _) in drawn.iter_mut() {
-                *q = self.table_to_uv(*q);
-                self.image.prefetch(self.options.mapping, *q);
+            for ((point, c), &(q, pdf_q)) in points.iter_mut().zip(&mut corners).zip(drawn.iter()) {
+                let p = self.table_to_uv(q);
+                *c = self.image.corners(mapping, p);
+                self.image.prefetch(c);
+                *point = [p[0], p[1], pdf_q];
             }
-            for (o, &(p, pdf_q)) in out.iter_mut().zip(drawn.iter()) {
-                *o = self.sample_at(p, pdf_q);
+            let (points, frames) = (&points[..n], &mut frames[..n]);
+            match mapping {
+                Mapping::LatLong => {
+                    simd::map_rows(frames, points, &frame!(Mapping::LatLong), |_| true, false)
+                }
+                Mapping::Angular => {
+                    simd::map_rows(frames, points, &frame!(Mapping::Angular), |_| true, false)
+                }
+                Mapping::Cube => {
+                    simd::map_rows(frames, points, &frame!(Mapping::Cube), |_| true, false)
+                }
+            };
+            for ((o, f), c) in out.iter_mut().zip(frames.iter()).zip(&corners) {
+                *o = self.sample_from(f, c);
             }
         }
     }
@@ -550,24 +617,45 @@ impl EnvMap {
     }
 
     /// The sample at domain point `p`, drawn with density `pdf_q` per unit
-    /// area of the sampling table. The Jacobian takes sin θ from the
-    /// direction's own formula (a unit vector by construction): no
-    /// normalisation, as [`EnvMap::table_jacobian`] needs for a query.
+    /// area of the sampling table.
     #[inline(always)]
     fn sample_at(&self, p: [f64; 2], pdf_q: f64) -> EnvSample {
         let mapping = self.options.mapping;
+        let frame = self.frame_at(mapping, p, pdf_q);
+        self.sample_from(&frame, &self.image.corners(mapping, p))
+    }
+
+    /// The world direction at domain point `p` of `mapping` (this map's),
+    /// its density per steradian and the inverse of that density (0 where
+    /// it is 0), for a point drawn with density `pdf_q` per unit area of
+    /// the sampling table: `[x, y, z, pdf, 1/pdf]`. Branch-free for the
+    /// polar mappings, so that a group's frames are computed at SIMD width.
+    /// The Jacobian takes sin θ from the direction's own formula (a unit
+    /// vector by construction): no normalisation, as
+    /// [`EnvMap::table_jacobian`] needs for a query.
+    #[inline(always)]
+    fn frame_at(&self, mapping: Mapping, p: [f64; 2], pdf_q: f64) -> [f64; 5] {
         let (local, sin_theta) = mapping.to_dir_and_sin(p);
         let jacobian = match mapping {
             Mapping::Cube => mapping.jacobian(p),
             _ => polar_jacobian(sin_theta),
         };
         let pdf = pdf_q / jacobian;
-        let radiance = self.radiance_at(p);
         let inv_pdf = if pdf > 0.0 { 1.0 / pdf } else { 0.0 };
+        let [x, y, z] = self.to_world(local);
+        [x, y, z, pdf, inv_pdf]
+    }
+
+    /// The sample of a frame ([`EnvMap::frame_at`]) whose radiance is the
+    /// blend of `corners` times scale.
+    #[inline(always)]
+    fn sample_from(&self, frame: &[f64; 5], corners: &Corners<f64>) -> EnvSample {
+        let scale = self.options.scale;
+        let [x, y, z, pdf, inv_pdf] = *frame;
         EnvSample {
-            direction: self.to_world(local),
+            direction: [x, y, z],
             pdf,
-            weight: radiance.map(|l| l * inv_pdf),
+            weight: self.image.blend(corners).map(|l| l * scale * inv_pdf),
         }
     }
 

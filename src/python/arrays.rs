@@ -20,7 +20,10 @@ use pyo3::types::PyTuple;
 
 /// A float type the bindings compute in: `f32` or `f64`, readable from
 /// Python and storable in numpy arrays.
-pub trait PyFloat: Element + Real + for<'a, 'py> FromPyObject<'a, 'py> {}
+pub trait PyFloat:
+    Element + Real + crate::envmap::TableFloat + for<'a, 'py> FromPyObject<'a, 'py>
+{
+}
 impl PyFloat for f32 {}
 impl PyFloat for f64 {}
 

@@ -251,6 +251,31 @@ impl PyEnvMap {
         })
     }
 
+    /// `eval` by [`EnvMap::eval_into`] in `F`, which checks that every
+    /// direction is finite in the same pass.
+    fn eval_as<'py, F: PyFloat>(
+        &self,
+        py: Python<'py>,
+        d: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let d = Points::<F, 3>::extract(d, "d")?;
+        let out = zeros::<F>(py, &d.out_shape(3));
+        {
+            let mut guard = out.readwrite();
+            let rows = d.rows();
+            let env = &self.0;
+            let finite = |x: &[F; 3]| Check::Finite.holds_all(x);
+            let flat = guard.as_slice_mut()?.as_chunks_mut::<3>().0;
+            let valid = run_batch(py, d.n, flat, |range, chunk: &mut [[F; 3]]| {
+                env.eval_into(&rows[range], chunk, finite)
+            })?;
+            if !valid {
+                return Err(d.invalid(Check::Finite));
+            }
+        }
+        finish(out)
+    }
+
     /// `pdf` by [`EnvMap::pdf_into`], which checks that every direction is
     /// finite in the same pass.
     fn pdf_as<'py, F: PyFloat>(
@@ -410,7 +435,7 @@ impl PyEnvMap {
     /// -------
     /// ndarray, shape (N, 3) or (3,), in d's precision.
     fn eval<'py>(&self, py: Python<'py>, d: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        with_precision!(d, F => self.directions::<F, 3>(py, d, |e, x| e.eval(x)))
+        with_precision!(d, F => self.eval_as::<F>(py, d))
     }
 
     /// The density of ``sample`` at world directions d, per steradian.

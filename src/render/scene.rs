@@ -71,7 +71,9 @@ impl Environment {
     /// [`Environment::eval`] for a batch of directions.
     pub fn eval_into(&self, d: &[[f32; 3]], out: &mut [[f32; 3]]) {
         match self {
-            Environment::Map(env) => env.eval_into(d, out),
+            Environment::Map(env) => {
+                env.eval_into(d, out, |_| true);
+            }
             Environment::Constant(l) => out.fill(l.map(|v| v as f32)),
         }
     }
