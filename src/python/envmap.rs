@@ -433,7 +433,9 @@ impl PyEnvMap {
     ///
     /// Returns
     /// -------
-    /// ndarray, shape (N, 3) or (3,), in d's precision.
+    /// ndarray, shape (N, 3) or (3,), in d's precision (and computed in
+    /// it: for float32 directions the place on the map is good to a few
+    /// float32 ulps, as in Mitsuba's float32 variants).
     fn eval<'py>(&self, py: Python<'py>, d: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         with_precision!(d, F => self.eval_as::<F>(py, d))
     }
