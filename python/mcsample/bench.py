@@ -44,6 +44,23 @@ def measure(fn: Callable[[], object], repeat: int = 7, warmup: int = 2) -> float
     return statistics.median(times)
 
 
+def measure_side_by_side(fns: list[Callable[[], object]], repeat: int = 7,
+                         warmup: int = 2) -> list[float]:
+    """Median wall time of each of ``fns`` in seconds, run in turn (one run
+    of each per round, ``repeat`` rounds after ``warmup``), so that a slow
+    spell of a shared machine weighs on all of them alike."""
+    for _ in range(warmup):
+        for fn in fns:
+            fn()
+    times: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeat):
+        for fn, t in zip(fns, times):
+            start = time.perf_counter()
+            fn()
+            t.append(time.perf_counter() - start)
+    return [statistics.median(t) for t in times]
+
+
 def _numpy_cosine_hemisphere(u: np.ndarray) -> np.ndarray:
     """Malley's method on the concentric disk, vectorised with numpy."""
     a, b = 2 * u[:, 0] - 1, 2 * u[:, 1] - 1
@@ -192,8 +209,14 @@ def suite_distr(n: int, repeat: int, mi) -> list[Timing]:
         import drjit as dr
 
         w32 = weights.astype(np.float32)
+        def mi_build():
+            # The constructor only records the running sums: evaluate them.
+            built = mi.DiscreteDistribution(w32)
+            dr.eval(built.cdf)
+            dr.sync_thread()
+
         out.append(Timing("build 10^6 (entries/s)", "Mitsuba 3 llvm", "float32", size,
-                          measure(lambda: mi.DiscreteDistribution(w32), repeat)))
+                          measure(mi_build, repeat)))
         dist = mi.DiscreteDistribution(w32)
         uf = mi.Float(u.astype(np.float32))
 
@@ -298,22 +321,14 @@ def suite_envmap(n: int, repeat: int, mi) -> list[Timing]:
     u32 = u64.astype(np.float32)
     d64 = env.sample(u64).direction
     d32 = d64.astype(np.float32)
-    out += [
-        Timing("EnvMap.sample 1024x512", "mcsample", "float64", n,
-               measure(lambda: env.sample(u64), repeat)),
-        Timing("EnvMap.sample 1024x512", "mcsample", "float32", n,
-               measure(lambda: env.sample(u32), repeat)),
-        Timing("EnvMap.pdf 1024x512", "mcsample", "float64", n,
-               measure(lambda: env.pdf(d64), repeat)),
-        Timing("EnvMap.pdf 1024x512", "mcsample", "float32", n,
-               measure(lambda: env.pdf(d32), repeat)),
-        Timing("EnvMap.eval 1024x512", "mcsample", "float32", n,
-               measure(lambda: env.eval(d32), repeat)),
+    # (case, implementation, dtype, function), timed side by side.
+    cases = [
+        ("EnvMap.sample 1024x512", "mcsample", "float64", lambda: env.sample(u64)),
+        ("EnvMap.sample 1024x512", "mcsample", "float32", lambda: env.sample(u32)),
+        ("EnvMap.pdf 1024x512", "mcsample", "float64", lambda: env.pdf(d64)),
+        ("EnvMap.pdf 1024x512", "mcsample", "float32", lambda: env.pdf(d32)),
+        ("EnvMap.eval 1024x512", "mcsample", "float32", lambda: env.eval(d32)),
     ]
-    numpy_sample = _numpy_envmap_sampler(image)
-    m = max(n // 10, 1)
-    out.append(Timing("EnvMap.sample 1024x512", "numpy", "float64", m,
-                      measure(lambda: numpy_sample(u64[:m]), max(repeat // 2, 1), 1)))
     if mi is not None:
         import drjit as dr
 
@@ -334,10 +349,14 @@ def suite_envmap(n: int, repeat: int, mi) -> list[Timing]:
             dr.eval(p)
             dr.sync_thread()
 
-        out += [Timing("EnvMap.sample 1024x512", "Mitsuba 3 llvm", "float32", n,
-                       measure(mi_sample, repeat)),
-                Timing("EnvMap.pdf 1024x512", "Mitsuba 3 llvm", "float32", n,
-                       measure(mi_pdf, repeat))]
+        cases += [("EnvMap.sample 1024x512", "Mitsuba 3 llvm", "float32", mi_sample),
+                  ("EnvMap.pdf 1024x512", "Mitsuba 3 llvm", "float32", mi_pdf)]
+    seconds = measure_side_by_side([c[3] for c in cases], repeat)
+    out += [Timing(case, impl, dtype, n, t) for (case, impl, dtype, _), t in zip(cases, seconds)]
+    numpy_sample = _numpy_envmap_sampler(image)
+    m = max(n // 10, 1)
+    out.append(Timing("EnvMap.sample 1024x512", "numpy", "float64", m,
+                      measure(lambda: numpy_sample(u64[:m]), max(repeat // 2, 1), 1)))
     return out
 
 
@@ -378,17 +397,19 @@ def suite_render(n: int, repeat: int, mi, spp: int = 64) -> list[Timing]:
                 mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp, directory=directory))
         for integrator in ("direct", "path"):
             case = f"render {name}, {integrator}"
-            out.append(Timing(case, "mcsample", "float32", samples, measure(
-                lambda: mcs.render(scene, spp, integrator=integrator, progress=False),
-                repeat, 1)))
+            runs = [("mcsample", lambda: mcs.render(scene, spp, integrator=integrator,
+                                                    progress=False))]
             if mi_scene is not None:
                 mi_int = mi.load_dict({"type": integrator})
 
                 def run_mitsuba():
                     img = mi.render(mi_scene, integrator=mi_int, spp=spp)
                     np.asarray(img)
-                out.append(Timing(case, "mitsuba llvm_ad_rgb", "float32", samples,
-                                  measure(run_mitsuba, repeat, 2)))
+                runs.append(("mitsuba llvm_ad_rgb", run_mitsuba))
+            # Side by side, after two warm-up renders of each (Mitsuba's JIT).
+            seconds = measure_side_by_side([r[1] for r in runs], repeat, 2)
+            out += [Timing(case, impl, "float32", samples, t)
+                    for (impl, _), t in zip(runs, seconds)]
     return out
 
 
