@@ -1,8 +1,9 @@
 //! Environment maps in the core, on one thread: build time of a 1024 × 512
-//! and a 2048 × 1024 sky, and nanoseconds per sample, pdf and eval:
+//! and a 2048 × 1024 sky, and nanoseconds per sample, pdf and eval (one
+//! at a time, and in batches):
 //! `cargo bench --bench envmap`.
 
-use mcsample::envmap::{EnvMap, Options};
+use mcsample::envmap::{EnvMap, EnvSample, Options};
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -60,6 +61,32 @@ fn main() {
             [x, (i as f64 + 0.5) / n as f64]
         })
         .collect();
+    // Batches on random numbers, as Python's EnvMap.sample and .pdf run them
+    // (on each thread).
+    let mut state = 0x853c_49e6_748f_ea9b_u64;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let random: Vec<[f64; 2]> = (0..n).map(|_| [next(), next()]).collect();
+    let mut samples = vec![EnvSample::default(); n];
+    let t = best(3, || env.sample_into(black_box(&random), &mut samples));
+    println!("sample_into (random u): {:.1} ns", t / n as f64 * 1e9);
+    let d32: Vec<[f32; 3]> = samples
+        .iter()
+        .map(|s| s.direction.map(|x| x as f32))
+        .collect();
+    let mut pdf32 = vec![0.0f32; n];
+    let t = best(3, || {
+        env.pdf_into(black_box(&d32), &mut pdf32, |_| true);
+        black_box(&pdf32);
+    });
+    println!(
+        "pdf_into f32 (sampled directions): {:.1} ns",
+        t / n as f64 * 1e9
+    );
     let mut dirs = vec![[0.0; 3]; n];
     let t = best(3, || {
         for (d, &x) in dirs.iter_mut().zip(&u) {
