@@ -233,6 +233,13 @@ fn settings(
     })
 }
 
+/// Whether every coordinate of the direction `x` is finite (the check of
+/// the batch methods, inlined into their loops).
+#[inline(always)]
+fn finite<F: PyFloat>(x: &[F; 3]) -> bool {
+    Check::Finite.holds_all(x)
+}
+
 impl PyEnvMap {
     fn build(py: Python<'_>, w: usize, h: usize, data: &[f32], options: Options) -> PyResult<Self> {
         Ok(Self(detached(py, || EnvMap::new(w, h, data, options))?))
@@ -251,47 +258,24 @@ impl PyEnvMap {
         })
     }
 
-    /// `eval` by [`EnvMap::eval_into`] in `F`, which checks that every
-    /// direction is finite in the same pass.
-    fn eval_as<'py, F: PyFloat>(
+    /// `M` values per world direction of `d`, computed in `F` by a batch
+    /// method of [`EnvMap`] (`eval_into`, `pdf_into`) that checks with
+    /// [`finite`] that every direction is finite, in the same pass.
+    fn batch_as<'py, F: PyFloat, const M: usize>(
         &self,
         py: Python<'py>,
         d: &Bound<'py, PyAny>,
+        kernel: impl Fn(&EnvMap, &[[F; 3]], &mut [[F; M]]) -> bool + Sync + Send,
     ) -> PyResult<Bound<'py, PyAny>> {
         let d = Points::<F, 3>::extract(d, "d")?;
-        let out = zeros::<F>(py, &d.out_shape(3));
+        let out = zeros::<F>(py, &d.out_shape(M));
         {
             let mut guard = out.readwrite();
             let rows = d.rows();
             let env = &self.0;
-            let finite = |x: &[F; 3]| Check::Finite.holds_all(x);
-            let flat = guard.as_slice_mut()?.as_chunks_mut::<3>().0;
-            let valid = run_batch(py, d.n, flat, |range, chunk: &mut [[F; 3]]| {
-                env.eval_into(&rows[range], chunk, finite)
-            })?;
-            if !valid {
-                return Err(d.invalid(Check::Finite));
-            }
-        }
-        finish(out)
-    }
-
-    /// `pdf` by [`EnvMap::pdf_into`], which checks that every direction is
-    /// finite in the same pass.
-    fn pdf_as<'py, F: PyFloat>(
-        &self,
-        py: Python<'py>,
-        d: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let d = Points::<F, 3>::extract(d, "d")?;
-        let out = zeros::<F>(py, &d.out_shape(1));
-        {
-            let mut guard = out.readwrite();
-            let rows = d.rows();
-            let env = &self.0;
-            let finite = |x: &[F; 3]| Check::Finite.holds_all(x);
-            let valid = run_batch(py, d.n, guard.as_slice_mut()?, |range, chunk: &mut [F]| {
-                env.pdf_into(&rows[range], chunk, finite)
+            let flat = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
+            let valid = run_batch(py, d.n, flat, |range, chunk: &mut [[F; M]]| {
+                kernel(env, &rows[range], chunk)
             })?;
             if !valid {
                 return Err(d.invalid(Check::Finite));
@@ -437,7 +421,9 @@ impl PyEnvMap {
     /// it: for float32 directions the place on the map is good to a few
     /// float32 ulps, as in Mitsuba's float32 variants).
     fn eval<'py>(&self, py: Python<'py>, d: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        with_precision!(d, F => self.eval_as::<F>(py, d))
+        with_precision!(d, F => self.batch_as::<F, 3>(py, d, |env, d, out| {
+            env.eval_into(d, out, finite::<F>)
+        }))
     }
 
     /// The density of ``sample`` at world directions d, per steradian.
@@ -450,7 +436,9 @@ impl PyEnvMap {
     /// -------
     /// ndarray, shape (N,) (a scalar for one direction).
     fn pdf<'py>(&self, py: Python<'py>, d: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        with_precision!(d, F => self.pdf_as::<F>(py, d))
+        with_precision!(d, F => self.batch_as::<F, 1>(py, d, |env, d, out| {
+            env.pdf_into(d, out.as_flattened_mut(), finite::<F>)
+        }))
     }
 
     /// Directions drawn with density ``pdf``.
