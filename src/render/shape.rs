@@ -5,7 +5,9 @@
 //! sphere's quadratic, solved in `f64` so that its roots stay accurate far
 //! from the origin.
 
-use glam::{Affine3A, DVec3, Vec3A};
+use std::ops::{Add, BitAnd, Div, Mul, Sub};
+
+use glam::{Affine3A, BVec4A, DVec3, Vec3A, Vec4};
 
 use crate::warp;
 
@@ -56,29 +58,16 @@ pub struct Triangle {
 
 impl Triangle {
     /// Möller–Trumbore: the distance and barycentrics of the hit in
-    /// `(0, tmax)`, if any. The tests run on the barycentrics and distance
-    /// scaled by the determinant (made positive), so that a miss costs no
-    /// division.
+    /// `(0, tmax)`, if any (see [`moller_trumbore`]).
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Candidate> {
-        let pvec = ray.d.cross(self.e2);
-        let det = self.e1.dot(pvec);
-        if !(det != 0.0 && det.is_finite()) {
+        let [o, d, p0, e1, e2] = [ray.o, ray.d, self.p0, self.e1, self.e2].map(|v| v.to_array());
+        let scaled = moller_trumbore(o, d, p0, e1, e2);
+        if !scaled.inside {
             return None;
         }
-        let tvec = ray.o - self.p0;
-        let qvec = tvec.cross(self.e1);
-        let sign = det.signum();
-        let (det, b1, b2) = (det.abs(), sign * tvec.dot(pvec), sign * ray.d.dot(qvec));
-        if !(b1 >= 0.0 && b1 <= det && b2 >= 0.0 && b1 + b2 <= det) {
-            return None;
-        }
-        let inv = 1.0 / det;
-        let t = sign * self.e2.dot(qvec) * inv;
-        (t > 0.0 && t < ray.tmax).then_some(Candidate {
-            t,
-            bary: [b1 * inv, b2 * inv],
-        })
+        let (ahead, t, bary) = scaled.hit(ray.tmax);
+        ahead.then_some(Candidate { t, bary })
     }
 
     /// Area, `|e1 × e2| / 2`.
@@ -105,6 +94,196 @@ impl Triangle {
     pub fn sample(&self, u: [f32; 2]) -> SurfacePoint {
         let [b1, b2] = warp::square_to_uniform_triangle(u);
         self.point([b1, b2])
+    }
+}
+
+/// Numbers that Möller–Trumbore runs on: one `f32` (one triangle), or a
+/// `Vec4` (four triangles at once, one per lane).
+pub trait Lanes:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
+{
+    /// Per-lane truth values.
+    type Mask: Copy + BitAnd<Output = Self::Mask>;
+    /// `x` in every lane.
+    fn splat(x: f32) -> Self;
+    /// `±1` by the sign bit.
+    fn signum(self) -> Self;
+    /// `|x|`.
+    fn abs(self) -> Self;
+    /// `self < other`.
+    fn lt(self, other: Self) -> Self::Mask;
+    /// `self <= other`.
+    fn le(self, other: Self) -> Self::Mask;
+}
+
+impl Lanes for f32 {
+    type Mask = bool;
+    fn splat(x: f32) -> Self {
+        x
+    }
+    fn signum(self) -> Self {
+        f32::signum(self)
+    }
+    fn abs(self) -> Self {
+        f32::abs(self)
+    }
+    fn lt(self, other: Self) -> bool {
+        self < other
+    }
+    fn le(self, other: Self) -> bool {
+        self <= other
+    }
+}
+
+impl Lanes for Vec4 {
+    type Mask = BVec4A;
+    fn splat(x: f32) -> Self {
+        Vec4::splat(x)
+    }
+    fn signum(self) -> Self {
+        Vec4::signum(self)
+    }
+    fn abs(self) -> Self {
+        Vec4::abs(self)
+    }
+    fn lt(self, other: Self) -> BVec4A {
+        self.cmplt(other)
+    }
+    fn le(self, other: Self) -> BVec4A {
+        self.cmple(other)
+    }
+}
+
+/// Möller–Trumbore's quantities, scaled by the determinant made positive,
+/// `|det|`: `b1 |det|`, `b2 |det|` and `t |det|`. The inside test runs on
+/// them, so that a miss costs no division.
+pub struct Scaled<L: Lanes> {
+    /// Whether `det` is finite and not 0 and the barycentrics lie in the
+    /// triangle.
+    pub inside: L::Mask,
+    det: L,
+    b1: L,
+    b2: L,
+    t: L,
+}
+
+impl<L: Lanes> Scaled<L> {
+    /// Whether the hit lies in `(0, tmax)`, its distance and barycentrics.
+    #[inline(always)]
+    pub fn hit(&self, tmax: f32) -> (L::Mask, L, [L; 2]) {
+        let inv = L::splat(1.0) / self.det;
+        let t = self.t * inv;
+        let ahead = L::splat(0.0).lt(t) & t.lt(L::splat(tmax));
+        (ahead, t, [self.b1 * inv, self.b2 * inv])
+    }
+}
+
+/// Möller–Trumbore for the ray `o + t d` and the triangle `p0 + b1 e1 +
+/// b2 e2` (in lanes: several triangles, one ray splatted), as vectors of
+/// components:
+///
+/// ```text
+/// p = d × e2,  det = e1 · p,  s = o − p0,  q = s × e1,
+/// b1 = (s · p) / det,  b2 = (d · q) / det,  t = (e2 · q) / det
+/// ```
+#[inline(always)]
+pub fn moller_trumbore<L: Lanes>(
+    o: [L; 3],
+    d: [L; 3],
+    p0: [L; 3],
+    e1: [L; 3],
+    e2: [L; 3],
+) -> Scaled<L> {
+    let cross = |a: [L; 3], b: [L; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let dot = |a: [L; 3], b: [L; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let p = cross(d, e2);
+    let det = dot(e1, p);
+    let s = [o[0] - p0[0], o[1] - p0[1], o[2] - p0[2]];
+    let q = cross(s, e1);
+    let sign = det.signum();
+    let (det, b1, b2) = (det.abs(), sign * dot(s, p), sign * dot(d, q));
+    let zero = L::splat(0.0);
+    let inside = zero.lt(det)
+        & det.lt(L::splat(f32::INFINITY))
+        & zero.le(b1)
+        & b1.le(det)
+        & zero.le(b2)
+        & (b1 + b2).le(det);
+    Scaled {
+        inside,
+        det,
+        b1,
+        b2,
+        t: sign * dot(e2, q),
+    }
+}
+
+/// Up to four triangles side by side, component by component, tested
+/// against one ray at once (unused lanes hold a degenerate triangle, which
+/// nothing hits).
+#[derive(Clone, Copy, Debug)]
+pub struct Triangles4 {
+    p0: [Vec4; 3],
+    e1: [Vec4; 3],
+    e2: [Vec4; 3],
+}
+
+impl Triangles4 {
+    /// At most four triangles, in lane order.
+    pub fn new(triangles: &[Triangle]) -> Self {
+        let mut pack = Triangles4 {
+            p0: [Vec4::ZERO; 3],
+            e1: [Vec4::ZERO; 3],
+            e2: [Vec4::ZERO; 3],
+        };
+        for (lane, t) in triangles.iter().take(4).enumerate() {
+            for k in 0..3 {
+                pack.p0[k][lane] = t.p0[k];
+                pack.e1[k][lane] = t.e1[k];
+                pack.e2[k][lane] = t.e2[k];
+            }
+        }
+        pack
+    }
+
+    /// The nearest hit in `(0, tmax)` among the four: its lane and
+    /// candidate.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<(usize, Candidate)> {
+        let scaled = moller_trumbore::<Vec4>(
+            ray.o.to_array().map(Vec4::splat),
+            ray.d.to_array().map(Vec4::splat),
+            self.p0,
+            self.e1,
+            self.e2,
+        );
+        if !scaled.inside.any() {
+            return None;
+        }
+        let (ahead, t, [b1, b2]) = scaled.hit(ray.tmax);
+        let hits = (scaled.inside & ahead).bitmask();
+        let lane = (0..4)
+            .filter(|l| hits & (1 << l) != 0)
+            .min_by(|&a, &b| t[a].total_cmp(&t[b]))?;
+        Some((
+            lane,
+            Candidate {
+                t: t[lane],
+                bary: [b1[lane], b2[lane]],
+            },
+        ))
+    }
+
+    /// Whether any of the four lies on the ray in `(0, tmax)`.
+    #[inline]
+    pub fn occludes(&self, ray: &Ray) -> bool {
+        self.intersect(ray).is_some()
     }
 }
 
@@ -297,6 +476,52 @@ mod tests {
                 .is_none()
         );
         assert!((tri.area() - 0.5).abs() < 1e-7);
+    }
+
+    /// Four triangles tested at once give the nearest of the hits each
+    /// gives alone (and its barycentrics), on rays that hit none, one or
+    /// several of them; three triangles leave a padding lane that nothing
+    /// hits.
+    #[test]
+    fn four_triangles_at_once_agree_with_one_at_a_time() {
+        let tri = |p0: [f32; 3], e1: [f32; 3], e2: [f32; 3]| Triangle {
+            p0: Vec3A::from(p0),
+            e1: Vec3A::from(e1),
+            e2: Vec3A::from(e2),
+            normals: None,
+        };
+        let tris = [
+            tri([-1.0, -1.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]),
+            tri([-1.0, -1.0, -1.0], [0.0, 2.0, 0.0], [2.0, 0.0, 0.0]),
+            tri([0.0, -2.0, -3.0], [0.0, 4.0, 0.0], [0.0, 0.0, 4.0]),
+            tri([0.3, -0.5, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.2]),
+        ];
+        for count in [3, 4] {
+            let pack = Triangles4::new(&tris[..count]);
+            let mut nearest_lanes = [0; 4];
+            for i in 0..400 {
+                let (a, b) = ((i % 20) as f32 / 10.0 - 1.0, (i / 20) as f32 / 10.0 - 1.0);
+                let r = ray([a, b, 2.0], [0.3 * b, -0.2, -1.0]);
+                let nearest = tris[..count]
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(l, t)| t.intersect(&r).map(|c| (l, c)))
+                    .min_by(|x, y| x.1.t.total_cmp(&y.1.t));
+                let packed = pack.intersect(&r);
+                assert_eq!(packed.map(|p| p.0), nearest.map(|n| n.0), "ray {i}");
+                if let (Some((_, p)), Some((_, n))) = (packed, nearest) {
+                    assert_eq!((p.t, p.bary), (n.t, n.bary), "ray {i}");
+                }
+                assert_eq!(pack.occludes(&r), nearest.is_some());
+                if let Some((l, _)) = nearest {
+                    nearest_lanes[l] += 1;
+                }
+            }
+            assert!(
+                nearest_lanes[..count].iter().all(|&n| n > 0),
+                "{nearest_lanes:?}"
+            );
+        }
     }
 
     #[test]
