@@ -204,6 +204,38 @@ def test_float32_in_float32_out():
     np.testing.assert_allclose(s.pdf, SKY.sample(u.astype(np.float64)).pdf, rtol=1e-5)
 
 
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_out_receives_the_results(dtype):
+    u = mcs.uniform(1000, 2, seed=3).astype(dtype)
+    fresh = SKY.sample(u)
+    outs = (np.empty((1000, 3), dtype), np.empty(1000, dtype), np.empty((1000, 3), dtype))
+    s = SKY.sample(u, out=outs)
+    assert all(got is out for got, out in zip((s.direction, s.pdf, s.weight), outs))
+    for got, want in [(s.direction, fresh.direction), (s.pdf, fresh.pdf), (s.weight, fresh.weight)]:
+        assert np.array_equal(got, want)
+    pdf, radiance = np.empty(1000, dtype), np.empty((1000, 3), dtype)
+    assert SKY.pdf(fresh.direction, out=pdf) is pdf
+    assert np.array_equal(pdf, SKY.pdf(fresh.direction))
+    assert SKY.eval(fresh.direction, out=radiance) is radiance
+    assert np.array_equal(radiance, SKY.eval(fresh.direction))
+
+
+def test_bad_out_is_refused():
+    u = mcs.uniform(10, 2, seed=3)
+    d = SKY.sample(u).direction
+    with pytest.raises(TypeError, match="dtype float64"):
+        SKY.pdf(d, out=np.empty(10, np.float32))
+    with pytest.raises(ValueError, match="shape"):
+        SKY.eval(d, out=np.empty((10, 2)))
+    with pytest.raises(ValueError, match="share memory"):
+        SKY.eval(d, out=d)
+    with pytest.raises(TypeError, match="tuple of three arrays"):
+        SKY.sample(u, out=np.empty((10, 3)))
+    shared = np.empty((10, 3))
+    with pytest.raises(ValueError, match="share memory"):
+        SKY.sample(u, out=(shared, np.empty(10), shared))
+
+
 def test_single_direction_is_unbatched():
     assert SKY.eval([0, 1, 0]).shape == (3,)
     assert np.ndim(SKY.pdf([0, 1, 0])) == 0

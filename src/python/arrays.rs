@@ -12,6 +12,7 @@ use super::parallel::run_batch;
 use crate::error::{Error, shape_str};
 use crate::math::Real;
 use crate::simd::{STREAM_MIN_BYTES, map_rows};
+use numpy::PyReadwriteArrayDyn;
 use numpy::{AllowTypeChange, Element, PyArray, PyArrayDescrMethods, PyArrayDyn, PyArrayLikeDyn};
 use numpy::{PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
@@ -367,6 +368,18 @@ pub fn output<'py, T: Element>(
     Ok(array.clone())
 }
 
+/// Write access to an output array, which fails (rather than panics) when
+/// an `out` array shares memory with an input or another output.
+pub fn writable<'py, T: Element>(
+    out: &Bound<'py, PyArrayDyn<T>>,
+) -> PyResult<PyReadwriteArrayDyn<'py, T>> {
+    out.try_readwrite().map_err(|_| {
+        pyo3::exceptions::PyValueError::new_err(
+            "out must not share memory with an input array or another output",
+        )
+    })
+}
+
 /// As [`map`], writing into `out` when it is given (see [`output`]).
 pub fn map_into<'py, F, T, const K: usize, const M: usize>(
     py: Python<'py>,
@@ -381,9 +394,7 @@ where
 {
     let out = output::<T>(py, &x.out_shape(M), out)?;
     {
-        let mut guard = out.try_readwrite().map_err(|_| {
-            pyo3::exceptions::PyValueError::new_err("out must not share memory with an input array")
-        })?;
+        let mut guard = writable(&out)?;
         let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
         let in_rows = x.rows();
         let stream = size_of_val(&*out_rows) >= STREAM_MIN_BYTES;

@@ -1,7 +1,9 @@
 //! `mcsample.EnvMap`: environment maps (see [`crate::envmap`]), batched
 //! over directions and uniform samples.
 
-use super::arrays::{Check, Points, PyFloat, finish, map, map_each, with_precision, zeros};
+use super::arrays::{
+    Check, Points, PyFloat, finish, map, map_each, output, with_precision, writable,
+};
 use super::parallel::{detached, run_batch};
 use crate::distr::GROUP;
 use crate::envmap::{EnvMap, EnvSample, Mapping, Matrix3, Options, Sampling};
@@ -233,6 +235,21 @@ fn settings(
     })
 }
 
+/// The three arrays of `EnvMap.sample`'s `out` (direction, pdf, weight), or
+/// none.
+fn sample_outputs<'py>(
+    out: Option<&Bound<'py, PyAny>>,
+) -> PyResult<[Option<Bound<'py, PyAny>>; 3]> {
+    let Some(out) = out.filter(|o| !o.is_none()) else {
+        return Ok([None, None, None]);
+    };
+    let (d, p, w): (Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>) =
+        out.extract().map_err(|_| {
+            PyTypeError::new_err("out must be a tuple of three arrays: (direction, pdf, weight)")
+        })?;
+    Ok([Some(d), Some(p), Some(w)])
+}
+
 /// Whether every coordinate of the direction `x` is finite (the check of
 /// the batch methods, inlined into their loops).
 #[inline(always)]
@@ -260,17 +277,19 @@ impl PyEnvMap {
 
     /// `M` values per world direction of `d`, computed in `F` by a batch
     /// method of [`EnvMap`] (`eval_into`, `pdf_into`) that checks with
-    /// [`finite`] that every direction is finite, in the same pass.
+    /// [`finite`] that every direction is finite, in the same pass; into
+    /// `out` when given (see [`output`]).
     fn batch_as<'py, F: PyFloat, const M: usize>(
         &self,
         py: Python<'py>,
         d: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
         kernel: impl Fn(&EnvMap, &[[F; 3]], &mut [[F; M]]) -> bool + Sync + Send,
     ) -> PyResult<Bound<'py, PyAny>> {
         let d = Points::<F, 3>::extract(d, "d")?;
-        let out = zeros::<F>(py, &d.out_shape(M));
+        let out = output::<F>(py, &d.out_shape(M), out)?;
         {
-            let mut guard = out.readwrite();
+            let mut guard = writable(&out)?;
             let rows = d.rows();
             let env = &self.0;
             let flat = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
@@ -284,19 +303,23 @@ impl PyEnvMap {
         finish(out)
     }
 
+    /// Samples for `u`, into the arrays of `out` (direction, pdf, weight)
+    /// when given (see [`output`]).
     fn sample_as<'py, F: PyFloat>(
         &self,
         py: Python<'py>,
         u: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<PyEnvSample> {
         let u = Points::<F, 2>::extract(u, "u")?;
         let (vec_shape, scalar_shape) = (u.out_shape(3), u.out_shape(1));
-        let direction = zeros::<F>(py, &vec_shape);
-        let pdf = zeros::<F>(py, &scalar_shape);
-        let weight = zeros::<F>(py, &vec_shape);
+        let [o_d, o_p, o_w] = sample_outputs(out)?;
+        let direction = output::<F>(py, &vec_shape, o_d.as_ref())?;
+        let pdf = output::<F>(py, &scalar_shape, o_p.as_ref())?;
+        let weight = output::<F>(py, &vec_shape, o_w.as_ref())?;
         {
             let (mut g_d, mut g_p, mut g_w) =
-                (direction.readwrite(), pdf.readwrite(), weight.readwrite());
+                (writable(&direction)?, writable(&pdf)?, writable(&weight)?);
             let outputs = (
                 g_d.as_slice_mut()?.as_chunks_mut::<3>().0,
                 g_p.as_slice_mut()?,
@@ -414,14 +437,23 @@ impl PyEnvMap {
     /// Parameters
     /// ----------
     /// d : array_like, shape (N, 3) or (3,), directions (normalised here)
+    /// out : ndarray, optional, keyword only
+    ///     Array to write into (the result's shape and dtype, C-ordered), as
+    ///     numpy's ufuncs take; saves allocating a fresh result per call.
     ///
     /// Returns
     /// -------
     /// ndarray, shape (N, 3) or (3,), in d's precision (and computed in
     /// it: for float32 directions the place on the map is good to a few
     /// float32 ulps, as in Mitsuba's float32 variants).
-    fn eval<'py>(&self, py: Python<'py>, d: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        with_precision!(d, F => self.batch_as::<F, 3>(py, d, |env, d, out| {
+    #[pyo3(signature = (d, *, out = None))]
+    fn eval<'py>(
+        &self,
+        py: Python<'py>,
+        d: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(d, F => self.batch_as::<F, 3>(py, d, out, |env, d, out| {
             env.eval_into(d, out, finite::<F>)
         }))
     }
@@ -431,12 +463,20 @@ impl PyEnvMap {
     /// Parameters
     /// ----------
     /// d : array_like, shape (N, 3) or (3,), directions (normalised here)
+    /// out : ndarray, optional, keyword only
+    ///     Array to write into, shape (N,), of d's dtype (as for ``eval``).
     ///
     /// Returns
     /// -------
-    /// ndarray, shape (N,) (a scalar for one direction).
-    fn pdf<'py>(&self, py: Python<'py>, d: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        with_precision!(d, F => self.batch_as::<F, 1>(py, d, |env, d, out| {
+    /// ndarray, shape (N,) (a scalar for one direction), in d's precision.
+    #[pyo3(signature = (d, *, out = None))]
+    fn pdf<'py>(
+        &self,
+        py: Python<'py>,
+        d: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        with_precision!(d, F => self.batch_as::<F, 1>(py, d, out, |env, d, out| {
             env.pdf_into(d, out.as_flattened_mut(), finite::<F>)
         }))
     }
@@ -446,14 +486,24 @@ impl PyEnvMap {
     /// Parameters
     /// ----------
     /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    /// out : tuple of three ndarrays, optional, keyword only
+    ///     ``(direction, pdf, weight)`` to write into, of shapes (N, 3),
+    ///     (N,) and (N, 3) and u's dtype, as numpy's ufuncs with several
+    ///     results take; the EnvSample then holds these arrays.
     ///
     /// Returns
     /// -------
     /// EnvSample
     ///     ``.direction`` (N, 3), ``.pdf`` (N,) per steradian, ``.weight``
     ///     (N, 3) = eval / pdf (0 where pdf = 0), in u's precision.
-    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<PyEnvSample> {
-        with_precision!(u, F => self.sample_as::<F>(py, u))
+    #[pyo3(signature = (u, *, out = None))]
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        u: &Bound<'py, PyAny>,
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<PyEnvSample> {
+        with_precision!(u, F => self.sample_as::<F>(py, u, out))
     }
 
     /// The map coordinates (u, v) that look along world directions d:

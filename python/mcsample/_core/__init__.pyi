@@ -196,11 +196,12 @@ class EnvMap:
              scale: float = 1.0, sampling: str = "piecewise",
              compensate: bool = False) -> EnvMap:
         """Reads an OpenEXR or Radiance .hdr file."""
-    def eval(self, d: ArrayLike) -> Any:
+    def eval(self, d: ArrayLike, *, out: NDArray[Any] | None = None) -> Any:
         """Radiance from world directions d, (N, 3)."""
-    def pdf(self, d: ArrayLike) -> Any:
+    def pdf(self, d: ArrayLike, *, out: NDArray[Any] | None = None) -> Any:
         """Density of sample per steradian, (N,)."""
-    def sample(self, u: ArrayLike) -> EnvSample: ...
+    def sample(self, u: ArrayLike, *,
+               out: tuple[NDArray[Any], NDArray[Any], NDArray[Any]] | None = None) -> EnvSample: ...
     def dir_to_uv(self, d: ArrayLike) -> Any:
         """Map coordinates of world directions, (N, 2)."""
     def uv_to_dir(self, uv: ArrayLike) -> Any:
