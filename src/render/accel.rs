@@ -79,9 +79,41 @@ pub struct Accel {
     shape_of: Vec<u32>,
     bounds: Option<Aabb>,
     bvh: Option<CwBvh>,
-    /// Without a BVH: the triangles, four to a pack with their primitive
-    /// indices, and the indices of the other primitives.
-    leaf: (Vec<(Triangles4, [u32; 4])>, Vec<u32>),
+    /// The primitives as one leaf, when there is no BVH.
+    leaf: Leaf,
+}
+
+/// The primitives of a scene without a BVH, for testing all of them.
+#[derive(Default)]
+struct Leaf {
+    /// The triangles, four to a pack, with their primitive indices.
+    packs: Vec<(Triangles4, [u32; 4])>,
+    /// The indices of the other primitives.
+    others: Vec<u32>,
+}
+
+impl Leaf {
+    /// Sorts `primitives` into packs of triangles and the others.
+    fn new(primitives: &[Primitive]) -> Self {
+        let (mut triangles, mut others) = (Vec::new(), Vec::new());
+        for (i, p) in primitives.iter().enumerate() {
+            match p {
+                Primitive::Triangle(t) => triangles.push((*t, i as u32)),
+                _ => others.push(i as u32),
+            }
+        }
+        let packs = triangles
+            .chunks(4)
+            .map(|c| {
+                let (t, i): (Vec<Triangle>, Vec<u32>) = c.iter().copied().unzip();
+                (
+                    Triangles4::new(&t),
+                    std::array::from_fn(|l| i.get(l).copied().unwrap_or(0)),
+                )
+            })
+            .collect();
+        Leaf { packs, others }
+    }
 }
 
 impl Accel {
@@ -100,7 +132,7 @@ impl Accel {
         let leaf = if bvh.is_some() {
             Default::default()
         } else {
-            Self::leaf(&primitives)
+            Leaf::new(&primitives)
         };
         Accel {
             primitives,
@@ -109,28 +141,6 @@ impl Accel {
             bvh,
             leaf,
         }
-    }
-
-    /// The packs of four triangles and the other primitives of a leaf.
-    fn leaf(primitives: &[Primitive]) -> (Vec<(Triangles4, [u32; 4])>, Vec<u32>) {
-        let (mut triangles, mut others) = (Vec::new(), Vec::new());
-        for (i, p) in primitives.iter().enumerate() {
-            match p {
-                Primitive::Triangle(t) => triangles.push((*t, i as u32)),
-                _ => others.push(i as u32),
-            }
-        }
-        let packs = triangles
-            .chunks(4)
-            .map(|c| {
-                let (t, i): (Vec<Triangle>, Vec<u32>) = c.iter().copied().unzip();
-                (
-                    Triangles4::new(&t),
-                    std::array::from_fn(|l| i.get(l).copied().unwrap_or(0)),
-                )
-            })
-            .collect();
-        (packs, others)
     }
 
     /// The primitives, in the order they were given.
@@ -154,7 +164,7 @@ impl Accel {
         };
         let Some(bvh) = self.bvh.as_ref() else {
             let mut shrunk = *ray;
-            let (packs, others) = &self.leaf;
+            let Leaf { packs, others } = &self.leaf;
             for (pack, index) in packs {
                 if let Some((lane, c)) = pack.intersect(&shrunk) {
                     best = Hit {
@@ -204,7 +214,7 @@ impl Accel {
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let Some(bvh) = self.bvh.as_ref() else {
-            let (packs, others) = &self.leaf;
+            let Leaf { packs, others } = &self.leaf;
             return packs.iter().any(|(pack, _)| pack.occludes(ray))
                 || others
                     .iter()
