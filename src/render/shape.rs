@@ -252,10 +252,10 @@ impl Triangles4 {
         pack
     }
 
-    /// The nearest hit in `(0, tmax)` among the four: its lane and
-    /// candidate.
-    #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<(usize, Candidate)> {
+    /// Möller–Trumbore for all four lanes: which lanes the ray hits in
+    /// `(0, tmax)` (bit `l` for lane `l`), the distances and barycentrics.
+    #[inline(always)]
+    fn hits(&self, ray: &Ray) -> (u32, Vec4, [Vec4; 2]) {
         let scaled = moller_trumbore::<Vec4>(
             ray.o.to_array().map(Vec4::splat),
             ray.d.to_array().map(Vec4::splat),
@@ -264,10 +264,17 @@ impl Triangles4 {
             self.e2,
         );
         if !scaled.inside.any() {
-            return None;
+            return (0, Vec4::ZERO, [Vec4::ZERO; 2]);
         }
-        let (ahead, t, [b1, b2]) = scaled.hit(ray.tmax);
-        let hits = (scaled.inside & ahead).bitmask();
+        let (ahead, t, bary) = scaled.hit(ray.tmax);
+        ((scaled.inside & ahead).bitmask(), t, bary)
+    }
+
+    /// The nearest hit in `(0, tmax)` among the four: its lane and
+    /// candidate.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<(usize, Candidate)> {
+        let (hits, t, [b1, b2]) = self.hits(ray);
         let lane = (0..4)
             .filter(|l| hits & (1 << l) != 0)
             .min_by(|&a, &b| t[a].total_cmp(&t[b]))?;
@@ -283,7 +290,7 @@ impl Triangles4 {
     /// Whether any of the four lies on the ray in `(0, tmax)`.
     #[inline]
     pub fn occludes(&self, ray: &Ray) -> bool {
-        self.intersect(ray).is_some()
+        self.hits(ray).0 != 0
     }
 }
 
