@@ -191,11 +191,9 @@ where
 /// # Errors
 /// Only when the thread count cannot be determined (see [`num_threads`]).
 pub fn install<R: Send>(f: impl FnOnce() -> R + Send) -> Result<R> {
-    let threads = num_threads()?;
-    if threads == 1 {
-        return Ok(f());
-    }
-    Ok(pool(threads)?.install(f))
+    // Also for one thread: outside the pool, rayon's iterators would run on
+    // its global pool, one thread per core.
+    Ok(pool(num_threads()?)?.install(f))
 }
 
 fn split<O, K>(range: Range<usize>, outputs: O, kernel: &K) -> bool
@@ -248,6 +246,16 @@ mod tests {
         let n = 4 * CHUNK;
         let ok = for_each_chunk(n, (), |range, ()| !range.contains(&(3 * CHUNK + 5))).unwrap();
         assert!(!ok);
+    }
+
+    #[test]
+    fn builds_use_the_thread_count_asked_for() {
+        set_num_threads(1).unwrap();
+        let one = install(rayon::current_num_threads).unwrap();
+        REQUESTED.store(0, Ordering::Relaxed);
+        assert_eq!(one, 1);
+        let default = install(rayon::current_num_threads).unwrap();
+        assert_eq!(default, num_threads().unwrap());
     }
 
     #[test]

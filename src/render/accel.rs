@@ -34,6 +34,15 @@ impl Primitive {
         }
     }
 
+    /// Whether the primitive lies on the ray in `(0, ray.tmax)`.
+    #[inline]
+    fn occludes(&self, ray: &Ray) -> bool {
+        match self {
+            Primitive::Sphere(s) => s.occludes(ray),
+            _ => self.intersect(ray).is_some(),
+        }
+    }
+
     fn bounds(&self) -> Aabb {
         let (lo, hi) = match self {
             Primitive::Triangle(t) => {
@@ -218,7 +227,7 @@ impl Accel {
             return packs.iter().any(|(pack, _)| pack.occludes(ray))
                 || others
                     .iter()
-                    .any(|&p| self.primitives[p as usize].intersect(ray).is_some());
+                    .any(|&p| self.primitives[p as usize].occludes(ray));
         };
         let query = obvhs::ray::Ray::new(ray.o, ray.d, 0.0, ray.tmax);
         !bvh.ray_traverse_miss(query, |_, id| {

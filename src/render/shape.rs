@@ -306,36 +306,52 @@ pub struct Sphere {
 }
 
 impl Sphere {
-    /// The nearer root of `|o + t d − c|² = r²` in `(0, tmax)`, solved in
-    /// `f64` in the numerically stable form (no cancellation).
-    #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<Candidate> {
+    /// The roots of `|o + t d − c|² = r²` as `(q, a, k)`: they are `q/a`
+    /// and `k/q`, with `a = d·d`, `h = (o − c)·d`, `k = |o − c|² − r²` and
+    /// `q = −(h + sign(h)·√(h² − a k))`, the form without cancellation. The
+    /// discriminant is `h² − a k = a r² − |(o − c) × d|²` (Lagrange's
+    /// identity), accurate for rays far from the sphere, and needs no
+    /// division, so that a miss (the common case) costs none. `None` when
+    /// the ray's line misses the sphere. In `f64`.
+    #[inline(always)]
+    fn roots(&self, ray: &Ray) -> Option<(f64, f64, f64)> {
         let o = ray.o.as_dvec3() - self.center;
         let d = ray.d.as_dvec3();
         let a = d.length_squared();
-        let inv_a = 1.0 / a;
-        let od = o.dot(d);
-        // The discriminant as b² − 4ac = 4a(r² − |o − (o·d/a) d|²), which
-        // stays accurate for rays far from the sphere.
-        let f = o - (od * inv_a) * d;
         let r2 = self.radius * self.radius;
-        let disc = 4.0 * a * (r2 - f.length_squared());
+        let disc = a * r2 - o.cross(d).length_squared();
         if disc < 0.0 {
             return None;
         }
-        let b = 2.0 * od;
-        let c = o.length_squared() - r2;
-        let q = -0.5 * (b + b.signum() * disc.sqrt());
-        let (mut t0, mut t1) = (q * inv_a, c / q);
-        if t0 > t1 {
-            std::mem::swap(&mut t0, &mut t1);
-        }
-        let tmax = f64::from(ray.tmax);
-        let t = if t0 > 0.0 { t0 } else { t1 };
-        (t > 0.0 && t < tmax).then_some(Candidate {
+        let h = o.dot(d);
+        let q = -(h + h.signum() * disc.sqrt());
+        Some((q, a, o.length_squared() - r2))
+    }
+
+    /// The nearer root in `(0, tmax)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<Candidate> {
+        let (q, a, k) = self.roots(ray)?;
+        let (t0, t1) = (q / a, k / q);
+        let (near, far) = (t0.min(t1), t0.max(t1));
+        let t = if near > 0.0 { near } else { far };
+        (t > 0.0 && t < f64::from(ray.tmax)).then_some(Candidate {
             t: t as f32,
             bary: [0.0; 2],
         })
+    }
+
+    /// Whether a root lies in `(0, tmax)`, without dividing: `q/a` does
+    /// when `0 < q < a·tmax`, and `k/q` when `0 < σk < |q|·tmax` with `σ`
+    /// the sign of `q` (`a > 0`).
+    #[inline]
+    pub fn occludes(&self, ray: &Ray) -> bool {
+        let Some((q, a, k)) = self.roots(ray) else {
+            return false;
+        };
+        let tmax = f64::from(ray.tmax);
+        let sk = q.signum() * k;
+        (q > 0.0 && q < a * tmax) || (sk > 0.0 && sk < q.abs() * tmax)
     }
 
     /// The point on the sphere nearest to `p` (a hit point, snapped back onto
@@ -552,6 +568,37 @@ mod tests {
         );
         let sp = s.point(Vec3A::new(0.0, 0.0, -4.0));
         assert!((sp.ng - Vec3A::Z).length() < 1e-6);
+    }
+
+    #[test]
+    fn sphere_occlusion_agrees_with_the_nearest_hit() {
+        let s = Sphere {
+            center: DVec3::new(0.2, -0.1, -3.0),
+            radius: 0.8,
+            flip: false,
+        };
+        let (mut hits, mut misses) = (0, 0);
+        for i in 0..2000 {
+            let k = i as f32;
+            // Origins outside, inside and just off the surface (as a shadow
+            // ray leaves it); directions all around; finite and infinite
+            // tmax.
+            let start = match i % 3 {
+                0 => [0.0, 0.0, 0.0],
+                1 => [0.3, -0.2, -3.1],
+                _ => {
+                    let n = Vec3A::new((k * 0.37).sin(), (k * 0.71).cos(), (k * 0.13).sin())
+                        .normalize();
+                    (s.center.as_vec3a() + n * (0.8 + 1e-4)).to_array()
+                }
+            };
+            let mut r = ray(start, [(k * 1.3).sin(), (k * 0.9).cos(), -(k * 0.5).cos()]);
+            r.tmax = [f32::INFINITY, 0.5, 2.0, 4.0][i % 4];
+            let hit = s.intersect(&r).is_some();
+            assert_eq!(s.occludes(&r), hit, "ray {i}: {r:?}");
+            (hits, misses) = (hits + usize::from(hit), misses + usize::from(!hit));
+        }
+        assert!(hits > 300 && misses > 300, "{hits} hits, {misses} misses");
     }
 
     #[test]
