@@ -87,16 +87,7 @@ impl Discrete1D {
             weights.par_chunks(SUM_BLOCK),
         )
             .into_par_iter()
-            .map(|(cdf, copy, weights)| {
-                let (mut acc, mut valid) = (0.0, true);
-                for ((c, w_copy), &w) in cdf.iter_mut().zip(copy.iter_mut()).zip(weights) {
-                    acc += w;
-                    *c = acc;
-                    *w_copy = w;
-                    valid &= is_weight(w);
-                }
-                (acc, valid)
-            })
+            .map(|(cdf, copy, weights)| sum_into(weights, cdf, copy))
             .unzip();
         let valid = valid.into_iter().all(|v| v);
         let mut offsets = Vec::with_capacity(totals.len());
@@ -105,11 +96,7 @@ impl Discrete1D {
             offsets.push(acc);
             acc += total;
         }
-        let positive = |w: &f64| *w > 0.0;
-        let (Some(first), Some(last)) = (
-            weights.iter().position(positive),
-            weights.iter().rposition(positive),
-        ) else {
+        let Some((first, last)) = positive_range(weights) else {
             return (None, valid);
         };
         if !(valid && acc > 0.0 && acc.is_finite()) {
@@ -119,42 +106,17 @@ impl Discrete1D {
             .zip(offsets)
             .skip(1)
             .for_each(|(cdf, offset)| cdf.iter_mut().for_each(|c| *c += offset));
-        let mut table = Discrete1D {
+        let mut guide = Buffer::for_overwrite(guide_len(weights.len()));
+        fill_guide(&cdf, acc, (first, last), &mut guide);
+        let table = Discrete1D {
             weights: copy,
             cdf,
             sum: acc,
             first,
             last,
-            guide: Buffer::zeroed(0),
+            guide,
         };
-        table.guide = table.build_guide();
         (Some(table), valid)
-    }
-
-    fn build_guide(&self) -> Buffer<u32> {
-        let n = self.weights.len();
-        if n < GUIDE_MIN_LEN {
-            return Buffer::zeroed(0);
-        }
-        // One guide cell per 4 entries: a short search, a small table.
-        let cells = n / 4;
-        // guide[k] is the first i with C_i ≥ k·Σw/G. Branch-free: entry i
-        // writes its index into cell ⌊C_i·G/Σw⌋, last entries first, so each
-        // hit cell keeps its smallest index; a cell no entry hits takes the
-        // answer of the next cell up (a suffix minimum). Round-off here only
-        // costs a fallback search (see `bracket`).
-        let scale = cells as f64 / self.sum;
-        let mut guide = Buffer::<u32>::zeroed(cells + 1);
-        guide.fill(u32::MAX);
-        for (i, &c) in self.cdf.iter().enumerate().rev() {
-            guide[((c * scale) as usize).min(cells)] = i as u32;
-        }
-        let (first, mut next) = (self.first as u32, self.last as u32);
-        for g in guide.iter_mut().rev() {
-            next = next.min(*g);
-            *g = next.max(first);
-        }
-        guide
     }
 
     /// Number of entries.
@@ -230,8 +192,7 @@ impl Discrete1D {
     /// number for a second decision.
     #[inline]
     pub fn sample_reuse<F: Real>(&self, u: F) -> (usize, F) {
-        let search = self.search();
-        search.index_reuse(u, search.guide_cell(u.f64()))
+        self.search().sample_reuse(u)
     }
 
     /// The tables as slices, for the steps of a draw.
@@ -248,6 +209,79 @@ impl Discrete1D {
     }
 }
 
+/// The running sums of `weights` from 0 into `cdf`, in order, and the
+/// weights into `copy` (all three of one length): their total, and whether
+/// every weight is finite and `>= 0`.
+fn sum_into(weights: &[f64], cdf: &mut [f64], copy: &mut [f64]) -> (f64, bool) {
+    let (mut acc, mut valid) = (0.0, true);
+    for ((c, w_copy), &w) in cdf.iter_mut().zip(copy.iter_mut()).zip(weights) {
+        acc += w;
+        *c = acc;
+        *w_copy = w;
+        valid &= is_weight(w);
+    }
+    (acc, valid)
+}
+
+/// The first and last entries of positive weight (`None` if there is none).
+fn positive_range(weights: &[f64]) -> Option<(usize, usize)> {
+    let positive = |w: &f64| *w > 0.0;
+    Some((
+        weights.iter().position(positive)?,
+        weights.iter().rposition(positive)?,
+    ))
+}
+
+/// The length of the guide table of a table of `n` entries: one cell per 4
+/// entries (a short search, a small table), plus the end; 0 (no guide) for
+/// tables shorter than [`GUIDE_MIN_LEN`].
+pub(crate) fn guide_len(n: usize) -> usize {
+    if n < GUIDE_MIN_LEN { 0 } else { n / 4 + 1 }
+}
+
+/// Fills the guide table of the running sums `cdf` (total `sum`, entries of
+/// positive weight from `first` to `last`): `guide[k]` is the first `i`
+/// with `C_i ≥ k·Σw/G`, for `G + 1 = guide.len()` cells.
+///
+/// Branch-free: entry `i` writes its index into cell `⌊C_i·G/Σw⌋`, last
+/// entries first, so each hit cell keeps its smallest index; a cell no
+/// entry hits takes the answer of the next cell up (a suffix minimum).
+/// Round-off here only costs a fallback search (see [`Search::bracket`]).
+fn fill_guide(cdf: &[f64], sum: f64, (first, last): (usize, usize), guide: &mut [u32]) {
+    let Some(cells) = guide.len().checked_sub(1) else {
+        return;
+    };
+    let scale = cells as f64 / sum;
+    guide.fill(u32::MAX);
+    for (i, &c) in cdf.iter().enumerate().rev() {
+        guide[((c * scale) as usize).min(cells)] = i as u32;
+    }
+    let (first, mut next) = (first as u32, last as u32);
+    for g in guide.iter_mut().rev() {
+        next = next.min(*g);
+        *g = next.max(first);
+    }
+}
+
+/// The tables of one distribution written into slices of a larger store
+/// (the rows of a [`super::Discrete2D`]): `weights` (checked: finite and
+/// `>= 0`) copied into `copy`, their running sums into `cdf` (summed in
+/// order) and the guide table into `guide` ([`guide_len`] entries). Returns
+/// the sum and the first and last entries of positive weight, as
+/// [`Search::new`] takes them, or `None` for a table that sums to 0.
+pub(crate) fn fill_table(
+    weights: &[f64],
+    (copy, cdf, guide): (&mut [f64], &mut [f64], &mut [u32]),
+) -> Option<(f64, usize, usize)> {
+    let (sum, _) = sum_into(weights, cdf, copy);
+    let range = positive_range(weights)?;
+    if !(sum > 0.0 && sum.is_finite()) {
+        return None;
+    }
+    fill_guide(cdf, sum, range, guide);
+    Some((sum, range.0, range.1))
+}
+
 /// A [`Discrete1D`]'s tables as plain slices, and a draw in steps that a
 /// batch can interleave: [`Search::locate`] the guide cell (prefetched),
 /// [`Search::prefetch_bracket`], then [`Search::index`] or
@@ -262,13 +296,49 @@ pub(crate) struct Search<'a> {
     last: usize,
 }
 
-impl Search<'_> {
+impl<'a> Search<'a> {
+    /// The search of tables written by [`fill_table`] (`weights`, `cdf` and
+    /// `guide` as it wrote them; `(sum, first, last)` as it returned them).
+    #[inline(always)]
+    pub(crate) fn new(
+        (weights, cdf, guide): (&'a [f64], &'a [f64], &'a [u32]),
+        (sum, first, last): (f64, usize, usize),
+    ) -> Self {
+        Search {
+            weights,
+            cdf,
+            guide,
+            sum,
+            first,
+            last,
+        }
+    }
+
+    /// The sum of the weights.
+    #[inline(always)]
+    pub(crate) fn sum(&self) -> f64 {
+        self.sum
+    }
+
+    /// The weight of entry `i` (0 outside the table).
+    #[inline(always)]
+    pub(crate) fn weight(&self, i: usize) -> f64 {
+        self.weights.get(i).copied().unwrap_or(0.0)
+    }
+
     /// The guide cell `⌊u·G⌋` of `u` (clamped to the last cell; 0 without a
     /// guide table).
     #[inline(always)]
     fn guide_cell(&self, u: f64) -> usize {
         let cells = self.guide.len().saturating_sub(1);
         ((u * cells as f64) as usize).min(cells.saturating_sub(1))
+    }
+
+    /// The index and the rescaled `u` in one go (see
+    /// [`Discrete1D::sample_reuse`]).
+    #[inline(always)]
+    pub(crate) fn sample_reuse<F: Real>(&self, u: F) -> (usize, F) {
+        self.index_reuse(u, self.guide_cell(u.f64()))
     }
 
     /// Step 1: the guide cell of `u`, prefetched.
@@ -324,7 +394,7 @@ impl Search<'_> {
 
     /// `C_{i−1}` (0 for i = 0, Σw past the end).
     #[inline(always)]
-    fn sum_before(&self, i: usize) -> f64 {
+    pub(crate) fn sum_before(&self, i: usize) -> f64 {
         match i {
             0 => 0.0,
             _ => self.cdf.get(i - 1).copied().unwrap_or(self.sum),

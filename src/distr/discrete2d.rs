@@ -1,6 +1,8 @@
 //! [`Discrete2D`]: a discrete distribution over the cells of a table.
 
+use super::discrete::{Search, fill_table, guide_len};
 use super::{Discrete1D, GROUP, check_weights};
+use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::parallel;
@@ -18,12 +20,52 @@ use rayon::prelude::*;
 /// assignment of `u` as Mitsuba 3's `DiscreteDistribution2D` (whose
 /// `Point2u` is `(col, row)`). Both steps are [`Discrete1D`] searches, so a
 /// cell of weight 0 is never returned.
+///
+/// # Layout
+/// The conditionals' tables (weights, running sums, guide tables) lie
+/// row after row in three flat arrays, so that a draw finds a row's tables
+/// by arithmetic on its index, with no load of a per-row structure
+/// between the marginal's answer and the row's search.
 #[derive(Clone, Debug)]
 pub struct Discrete2D {
     marginal: Discrete1D,
-    /// One conditional per row; `None` for rows of weight 0 (never drawn).
-    conditionals: Vec<Option<Discrete1D>>,
     cols: usize,
+    /// Each row's weights, row after row.
+    weights: Buffer<f64>,
+    /// Each row's running sums from 0.
+    cdf: Buffer<f64>,
+    /// Each row's guide table, [`guide_len`]`(cols)` entries per row (left
+    /// unwritten for rows of weight 0, which are never searched).
+    guide: Buffer<u32>,
+    /// Each row's sum and first and last entries of positive weight;
+    /// `None` for rows of weight 0 (never drawn).
+    rows: Vec<Option<(f64, usize, usize)>>,
+}
+
+/// A [`Discrete2D`]'s flat tables as slices, from which a row's
+/// [`Search`] is cut.
+#[derive(Clone, Copy)]
+struct Rows<'a> {
+    cols: usize,
+    weights: &'a [f64],
+    cdf: &'a [f64],
+    guide: &'a [u32],
+    rows: &'a [Option<(f64, usize, usize)>],
+}
+
+impl<'a> Rows<'a> {
+    /// The conditional of `row` (`None` for a row of weight 0).
+    #[inline(always)]
+    fn search(&self, row: usize) -> Option<Search<'a>> {
+        let span = (*self.rows.get(row)?)?;
+        let (start, g) = (row * self.cols, guide_len(self.cols));
+        let tables = (
+            &self.weights[start..start + self.cols],
+            &self.cdf[start..start + self.cols],
+            &self.guide[row * g..(row + 1) * g],
+        );
+        Some(Search::new(tables, span))
+    }
 }
 
 impl Discrete2D {
@@ -57,36 +99,54 @@ impl Discrete2D {
                 max: super::MAX_ENTRIES,
             });
         }
-        // Rows are independent: build them on all cores (large tables only).
-        let rows_of = || -> Vec<Option<Discrete1D>> {
-            if weights.len() < 1 << 16 {
-                weights
-                    .chunks(cols_nz)
-                    .map(Discrete1D::from_checked)
-                    .collect()
-            } else {
-                weights
-                    .par_chunks(cols_nz)
-                    .map(Discrete1D::from_checked)
-                    .collect()
-            }
+        let g = guide_len(cols);
+        let mut copy = Buffer::<f64>::for_overwrite(weights.len());
+        let mut cdf = Buffer::<f64>::for_overwrite(weights.len());
+        let mut guide = Buffer::<u32>::for_overwrite(weights.len() / cols_nz * g);
+        let guides: Vec<&mut [u32]> = match g {
+            0 => (0..weights.len() / cols_nz).map(|_| &mut [][..]).collect(),
+            _ => guide.chunks_mut(g).collect(),
         };
-        let conditionals = parallel::install(rows_of)?;
-        let row_sums: Vec<f64> = conditionals
-            .iter()
-            .map(|c| c.as_ref().map_or(0.0, Discrete1D::sum))
-            .collect();
+        let row_tables = weights
+            .chunks(cols_nz)
+            .zip(copy.chunks_mut(cols_nz))
+            .zip(cdf.chunks_mut(cols_nz))
+            .zip(guides);
+        let fill = |(((w, copy), cdf), guide): (((_, _), _), _)| fill_table(w, (copy, cdf, guide));
+        // Rows are independent: build them on all cores (large tables only).
+        let spans: Vec<Option<(f64, usize, usize)>> = if weights.len() < 1 << 16 {
+            row_tables.map(fill).collect()
+        } else {
+            let row_tables: Vec<_> = row_tables.collect();
+            parallel::install(|| row_tables.into_par_iter().map(fill).collect())?
+        };
+        let row_sums: Vec<f64> = spans.iter().map(|s| s.map_or(0.0, |s| s.0)).collect();
         let marginal = Discrete1D::from_checked(&row_sums).ok_or(Error::AllZero { arg })?;
         Ok(Discrete2D {
             marginal,
-            conditionals,
             cols,
+            weights: copy,
+            cdf,
+            guide,
+            rows: spans,
         })
+    }
+
+    /// The flat tables as slices.
+    #[inline(always)]
+    fn tables(&self) -> Rows<'_> {
+        Rows {
+            cols: self.cols,
+            weights: &self.weights,
+            cdf: &self.cdf,
+            guide: &self.guide,
+            rows: &self.rows,
+        }
     }
 
     /// `(rows, cols)`.
     pub fn shape(&self) -> (usize, usize) {
-        (self.conditionals.len(), self.cols)
+        (self.rows.len(), self.cols)
     }
 
     /// The sum of all weights.
@@ -101,13 +161,17 @@ impl Discrete2D {
 
     /// The conditional distribution of columns in `row` (`None` for a row
     /// of weight 0).
-    pub fn conditional(&self, row: usize) -> Option<&Discrete1D> {
-        self.conditionals.get(row).and_then(Option::as_ref)
+    pub(crate) fn conditional(&self, row: usize) -> Option<Search<'_>> {
+        self.tables().search(row)
     }
 
     /// The weight of cell `(row, col)` as given (0 outside the table).
     pub fn weight(&self, row: usize, col: usize) -> f64 {
-        self.conditional(row).map_or(0.0, |c| c.weight(col))
+        if row < self.rows.len() && col < self.cols {
+            self.weights[row * self.cols + col]
+        } else {
+            0.0
+        }
     }
 
     /// Probability of cell `(row, col)`: `w / Σw` (0 outside the table).
@@ -128,7 +192,7 @@ impl Discrete2D {
     pub fn sample_reuse<F: Real>(&self, u: [F; 2]) -> ((usize, usize), [F; 2]) {
         let (row, u_row) = self.marginal.sample_reuse(u[1]);
         // The marginal never draws a row of weight 0.
-        match &self.conditionals[row] {
+        match self.conditional(row) {
             Some(conditional) => {
                 let (col, u_col) = conditional.sample_reuse(u[0]);
                 ((row, col), [u_col, u_row])
@@ -144,6 +208,7 @@ impl Discrete2D {
     /// rescaled `u` of each column; the cache misses of a group overlap.
     pub fn sample_reuse_into<F: Real>(&self, us: &[[F; 2]], out: &mut [((usize, usize), [F; 2])]) {
         let marginal = self.marginal.search();
+        let tables = self.tables();
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
             let mut cells = [0; GROUP];
             for (k, u) in cells.iter_mut().zip(us) {
@@ -155,26 +220,25 @@ impl Discrete2D {
             for ((o, u), k) in out.iter_mut().zip(us).zip(&mut cells) {
                 let (row, u_row) = marginal.index_reuse(u[1], *k);
                 *o = ((row, 0), [u[0], u_row]);
-                if let Some(c) = &self.conditionals[row] {
-                    *k = c.search().locate(u[0].f64());
+                if let Some(c) = tables.search(row) {
+                    *k = c.locate(u[0].f64());
                 }
             }
             for (o, &k) in out.iter().zip(&cells) {
-                if let Some(c) = &self.conditionals[o.0.0] {
-                    c.search().prefetch_bracket(k);
+                if let Some(c) = tables.search(o.0.0) {
+                    c.prefetch_bracket(k);
                 }
             }
             for ((o, u), &k) in out.iter_mut().zip(us).zip(&cells) {
                 // The marginal never draws a row of weight 0.
-                if let Some(c) = &self.conditionals[o.0.0] {
-                    let search = c.search();
-                    o.0.1 = search.index(u[0].f64(), k);
-                    search.prefetch_weight(o.0.1);
+                if let Some(c) = tables.search(o.0.0) {
+                    o.0.1 = c.index(u[0].f64(), k);
+                    c.prefetch_weight(o.0.1);
                 }
             }
             for (o, u) in out.iter_mut().zip(us) {
-                if let Some(c) = &self.conditionals[o.0.0] {
-                    o.1[0] = c.search().rescale(u[0], o.0.1);
+                if let Some(c) = tables.search(o.0.0) {
+                    o.1[0] = c.rescale(u[0], o.0.1);
                 }
             }
         }

@@ -1,6 +1,7 @@
 //! Piecewise-constant densities on an interval and on a rectangle, sampled
 //! by inverting their piecewise-linear CDFs.
 
+use super::discrete::Search;
 use super::{Discrete1D, Discrete2D, GROUP};
 use crate::error::{Error, Result};
 use crate::math::Real;
@@ -18,20 +19,35 @@ fn check_interval(arg: &'static str, a: f64, b: f64) -> Result<()> {
     }
 }
 
-/// An interval `[lo, hi]` cut into `n` equal cells.
+/// An interval `[lo, hi]` cut into `n` equal cells of width `h`.
 #[derive(Clone, Copy, Debug)]
 struct Axis {
     lo: f64,
     hi: f64,
     n: usize,
+    /// `n / (hi − lo)`, cells per unit length.
+    cells_per_unit: f64,
+    /// `(hi − lo) / n`, the cell width `h`.
+    width: f64,
 }
 
 impl Axis {
-    /// The continuous cell coordinate `t = (x − lo)/(hi − lo)·n` and the
+    /// `[lo, hi]` in `n` cells.
+    fn new(lo: f64, hi: f64, n: usize) -> Self {
+        Axis {
+            lo,
+            hi,
+            n,
+            cells_per_unit: n as f64 / (hi - lo),
+            width: (hi - lo) / n as f64,
+        }
+    }
+
+    /// The continuous cell coordinate `t = (x − lo)·n/(hi − lo)` and the
     /// cell `⌊t⌋` clamped to `[0, n − 1]`.
     #[inline(always)]
     fn locate(self, x: f64) -> (f64, usize) {
-        let t = (x - self.lo) / (self.hi - self.lo) * self.n as f64;
+        let t = (x - self.lo) * self.cells_per_unit;
         (t, (t.max(0.0) as usize).min(self.n - 1))
     }
 
@@ -46,7 +62,7 @@ impl Axis {
     /// outside), so that a density lookup of a sample finds its own cell.
     #[inline(always)]
     fn point<F: Real>(self, cell: usize, r: f64) -> F {
-        let x = self.lo + (cell as f64 + r) / self.n as f64 * (self.hi - self.lo);
+        let x = self.lo + (cell as f64 + r) * self.width;
         let mut p = F::c(x.clamp(self.lo, self.hi));
         let mut step = self.lo.abs().max(self.hi.abs()) * F::epsilon().f64();
         for _ in 0..16 {
@@ -66,7 +82,7 @@ impl Axis {
 /// The running sum of `table` at the continuous position `t` (`t` in
 /// `[0, n]`, within cell `cell`): `C_{cell−1} + (t − cell)·w_cell`.
 #[inline(always)]
-fn running_sum(table: &Discrete1D, t: f64, cell: usize) -> f64 {
+fn running_sum(table: Search<'_>, t: f64, cell: usize) -> f64 {
     table.sum_before(cell) + (t - cell as f64).clamp(0.0, 1.0) * table.weight(cell)
 }
 
@@ -96,11 +112,7 @@ impl PiecewiseConstant1D {
     pub fn new(values: &[f64], a: f64, b: f64) -> Result<Self> {
         check_interval("a", a, b)?;
         let table = Discrete1D::new(values).map_err(|e| rename(e, "values"))?;
-        let axis = Axis {
-            lo: a,
-            hi: b,
-            n: table.len(),
-        };
+        let axis = Axis::new(a, b, table.len());
         Ok(PiecewiseConstant1D { table, axis })
     }
 
@@ -146,7 +158,7 @@ impl PiecewiseConstant1D {
             return F::one();
         }
         let (t, cell) = self.axis.locate(x);
-        F::c((running_sum(&self.table, t, cell) / self.table.sum()).min(1.0))
+        F::c((running_sum(self.table.search(), t, cell) / self.table.sum()).min(1.0))
     }
 
     /// The `u` that [`PiecewiseConstant1D::sample`] maps to `x` (the CDF),
@@ -186,6 +198,8 @@ pub struct PiecewiseConstant2D {
     table: Discrete2D,
     x: Axis,
     y: Axis,
+    /// [`PiecewiseConstant2D::integral`], which every density divides by.
+    integral: f64,
 }
 
 impl PiecewiseConstant2D {
@@ -199,11 +213,15 @@ impl PiecewiseConstant2D {
         check_interval("domain", domain[0][0], domain[0][1])?;
         check_interval("domain", domain[1][0], domain[1][1])?;
         let table = Discrete2D::with_arg("values", values, rows, cols)?;
-        let axis = |[lo, hi]: [f64; 2], n| Axis { lo, hi, n };
+        let axis = |[lo, hi]: [f64; 2], n| Axis::new(lo, hi, n);
+        let (x, y) = (axis(domain[0], cols), axis(domain[1], rows));
+        let area = (x.hi - x.lo) * (y.hi - y.lo);
+        let integral = table.sum() * area / (cols * rows) as f64;
         Ok(PiecewiseConstant2D {
             table,
-            x: axis(domain[0], cols),
-            y: axis(domain[1], rows),
+            x,
+            y,
+            integral,
         })
     }
 
@@ -219,8 +237,7 @@ impl PiecewiseConstant2D {
 
     /// The integral of the values over the rectangle: `Σv · hx · hy`.
     pub fn integral(&self) -> f64 {
-        let area = (self.x.hi - self.x.lo) * (self.y.hi - self.y.lo);
-        self.table.sum() * area / (self.x.n * self.y.n) as f64
+        self.integral
     }
 
     /// The density of cell `(row, col)` per unit area.
@@ -278,7 +295,7 @@ impl PiecewiseConstant2D {
         self.cell_of(p)?;
         let (tx, col) = self.x.locate(p[0].f64());
         let (ty, row) = self.y.locate(p[1].f64());
-        let marginal = self.table.marginal();
+        let marginal = self.table.marginal().search();
         let u1 = running_sum(marginal, ty, row) / marginal.sum();
         let u0 = match self.table.conditional(row) {
             Some(c) => running_sum(c, tx, col) / c.sum(),
