@@ -124,6 +124,15 @@ def test_pdf_of_samples_and_weights(name):
                                rtol=1e-6, atol=1e-9)
 
 
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_pdf_ignores_the_length_of_directions(dtype):
+    d = SKY.sample(mcs.uniform(10_000, 2, seed=3)).direction.astype(dtype)
+    scaled = d * np.linspace(0.01, 100, len(d), dtype=dtype)[:, None]
+    np.testing.assert_allclose(SKY.pdf(scaled), SKY.pdf(d), rtol=1e-5)
+    # A zero vector has no direction: density 0, not NaN.
+    assert np.array_equal(SKY.pdf(np.zeros((3, 3), dtype)), np.zeros(3, dtype))
+
+
 @pytest.mark.parametrize("name", list(MAPS))
 def test_pdf_integrates_to_one(name):
     env = MAPS[name]

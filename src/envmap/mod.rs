@@ -242,17 +242,18 @@ impl PolarTable {
         let [a, b, c] = self
             .axes
             .map(|m| F::c(m[0]) * d[0] + F::c(m[1]) * d[1] + F::c(m[2]) * d[2]);
-        let inv = F::one() / (a * a + b * b + c * c).sqrt().max(F::min_positive_value());
-        let (a, b, c) = (a * inv, b * inv, c * inv);
+        // The angles need no normalisation of `d`; sin θ = r/|d| does.
         let r = (a * a + b * b).sqrt();
+        let length = (r * r + c * c).sqrt();
         let psi = atan2(a, b) * F::c(0.5 / PI) - F::c(self.shift);
         let psi = psi - psi.floor();
         let rho = atan2(r, c) * F::c(1.0 / PI);
         let (rows, cols) = (F::c(self.rows as f64), F::c(self.cols as f64));
         let col = (psi * cols).floor().min(cols - F::one());
         let row = (rho * rows).floor().min(rows - F::one());
-        let jacobian = F::c(2.0 * PI * PI) * r.max(F::c(SIN_FLOOR));
-        [row, col, F::one() / jacobian]
+        // 1/(2π² max(sin θ, floor)), one division; 0 for d = 0.
+        let scaled_sin = (r.max(F::c(SIN_FLOOR) * length)).max(F::min_positive_value());
+        [row, col, length / (F::c(2.0 * PI * PI) * scaled_sin)]
     }
 
     /// The index in [`PolarTable::density`] of a query's cell.
