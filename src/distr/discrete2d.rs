@@ -217,27 +217,31 @@ impl Discrete2D {
             for &k in &cells[..us.len()] {
                 marginal.prefetch_bracket(k);
             }
-            for ((o, u), k) in out.iter_mut().zip(us).zip(&mut cells) {
+            // Each row's search, cut once per draw.
+            let mut searches = [None; GROUP];
+            for (((o, u), k), search) in out.iter_mut().zip(us).zip(&mut cells).zip(&mut searches) {
                 let (row, u_row) = marginal.index_reuse(u[1], *k);
                 *o = ((row, 0), [u[0], u_row]);
-                if let Some(c) = tables.search(row) {
+                *search = tables.search(row);
+                if let Some(c) = search {
                     *k = c.locate(u[0].f64());
                 }
             }
-            for (o, &k) in out.iter().zip(&cells) {
-                if let Some(c) = tables.search(o.0.0) {
+            let searches = &searches[..us.len()];
+            for (c, &k) in searches.iter().zip(&cells) {
+                if let Some(c) = c {
                     c.prefetch_bracket(k);
                 }
             }
-            for ((o, u), &k) in out.iter_mut().zip(us).zip(&cells) {
+            for (((o, u), &k), c) in out.iter_mut().zip(us).zip(&cells).zip(searches) {
                 // The marginal never draws a row of weight 0.
-                if let Some(c) = tables.search(o.0.0) {
+                if let Some(c) = c {
                     o.0.1 = c.index(u[0].f64(), k);
                     c.prefetch_weight(o.0.1);
                 }
             }
-            for (o, u) in out.iter_mut().zip(us) {
-                if let Some(c) = tables.search(o.0.0) {
+            for ((o, u), c) in out.iter_mut().zip(us).zip(searches) {
+                if let Some(c) = c {
                     o.1[0] = c.rescale(u[0], o.0.1);
                 }
             }
