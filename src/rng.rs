@@ -43,6 +43,12 @@ impl Rng {
         self.pcg.next_u32()
     }
 
+    /// The next 64 bits: two 32-bit outputs.
+    #[inline(always)]
+    pub fn next_u64(&mut self) -> u64 {
+        self.pcg.next_u64()
+    }
+
     /// The next float in `[0, 1)`, from one 32-bit output.
     #[inline(always)]
     pub fn next_float<F: Real>(&mut self) -> F {

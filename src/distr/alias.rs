@@ -492,6 +492,17 @@ impl AliasTable {
         self.answer(c, fraction) as usize
     }
 
+    /// An index drawn with probability `pmf(i)` from 64 uniform random
+    /// bits `b`, read as the fixed-point number `t = b·n/2⁶⁴`: the cell is
+    /// its integer part and the 32 bits after the point its fraction. Every
+    /// cell gets the full 32-bit resolution of its threshold, whatever `n`
+    /// (a float `u` leaves `52 − log₂n` bits).
+    #[inline]
+    pub fn sample_bits(&self, bits: u64) -> usize {
+        let t = u128::from(bits) * self.cells.len() as u128;
+        self.answer((t >> 64) as usize, (t >> 32) as u32) as usize
+    }
+
     /// `out[i] = sample(us[i])` for a batch. Groups of draws first locate
     /// their cells and prefetch them, then read them, so that the cache
     /// misses of a group overlap (on tables larger than the cache, 3–4×
@@ -540,6 +551,29 @@ mod tests {
             assert!((p - w[i] / 16.0).abs() < 1e-12, "index {i}: {p}");
         }
         assert_eq!(t.sample(1.0), t.sample(f64::ONE_MINUS_EPSILON));
+    }
+
+    /// Draws from evenly spaced 64-bit patterns realise each entry's
+    /// probability: `M` patterns stratify `[0, 2⁶⁴)`, so each cell's kept
+    /// and aliased parts receive their share of them to within one pattern.
+    #[test]
+    fn bit_draws_realise_the_pmf() {
+        let w = [0.0, 1.0, 0.0, 2.0, 3.0, 0.0, 10.0, 0.5];
+        let t = AliasTable::new(&w).unwrap();
+        let m = 1u64 << 20;
+        let mut counts = [0u64; 8];
+        for k in 0..m {
+            counts[t.sample_bits(k << 44 | (k * 0x9E37) & 0xFFF)] += 1;
+        }
+        for (i, &c) in counts.iter().enumerate() {
+            let expected = t.pmf(i) * m as f64;
+            assert!(
+                (c as f64 - expected).abs() <= 16.0,
+                "index {i}: {c} vs {expected}"
+            );
+        }
+        assert_eq!(t.sample_bits(u64::MAX), t.sample(f64::ONE_MINUS_EPSILON));
+        assert_eq!(t.sample_bits(0), t.sample(0.0));
     }
 
     /// Asserts that `t` realises its pmf (up to the rounding of each

@@ -165,6 +165,11 @@ impl Discrete2D {
         self.tables().search(row)
     }
 
+    /// The weights as given, row after row.
+    pub fn weights(&self) -> &[f64] {
+        &self.weights
+    }
+
     /// The weight of cell `(row, col)` as given (0 outside the table).
     pub fn weight(&self, row: usize, col: usize) -> f64 {
         if row < self.rows.len() && col < self.cols {

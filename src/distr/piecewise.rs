@@ -256,7 +256,8 @@ impl PiecewiseConstant2D {
     /// `((x, y), p(x, y))` for `u` in `[0, 1]²`.
     #[inline]
     pub fn sample<F: Real>(&self, u: [F; 2]) -> ([F; 2], F) {
-        self.place(self.table.sample_reuse(u))
+        let (cell, r) = self.table.sample_reuse(u);
+        self.sample_in_cell(cell, r)
     }
 
     /// `out[i] = sample(us[i])` for a batch, drawing the cells with
@@ -266,16 +267,18 @@ impl PiecewiseConstant2D {
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
             let cells = &mut cells[..us.len()];
             self.table.sample_reuse_into(us, cells);
-            for (o, &cell) in out.iter_mut().zip(cells.iter()) {
-                *o = self.place(cell);
+            for (o, &(cell, r)) in out.iter_mut().zip(cells.iter()) {
+                *o = self.sample_in_cell(cell, r);
             }
         }
     }
 
-    /// The point that the rescaled `r` places in cell `(row, col)`, and
-    /// the density there.
+    /// The point at fractions `r` (in `[0, 1)²`) of cell `(row, col)`
+    /// along x and y, and the density there: where [`Self::sample`] puts a
+    /// draw of that cell with rescaled numbers `r`. Rounding never moves the
+    /// point out of its cell, so that [`Self::pdf`] finds the same density.
     #[inline(always)]
-    fn place<F: Real>(&self, ((row, col), r): ((usize, usize), [F; 2])) -> ([F; 2], F) {
+    pub fn sample_in_cell<F: Real>(&self, (row, col): (usize, usize), r: [F; 2]) -> ([F; 2], F) {
         let p = [self.x.point(col, r[0].f64()), self.y.point(row, r[1].f64())];
         (p, F::c(self.cell_pdf(row, col)))
     }

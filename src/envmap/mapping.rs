@@ -91,32 +91,33 @@ impl Mapping {
     /// angular; 0 for cube maps, which have none), as the direction's
     /// formula has it (`sin(π t)`, `sin(π r)`).
     #[inline(always)]
-    pub fn to_dir_and_sin(self, p: [f64; 2]) -> (V3<f64>, f64) {
+    pub fn to_dir_and_sin<F: Real>(self, p: [F; 2]) -> (V3<F>, F) {
         let [s, t] = p;
+        let (zero, one, two, half) = (F::zero(), F::one(), F::c(2.0), F::c(0.5));
         match self {
             Mapping::LatLong => {
-                let (sin_theta, cos_theta) = sin_cos_turn(0.5 * t);
+                let (sin_theta, cos_theta) = sin_cos_turn(half * t);
                 let (sin_phi, cos_phi) = sin_cos_turn(s);
                 let d = [sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta];
                 (d, sin_theta)
             }
             Mapping::Angular => {
-                let (a, b) = (2.0 * s - 1.0, 1.0 - 2.0 * t);
+                let (a, b) = (two * s - one, one - two * t);
                 let r = (a * a + b * b).sqrt();
-                if r == 0.0 {
-                    return ([0.0, 0.0, 1.0], 0.0);
+                if r == zero {
+                    return ([zero, zero, one], zero);
                 }
-                let (sin_theta, cos_theta) = sin_cos_turn(0.5 * r.min(1.0));
+                let (sin_theta, cos_theta) = sin_cos_turn(half * r.min(one));
                 ([a / r * sin_theta, b / r * sin_theta, cos_theta], sin_theta)
             }
             Mapping::Cube => {
-                let face = (t.max(0.0) as usize).min(5);
+                let (face, sc, tc) = cube_face(p);
                 let (major, s_axis, t_axis) = CUBE_FACES[face];
-                let (sc, tc) = (2.0 * s - 1.0, 2.0 * (t - face as f64) - 1.0);
-                let v: V3<f64> =
-                    std::array::from_fn(|k| major[k] + sc * s_axis[k] + tc * t_axis[k]);
+                let v: V3<F> = std::array::from_fn(|k| {
+                    F::c(major[k]) + sc * F::c(s_axis[k]) + tc * F::c(t_axis[k])
+                });
                 let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                (v.map(|x| x / norm), 0.0)
+                (v.map(|x| x / norm), zero)
             }
         }
     }
@@ -172,28 +173,37 @@ impl Mapping {
     /// `dω/dp` at `p`: solid angle per unit area of the domain (0 at the
     /// poles of a lat-long map and on or outside an angular map's circle).
     #[inline]
-    pub fn jacobian(self, p: [f64; 2]) -> f64 {
+    pub fn jacobian<F: Real>(self, p: [F; 2]) -> F {
         let [s, t] = p;
+        let (pi, one, two) = (F::PI(), F::one(), F::c(2.0));
         match self {
-            Mapping::LatLong => 2.0 * PI * PI * (PI * t).sin().max(0.0),
+            Mapping::LatLong => two * pi * pi * (pi * t).sin().max(F::zero()),
             Mapping::Angular => {
-                let (a, b) = (2.0 * s - 1.0, 1.0 - 2.0 * t);
+                let (a, b) = (two * s - one, one - two * t);
                 let r = (a * a + b * b).sqrt();
-                if r >= 1.0 {
-                    0.0
-                } else if r < 1e-8 {
-                    4.0 * PI * PI
+                if r >= one {
+                    F::zero()
+                } else if r < F::c(1e-8) {
+                    F::c(4.0) * pi * pi
                 } else {
-                    4.0 * PI * (PI * r).sin() / r
+                    F::c(4.0) * pi * (pi * r).sin() / r
                 }
             }
             Mapping::Cube => {
-                let face = (t.max(0.0) as usize).min(5);
-                let (sc, tc) = (2.0 * s - 1.0, 2.0 * (t - face as f64) - 1.0);
-                4.0 / (1.0 + sc * sc + tc * tc).powf(1.5)
+                let (_, sc, tc) = cube_face(p);
+                F::c(4.0) / (one + sc * sc + tc * tc).powf(F::c(1.5))
             }
         }
     }
+}
+
+/// The face of the cube-map point `p` and its coordinates on the face in
+/// `[−1, 1]²`: `(2s − 1, 2(t − face) − 1)`.
+#[inline(always)]
+fn cube_face<F: Real>([s, t]: [F; 2]) -> (usize, F, F) {
+    let face = (t.max(F::zero()).f64() as usize).min(5);
+    let (one, two) = (F::one(), F::c(2.0));
+    (face, two * s - one, two * (t - F::c(face as f64)) - one)
 }
 
 /// The angle between a unit vector and an axis, from its component `c`

@@ -33,10 +33,12 @@
 //! weight 0, a valid unit direction) and its pdf is 0 everywhere.
 
 mod bilinear;
+mod cell_sampler;
 mod image;
 mod mapping;
 
 pub use bilinear::BilinearGrid;
+pub use cell_sampler::CellSampler;
 pub use image::{Corners, Image};
 pub use mapping::{Mapping, normalized, polar_angle};
 
@@ -65,8 +67,8 @@ const BATCH_BLOCK: usize = 256;
 /// `dω/dq` of a polar sampling table at a direction `θ` from its axis:
 /// `2π² max(|sin θ|, 2⁻²⁴)` (see [`SIN_FLOOR`]).
 #[inline(always)]
-fn polar_jacobian(sin_theta: f64) -> f64 {
-    2.0 * PI * PI * sin_theta.abs().max(SIN_FLOOR)
+fn polar_jacobian<F: Real>(sin_theta: F) -> F {
+    F::c(2.0 * PI * PI) * sin_theta.abs().max(F::c(SIN_FLOOR))
 }
 
 /// The luminance weights of Mitsuba 3's `luminance()`, used in
@@ -281,15 +283,26 @@ pub struct PdfQuery {
     jacobian: f64,
 }
 
-/// One sample of [`EnvMap::sample`].
+/// One sample of [`EnvMap::sample`] (computed in `F`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct EnvSample {
+pub struct EnvSample<F = f64> {
     /// World direction toward the environment (unit length).
-    pub direction: V3<f64>,
+    pub direction: V3<F>,
     /// Its density per steradian.
-    pub pdf: f64,
+    pub pdf: F,
     /// `L(direction)/pdf` per RGB channel; 0 when `pdf = 0`.
-    pub weight: V3<f64>,
+    pub weight: V3<F>,
+}
+
+impl<F: Real> EnvSample<F> {
+    /// The sample rounded to `G`.
+    pub fn cast<G: Real>(&self) -> EnvSample<G> {
+        EnvSample {
+            direction: self.direction.map(|x| G::c(x.f64())),
+            pdf: G::c(self.pdf.f64()),
+            weight: self.weight.map(|x| G::c(x.f64())),
+        }
+    }
 }
 
 impl EnvMap {
@@ -363,9 +376,9 @@ impl EnvMap {
     }
 
     #[inline(always)]
-    fn to_world(&self, d: V3<f64>) -> V3<f64> {
+    fn to_world<F: Real>(&self, d: V3<F>) -> V3<F> {
         let m = &self.options.to_world;
-        std::array::from_fn(|k| m[k][0] * d[0] + m[k][1] * d[1] + m[k][2] * d[2])
+        std::array::from_fn(|k| F::c(m[k][0]) * d[0] + F::c(m[k][1]) * d[1] + F::c(m[k][2]) * d[2])
     }
 
     /// The domain point `(s, t)` that looks along the world direction `d`.
@@ -618,9 +631,9 @@ impl EnvMap {
     }
 
     /// The sample at domain point `p`, drawn with density `pdf_q` per unit
-    /// area of the sampling table.
+    /// area of the sampling table, computed in `F`.
     #[inline(always)]
-    fn sample_at(&self, p: [f64; 2], pdf_q: f64) -> EnvSample {
+    fn sample_at<F: Real>(&self, p: [F; 2], pdf_q: F) -> EnvSample<F> {
         let mapping = self.options.mapping;
         let frame = self.frame_at(mapping, p, pdf_q);
         self.sample_from(&frame, &self.image.corners(mapping, p))
@@ -635,14 +648,18 @@ impl EnvMap {
     /// vector by construction): no normalisation, as
     /// [`EnvMap::table_jacobian`] needs for a query.
     #[inline(always)]
-    fn frame_at(&self, mapping: Mapping, p: [f64; 2], pdf_q: f64) -> [f64; 5] {
+    fn frame_at<F: Real>(&self, mapping: Mapping, p: [F; 2], pdf_q: F) -> [F; 5] {
         let (local, sin_theta) = mapping.to_dir_and_sin(p);
         let jacobian = match mapping {
             Mapping::Cube => mapping.jacobian(p),
             _ => polar_jacobian(sin_theta),
         };
         let pdf = pdf_q / jacobian;
-        let inv_pdf = if pdf > 0.0 { 1.0 / pdf } else { 0.0 };
+        let inv_pdf = if pdf > F::zero() {
+            pdf.recip()
+        } else {
+            F::zero()
+        };
         let [x, y, z] = self.to_world(local);
         [x, y, z, pdf, inv_pdf]
     }
@@ -650,8 +667,8 @@ impl EnvMap {
     /// The sample of a frame ([`EnvMap::frame_at`]) whose radiance is the
     /// blend of `corners` times scale.
     #[inline(always)]
-    fn sample_from(&self, frame: &[f64; 5], corners: &Corners<f64>) -> EnvSample {
-        let scale = self.options.scale;
+    fn sample_from<F: Real>(&self, frame: &[F; 5], corners: &Corners<F>) -> EnvSample<F> {
+        let scale = F::c(self.options.scale);
         let [x, y, z, pdf, inv_pdf] = *frame;
         EnvSample {
             direction: [x, y, z],
@@ -685,11 +702,11 @@ impl EnvMap {
 
     /// The domain point (`dir_to_uv`'s coordinates) of the table point `q`.
     #[inline(always)]
-    fn table_to_uv(&self, q: [f64; 2]) -> [f64; 2] {
+    fn table_to_uv<F: Real>(&self, q: [F; 2]) -> [F; 2] {
         match self.options.mapping {
             Mapping::LatLong => {
-                let s = q[0] + 0.5 / self.image.width() as f64;
-                [if s >= 1.0 { s - 1.0 } else { s }, q[1]]
+                let s = q[0] + F::c(0.5 / self.image.width() as f64);
+                [if s >= F::one() { s - F::one() } else { s }, q[1]]
             }
             Mapping::Angular => angular_uv(q[0], q[1]),
             Mapping::Cube => q,
@@ -887,9 +904,10 @@ fn piecewise_table(image: &Image, options: &Options) -> Result<(Distribution, Bu
 
 /// The domain point of polar coordinates `(ψ, ρ)` around +Z of an angular
 /// map.
-fn angular_uv(psi: f64, rho: f64) -> [f64; 2] {
+fn angular_uv<F: Real>(psi: F, rho: F) -> [F; 2] {
     let (sin_psi, cos_psi) = sin_cos_turn(psi);
-    [(rho * cos_psi + 1.0) * 0.5, (1.0 - rho * sin_psi) * 0.5]
+    let (one, half) = (F::one(), F::c(0.5));
+    [(rho * cos_psi + one) * half, (one - rho * sin_psi) * half]
 }
 
 /// The weight of the angular-map sector centred at `q = (ψ, ρ)` of size

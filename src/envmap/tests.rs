@@ -319,3 +319,70 @@ fn bad_options_are_errors() {
     .unwrap_err();
     assert!(e.to_string().starts_with("sampling = \"mitsuba\""), "{e}");
 }
+
+/// The cell sampler draws the table's density: each direction carries the
+/// density and radiance that `pdf` and `eval` give it (in `f64`; in `f32`
+/// to a few ulps), and the cells its directions fall in are hit as often
+/// as the table's probabilities say (z-scores of every cell expected to
+/// get 20 draws or more, fixed seed).
+#[test]
+fn cell_sampler_draws_the_table_density() {
+    for m in all_maps() {
+        let Some(cells) = CellSampler::new(&m).unwrap() else {
+            assert_eq!(m.options().sampling, Sampling::Mitsuba);
+            continue;
+        };
+        let Distribution::Piecewise(table) = &m.distribution else {
+            unreachable!("a cell sampler needs a piecewise table");
+        };
+        let (rows, cols) = table.table().shape();
+        let mut counts = vec![0u32; rows * cols];
+        let mut rng = crate::rng::Rng::new(7, 3);
+        let n = 400_000;
+        for _ in 0..n {
+            let bits = rng.next_u64();
+            let r: [f64; 2] = [rng.next_float(), rng.next_float()];
+            let s = cells.sample(&m, bits, r);
+            let pdf = m.pdf(s.direction);
+            assert!((pdf - s.pdf).abs() <= 1e-9 * s.pdf, "{:?}", m.options());
+            let l = m.eval(s.direction);
+            for (w, l) in s.weight.iter().zip(l) {
+                assert!((w * s.pdf - l).abs() <= 1e-9 * l.max(1e-3));
+            }
+            let s32 = cells.sample(&m, bits, r.map(|x| x as f32));
+            for (a, b) in s32.direction.iter().zip(s.direction) {
+                assert!((f64::from(*a) - b).abs() < 1e-5);
+            }
+            // Near a pole, f32 places the point (and sin θ) to an ulp of
+            // the table's extent: a relative error of about 1e-7 / sin θ.
+            let d = m.to_local(s.direction);
+            let sin = match m.options().mapping {
+                Mapping::LatLong => d[0].hypot(d[2]),
+                Mapping::Angular => d[0].hypot(d[1]),
+                Mapping::Cube => 1.0,
+            };
+            let tol = 1e-5 + 1e-6 / sin;
+            assert!(
+                (f64::from(s32.pdf) - s.pdf).abs() <= tol * s.pdf,
+                "{:?}",
+                m.options()
+            );
+            let q = m.table_point(m.to_local(s.direction));
+            let (row, col) = table.cell_of(q).expect("a direction inside the table");
+            counts[row * cols + col] += 1;
+        }
+        let sum = table.table().sum();
+        let mut tested = 0;
+        for (c, &count) in counts.iter().enumerate() {
+            let expected = table.table().weights()[c] / sum * f64::from(n);
+            if expected == 0.0 {
+                assert_eq!(count, 0, "{:?}: a cell of weight 0 drawn", m.options());
+            } else if expected >= 20.0 {
+                let z = (f64::from(count) - expected) / expected.sqrt();
+                assert!(z.abs() < 5.5, "{:?}: cell {c}, z = {z}", m.options());
+                tested += 1;
+            }
+        }
+        assert!(tested > 50, "{:?}: {tested} cells tested", m.options());
+    }
+}

@@ -181,6 +181,7 @@ pub fn add_escaped(scene: &Scene, settings: &Settings, escaped: &mut Escaped, l:
 pub fn radiance(
     scene: &Scene,
     ray: Ray,
+    hit: Option<Hit>,
     rng: &mut Rng,
     settings: &Settings,
     escaped: &mut Escaped,
@@ -189,7 +190,7 @@ pub fn radiance(
     if settings.max_depth() == 0 {
         return [0.0; 3];
     }
-    match scene.accel().intersect(&ray) {
+    match hit {
         Some(hit) => path(scene, ray, hit, rng, settings, escaped, slot),
         None => {
             if scene.environment().is_some() {
@@ -242,7 +243,7 @@ fn path(
 
         if settings.strategy != Strategy::Bsdf {
             let u = [rng.next_float(), rng.next_float(), rng.next_float()];
-            if let Some(ls) = scene.sample_light(sp.p, u) {
+            if let Some(ls) = scene.sample_light(sp.p, u, || rng.next_u64()) {
                 let wo = frame.to_local(ls.d.to_array());
                 let (f, pdf_wo) = view.eval_pdf_one(wo);
                 if f.iter().any(|&v| v > 0.0) {

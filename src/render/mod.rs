@@ -16,6 +16,12 @@
 //! light of every ray that left the scene is looked up for the whole batch
 //! at the end (vectorised, with the texel reads overlapping). The draws of a
 //! pixel thus come in a fixed order, whatever the batch size or thread.
+//!
+//! Emitter sampling draws an environment map with the density of its own
+//! [`crate::envmap::EnvMap::pdf`], but by its
+//! [`crate::envmap::CellSampler`] (an alias table over the sampling table's
+//! cells, in `f32`): one draw at a time between other work, a search of the
+//! table's running sums would wait on each of its loads in turn.
 
 pub mod accel;
 pub mod camera;
@@ -35,6 +41,7 @@ use crate::error::Result;
 use crate::math::luminance;
 use crate::parallel;
 use crate::rng::Rng;
+use accel::Hit;
 use integrator::Escaped;
 use shape::Ray;
 
@@ -80,6 +87,8 @@ struct Batch {
     /// Film and lens positions of each sample.
     camera_u: Vec<[f32; 4]>,
     rays: Vec<Ray>,
+    /// Where each camera ray first meets the scene.
+    hits: Vec<Option<Hit>>,
 }
 
 impl Batch {
@@ -116,12 +125,23 @@ impl Batch {
         }
         self.rays.resize(self.camera_u.len(), Ray::default());
         scene.camera().rays_into(&self.camera_u, &mut self.rays);
-        let per_pixel = self.rays.chunks(spp.max(1) as usize);
-        for (mut rng, rays) in rngs.into_iter().zip(per_pixel) {
-            for ray in rays {
+        self.hits.clear();
+        self.hits
+            .extend(self.rays.iter().map(|ray| scene.accel().intersect(ray)));
+        let spp = spp.max(1) as usize;
+        let per_pixel = self.rays.chunks(spp).zip(self.hits.chunks(spp));
+        for (mut rng, (rays, hits)) in rngs.into_iter().zip(per_pixel) {
+            for (ray, hit) in rays.iter().zip(hits) {
                 let slot = self.radiance.len() as u32;
-                let l =
-                    integrator::radiance(scene, *ray, &mut rng, settings, &mut self.escaped, slot);
+                let l = integrator::radiance(
+                    scene,
+                    *ray,
+                    *hit,
+                    &mut rng,
+                    settings,
+                    &mut self.escaped,
+                    slot,
+                );
                 self.radiance.push(l);
             }
         }

@@ -8,7 +8,7 @@ use super::accel::{Accel, Primitive};
 use super::camera::Camera;
 use super::shape::{Disk, Sphere, SurfacePoint, Triangle};
 use crate::distr::Discrete1D;
-use crate::envmap::EnvMap;
+use crate::envmap::{CellSampler, EnvMap};
 use crate::error::{Error, Result};
 use crate::math::luminance;
 use crate::phong::Phong;
@@ -87,18 +87,23 @@ impl Environment {
         }
     }
 
-    /// A direction, its density per steradian and its radiance.
+    /// A direction, its density per steradian and its radiance. A map
+    /// draws by `cells` (its [`CellSampler`], with 64 random bits for the
+    /// cell, `u` placing the point in it) where it has one, else by
+    /// [`EnvMap::sample`] of `u`.
     #[inline]
-    pub fn sample(&self, u: [f32; 2]) -> (Vec3A, f32, [f32; 3]) {
+    pub fn sample(
+        &self,
+        u: [f32; 2],
+        cells: Option<(&CellSampler, u64)>,
+    ) -> (Vec3A, f32, [f32; 3]) {
         match self {
             Environment::Map(env) => {
-                let s = env.sample(u.map(f64::from));
-                let l = s.weight.map(|w| (w * s.pdf) as f32);
-                (
-                    Vec3A::from(DVec3::from(s.direction).as_vec3()),
-                    s.pdf as f32,
-                    l,
-                )
+                let s = match cells {
+                    Some((cells, bits)) => cells.sample(env, bits, u),
+                    None => env.sample(u.map(f64::from)).cast(),
+                };
+                (Vec3A::from(s.direction), s.pdf, s.weight.map(|w| w * s.pdf))
             }
             Environment::Constant(l) => {
                 let d = warp::square_to_uniform_sphere(u);
@@ -136,7 +141,9 @@ enum Light {
         total_area: f32,
         radiance: [f32; 3],
     },
-    Environment,
+    /// The environment, drawn by its map's [`CellSampler`] where it has
+    /// one.
+    Environment { cells: Option<CellSampler> },
 }
 
 /// A direction toward a light, from emitter sampling.
@@ -243,7 +250,11 @@ impl Scene {
             let power = std::f64::consts::PI * radius * radius * env.luminance_integral();
             if power > 0.0 {
                 env_light = Some(lights.len() as u32);
-                lights.push(Light::Environment);
+                let cells = match env {
+                    Environment::Map(map) => CellSampler::new(map)?,
+                    Environment::Constant(_) => None,
+                };
+                lights.push(Light::Environment { cells });
                 powers.push(power);
             }
         }
@@ -339,17 +350,24 @@ impl Scene {
 
     /// Emitter sampling from the shading point `x`: a light chosen by power
     /// (`u[0]`), then a point on it uniformly by area or an environment
-    /// direction by the environment's own sampling (`u[1..3]`). `None` when
-    /// the scene has no light or the sample carries no radiance.
+    /// direction by the environment's own sampling (`u[1..3]`, and 64 bits
+    /// from `bits` for a map's cell). `None` when the scene has no light or
+    /// the sample carries no radiance.
     #[inline]
-    pub fn sample_light(&self, x: Vec3A, u: [f32; 3]) -> Option<LightSample> {
+    pub fn sample_light(
+        &self,
+        x: Vec3A,
+        u: [f32; 3],
+        bits: impl FnOnce() -> u64,
+    ) -> Option<LightSample> {
         let choice = self.light_choice.as_ref()?;
         let index = choice.sample(u[0]);
         let pmf = choice.pmf(index) as f32;
         match &self.lights[index] {
-            Light::Environment => {
+            Light::Environment { cells } => {
                 let env = self.environment.as_ref()?;
-                let (d, pdf, radiance) = env.sample([u[1], u[2]]);
+                let cells = cells.as_ref().map(|c| (c, bits()));
+                let (d, pdf, radiance) = env.sample([u[1], u[2]], cells);
                 (pdf > 0.0).then_some(LightSample {
                     d,
                     dist: f32::INFINITY,
