@@ -25,7 +25,7 @@ pub enum Primitive {
 }
 
 impl Primitive {
-    #[inline]
+    #[inline(always)]
     fn intersect(&self, ray: &Ray) -> Option<Candidate> {
         match self {
             Primitive::Triangle(t) => t.intersect(ray),
@@ -163,38 +163,53 @@ impl Accel {
         self.shape_of[primitive as usize]
     }
 
-    /// The nearest hit in `(0, ray.tmax)`.
-    #[inline]
+    /// The nearest hit in `(0, ray.tmax)`. Inlined for scenes of one leaf
+    /// (whose test is short: a call, and the hit returned through memory,
+    /// would cost a good part of it).
+    #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        match self.bvh.as_ref() {
+            None => self.intersect_leaf(ray),
+            Some(bvh) => self.intersect_bvh(bvh, ray),
+        }
+    }
+
+    /// [`Accel::intersect`] in a scene without a BVH: every primitive.
+    #[inline(always)]
+    fn intersect_leaf(&self, ray: &Ray) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut shrunk = *ray;
+        let Leaf { packs, others } = &self.leaf;
+        for (pack, index) in packs {
+            if let Some((lane, c)) = pack.intersect(&shrunk) {
+                best = Some(Hit {
+                    t: c.t,
+                    primitive: index[lane],
+                    bary: c.bary,
+                });
+                shrunk.tmax = c.t;
+            }
+        }
+        for &primitive in others {
+            if let Some(c) = self.primitives[primitive as usize].intersect(&shrunk) {
+                best = Some(Hit {
+                    t: c.t,
+                    primitive,
+                    bary: c.bary,
+                });
+                shrunk.tmax = c.t;
+            }
+        }
+        best
+    }
+
+    /// [`Accel::intersect`] through the BVH.
+    #[inline(never)]
+    fn intersect_bvh(&self, bvh: &CwBvh, ray: &Ray) -> Option<Hit> {
         let mut best = Hit {
             t: ray.tmax,
             primitive: 0,
             bary: [0.0; 2],
-        };
-        let Some(bvh) = self.bvh.as_ref() else {
-            let mut shrunk = *ray;
-            let Leaf { packs, others } = &self.leaf;
-            for (pack, index) in packs {
-                if let Some((lane, c)) = pack.intersect(&shrunk) {
-                    best = Hit {
-                        t: c.t,
-                        primitive: index[lane],
-                        bary: c.bary,
-                    };
-                    shrunk.tmax = c.t;
-                }
-            }
-            for &primitive in others {
-                if let Some(c) = self.primitives[primitive as usize].intersect(&shrunk) {
-                    best = Hit {
-                        t: c.t,
-                        primitive,
-                        bary: c.bary,
-                    };
-                    shrunk.tmax = c.t;
-                }
-            }
-            return (best.t < ray.tmax).then_some(best);
         };
         let mut hit = RayHit::none();
         let query = obvhs::ray::Ray::new(ray.o, ray.d, 0.0, ray.tmax);
