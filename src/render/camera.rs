@@ -41,7 +41,9 @@ impl FovAxis {
 /// A perspective or thin-lens camera with its film size.
 #[derive(Clone, Copy, Debug)]
 pub struct Camera {
-    to_world: Affine3A,
+    /// `to_world`'s columns (x, y, z axes and translation), as plain
+    /// arrays: the ray kernel then runs one ray per SIMD lane.
+    to_world: [[f32; 3]; 4],
     /// `tan(fov_x / 2)` and `tan(fov_y / 2)`.
     tan_half: Vec2,
     near_clip: f32,
@@ -109,8 +111,9 @@ impl Camera {
             FovAxis::Larger if w >= h => t,
             FovAxis::Larger => t * w / h,
         };
+        let m = to_world.to_cols_array();
         Ok(Camera {
-            to_world,
+            to_world: std::array::from_fn(|c| std::array::from_fn(|r| m[3 * c + r])),
             tan_half: Vec2::new(tx as f32, (tx * h / w) as f32),
             near_clip: near_clip as f32,
             far_clip: far_clip as f32,
@@ -125,57 +128,90 @@ impl Camera {
     /// `v = ((1 − 2x) tan(fov_x/2), (1 − 2y) tan(fov_y/2), 1)`; the thin lens
     /// aims from the aperture point `a` at `v·focus_distance`. The ray starts
     /// where it crosses the near clip plane and ends at the far one, as in
-    /// Mitsuba. Branch-free (both the pinhole and the lens are computed),
-    /// so that [`Camera::rays_into`] vectorises.
-    #[inline(always)]
+    /// Mitsuba.
+    #[inline]
     pub fn ray(&self, film: [f32; 2], lens: [f32; 2]) -> Ray {
-        let v = Vec3A::new(
-            (1.0 - 2.0 * film[0]) * self.tan_half.x,
-            (1.0 - 2.0 * film[1]) * self.tan_half.y,
-            1.0,
-        );
-        let [x, y] = warp::square_to_uniform_disk_concentric(lens);
-        let aperture = Vec3A::new(x, y, 0.0) * self.aperture_radius;
         let thin = self.aperture_radius > 0.0;
+        ray_from_row(self.ray_row([film[0], film[1], lens[0], lens[1]], thin))
+    }
+
+    /// [`Camera::ray`] of `u = (film x, film y, lens x, lens y)` as the row
+    /// `[o, d, tmax]`, for a pinhole or (`thin`) a thin lens: plain `f32`
+    /// arithmetic without branches, so that a loop over rays runs one per
+    /// SIMD lane.
+    #[inline(always)]
+    fn ray_row(&self, u: [f32; 4], thin: bool) -> [f32; 7] {
+        let v = [
+            (1.0 - 2.0 * u[0]) * self.tan_half.x,
+            (1.0 - 2.0 * u[1]) * self.tan_half.y,
+            1.0,
+        ];
         let (o, d) = if thin {
-            (aperture, v * self.focus_distance - aperture)
+            let [x, y] = warp::square_to_uniform_disk_concentric([u[2], u[3]]);
+            let a = [x * self.aperture_radius, y * self.aperture_radius, 0.0];
+            (
+                a,
+                std::array::from_fn(|k| v[k] * self.focus_distance - a[k]),
+            )
         } else {
-            (Vec3A::ZERO, v)
+            ([0.0; 3], v)
         };
         // Mitsuba clips along the final direction: the ray starts where it
         // crosses the near plane `z = near_clip` (in camera space), which is
         // `near/d.z` along `d` (`d.z > 0`), or `|d|·near/d.z` along `d/|d|`.
-        let inv_z = 1.0 / d.z;
-        let o = o + d * (self.near_clip * inv_z);
-        Ray {
-            o: self.to_world.transform_point3a(o),
-            d: self.to_world.transform_vector3a(d).normalize(),
-            tmax: (self.far_clip - self.near_clip) * d.length() * inv_z,
-        }
+        let inv_z = 1.0 / d[2];
+        let o: [f32; 3] = std::array::from_fn(|k| o[k] + d[k] * (self.near_clip * inv_z));
+        let m = &self.to_world;
+        let wo: [f32; 3] =
+            std::array::from_fn(|k| m[0][k] * o[0] + m[1][k] * o[1] + m[2][k] * o[2] + m[3][k]);
+        let wd: [f32; 3] =
+            std::array::from_fn(|k| m[0][k] * d[0] + m[1][k] * d[1] + m[2][k] * d[2]);
+        let inv_len = 1.0 / (wd[0] * wd[0] + wd[1] * wd[1] + wd[2] * wd[2]).sqrt();
+        let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        [
+            wo[0],
+            wo[1],
+            wo[2],
+            wd[0] * inv_len,
+            wd[1] * inv_len,
+            wd[2] * inv_len,
+            (self.far_clip - self.near_clip) * length * inv_z,
+        ]
     }
 
     /// `out[i]` the ray of `u[i] = (film x, film y, lens x, lens y)` (see
     /// [`Camera::ray`]) for a batch, at full SIMD width.
     pub fn rays_into(&self, u: &[[f32; 4]], out: &mut [Ray]) {
         let mut rows = [[0.0f32; 7]; BLOCK];
-        let kernel = {
+        let pinhole = {
             #[inline(always)]
-            |u: [f32; 4]| {
-                let r = self.ray([u[0], u[1]], [u[2], u[3]]);
-                [r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.tmax]
-            }
+            |u: [f32; 4]| self.ray_row(u, false)
+        };
+        let thin = {
+            #[inline(always)]
+            |u: [f32; 4]| self.ray_row(u, true)
         };
         for (u, out) in u.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
             let rows = &mut rows[..u.len()];
-            simd::map_rows(rows, u, &kernel, |_| true, false);
+            if self.aperture_radius > 0.0 {
+                simd::map_rows(rows, u, &thin, |_| true, false);
+            } else {
+                simd::map_rows(rows, u, &pinhole, |_| true, false);
+            }
             for (o, r) in out.iter_mut().zip(rows.iter()) {
-                *o = Ray {
-                    o: Vec3A::new(r[0], r[1], r[2]),
-                    d: Vec3A::new(r[3], r[4], r[5]),
-                    tmax: r[6],
-                };
+                *o = ray_from_row(*r);
             }
         }
+    }
+}
+
+/// The ray of a row `[o, d, tmax]`.
+#[inline(always)]
+fn ray_from_row(r: [f32; 7]) -> Ray {
+    Ray {
+        o: Vec3A::new(r[0], r[1], r[2]),
+        d: Vec3A::new(r[3], r[4], r[5]),
+        tmax: r[6],
     }
 }
 
