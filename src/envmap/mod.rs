@@ -568,30 +568,45 @@ impl EnvMap {
     /// the tables' batch samplers (whose cache misses overlap), then the
     /// texels under them located and prefetched, the directions and
     /// densities of the group in one loop at SIMD width, and last the
-    /// radiance. The same bits as [`EnvMap::sample`].
-    pub fn sample_into(&self, us: &[[f64; 2]], out: &mut [EnvSample]) {
+    /// radiance. Computed in `F` past the table draw (whose searches run in
+    /// `f64`; Mitsuba's bilinear density is sampled in `f64` and rounded);
+    /// in `f64`, the same bits as [`EnvMap::sample`]. In `f32` a direction
+    /// and its density are good to a few ulps of `f32` (the density near a
+    /// pole of a polar table to about `10⁻⁷/sin θ`).
+    pub fn sample_into<F: Real>(&self, us: &[[F; 2]], out: &mut [EnvSample<F>]) {
         // One loop per mapping, each with its own formulas inlined (see
         // `eval_into`).
         macro_rules! frame {
             ($mapping:expr) => {{
                 #[inline(always)]
-                |[s, t, pdf_q]: [f64; 3]| self.frame_at($mapping, [s, t], pdf_q)
+                |[s, t, pdf_q]: [F; 3]| self.frame_at($mapping, [s, t], pdf_q)
             }};
         }
-        let mut drawn = [([0.0; 2], 0.0); GROUP];
-        let mut points = [[0.0; 3]; GROUP];
-        let mut frames = [[0.0; 5]; GROUP];
-        let mut corners = [([0; 4], [0.0; 4]); GROUP];
+        let zero = F::zero();
+        let mut drawn = [([zero; 2], zero); GROUP];
+        let mut points = [[zero; 3]; GROUP];
+        let mut frames = [[zero; 5]; GROUP];
+        let mut corners = [([0; 4], [zero; 4]); GROUP];
+        let mut bilinear = [([0.0; 2], 0.0); GROUP];
         let mapping = self.options.mapping;
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
             let n = us.len();
             let drawn = &mut drawn[..n];
             match &self.distribution {
                 Distribution::Piecewise(table) => table.sample_into(us, drawn),
-                Distribution::Bilinear(grid) => grid.sample_into(us, drawn),
+                Distribution::Bilinear(grid) => {
+                    let (u64s, b) = (&mut [[0.0; 2]; GROUP][..n], &mut bilinear[..n]);
+                    for (u, x) in u64s.iter_mut().zip(us) {
+                        *u = x.map(F::f64);
+                    }
+                    grid.sample_into(u64s, b);
+                    for (d, &(q, pdf)) in drawn.iter_mut().zip(b.iter()) {
+                        *d = (q.map(F::c), F::c(pdf));
+                    }
+                }
                 Distribution::Black => {
                     for (o, &u) in out.iter_mut().zip(us) {
-                        *o = self.sample_black(u);
+                        *o = self.sample_black(u.map(F::f64)).cast();
                     }
                     continue;
                 }

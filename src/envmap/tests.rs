@@ -127,6 +127,32 @@ fn batch_sampling_agrees_with_single_draws() {
         for (&u, o) in us.iter().zip(&out) {
             assert_eq!(*o, m.sample(u), "{:?}: u = {u:?}", m.options());
         }
+        // In f32: the same directions and densities to f32 precision, away
+        // from the poles and seams (where rounding u may pick a neighbour).
+        let u32s: Vec<[f32; 2]> = us.iter().map(|u| u.map(|x| x as f32)).collect();
+        let mut out32 = vec![EnvSample::<f32>::default(); us.len()];
+        m.sample_into(&u32s, &mut out32);
+        let mut far = 0;
+        for (&u, o) in u32s.iter().zip(&out32) {
+            let s = m.sample(u.map(f64::from));
+            // sin θ from the lat-long (+Y) and the angular (+Z) pole.
+            let d = m.to_local(s.direction);
+            if d[0].hypot(d[2]).min(d[0].hypot(d[1])) < 1e-2 {
+                continue;
+            }
+            let close = o
+                .direction
+                .iter()
+                .zip(s.direction)
+                .all(|(a, b)| (f64::from(*a) - b).abs() < 1e-4)
+                && (f64::from(o.pdf) - s.pdf).abs() <= 1e-3 * s.pdf;
+            far += usize::from(!close);
+        }
+        assert!(
+            far == 0,
+            "{:?}: {far} f32 samples away from f64's",
+            m.options()
+        );
     }
 }
 

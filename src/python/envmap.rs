@@ -329,17 +329,18 @@ impl PyEnvMap {
             let env = &self.0;
             let valid = run_batch(py, u.n, outputs, |range, (o_d, o_p, o_w)| {
                 let mut ok = true;
-                let (mut us, mut samples) = ([[0.0; 2]; GROUP], [EnvSample::default(); GROUP]);
+                let (zero, one) = (F::zero(), F::one());
+                let mut us = [[zero; 2]; GROUP];
+                let mut samples = [EnvSample::<F>::default(); GROUP];
                 for (g, rows) in rows[range].chunks(GROUP).enumerate() {
                     let (us, samples) = (&mut us[..rows.len()], &mut samples[..rows.len()]);
                     for (u, x) in us.iter_mut().zip(rows) {
                         ok &= Check::Unit.holds_all(x);
-                        *u = x.map(|v| v.f64().clamp(0.0, 1.0));
+                        *u = x.map(|v| v.max(zero).min(one));
                     }
                     env.sample_into(us, samples);
                     for (k, s) in (g * GROUP..).zip(samples.iter()) {
-                        (o_d[k], o_p[k], o_w[k]) =
-                            (s.direction.map(F::c), F::c(s.pdf), s.weight.map(F::c));
+                        (o_d[k], o_p[k], o_w[k]) = (s.direction, s.pdf, s.weight);
                     }
                 }
                 ok
