@@ -5,6 +5,7 @@ use super::{Distribution, EnvMap, EnvSample};
 use crate::distr::AliasTable;
 use crate::error::Result;
 use crate::math::Real;
+use crate::warp::V3;
 
 /// The density of [`EnvMap::sample`] (piecewise sampling), drawn in O(1):
 /// the table cell `(row, col)` by an [`AliasTable`] over the cells'
@@ -42,18 +43,24 @@ impl CellSampler {
         }))
     }
 
-    /// A direction of `env` (the map this sampler was built for): the cell
-    /// from the 64 random bits `bits`, the point within it at fractions
-    /// `r` in `[0, 1)²` (along the table's x and y). Computed in `F`: in
-    /// `f32` the point stays in its cell, and the direction and density are
-    /// good to a few `f32` ulps.
+    /// A direction of `env` (the map this sampler was built for), its
+    /// density per steradian and the radiance arriving along it (not
+    /// divided by the density, as a renderer's light sample wants it): the
+    /// cell from the 64 random bits `bits`, the point within it at
+    /// fractions `r` in `[0, 1)²` (along the table's x and y). Computed in
+    /// `F`: in `f32` the point stays in its cell, and the direction and
+    /// density are good to a few `f32` ulps. (Given a map that is not
+    /// sampled piecewise, it draws by [`EnvMap::sample`] of `r`.)
     #[inline]
-    pub fn sample<F: Real>(&self, env: &EnvMap, bits: u64, r: [F; 2]) -> EnvSample<F> {
+    pub fn sample<F: Real>(&self, env: &EnvMap, bits: u64, r: [F; 2]) -> (V3<F>, F, V3<F>) {
         let Distribution::Piecewise(table) = &env.distribution else {
-            return env.sample(r.map(F::f64)).cast();
+            let s: EnvSample<F> = env.sample(r.map(F::f64)).cast();
+            return (s.direction, s.pdf, s.radiance());
         };
         let c = self.cells.sample_bits(bits);
         let (q, pdf_q) = table.sample_in_cell((c / self.cols, c % self.cols), r);
-        env.sample_at(env.table_to_uv(q), pdf_q)
+        let (mapping, p) = (env.options.mapping, env.table_to_uv(q));
+        let [x, y, z, pdf, _] = env.frame_at(mapping, p, pdf_q);
+        ([x, y, z], pdf, env.radiance_at(p))
     }
 }

@@ -295,6 +295,11 @@ pub struct EnvSample<F = f64> {
 }
 
 impl<F: Real> EnvSample<F> {
+    /// The radiance arriving along the direction, `weight · pdf`.
+    pub fn radiance(&self) -> V3<F> {
+        self.weight.map(|w| w * self.pdf)
+    }
+
     /// The sample rounded to `G`.
     pub fn cast<G: Real>(&self) -> EnvSample<G> {
         EnvSample {

@@ -173,7 +173,8 @@ pub fn add_escaped(scene: &Scene, settings: &Settings, escaped: &mut Escaped, l:
     }
 }
 
-/// The radiance arriving at the camera along `ray`: one sample of the
+/// The radiance arriving at the camera along `ray`, whose first hit
+/// ([`super::accel::Accel::intersect`]) is `hit`: one sample of the
 /// estimator above, drawing its random numbers from `rng`. Light from the
 /// environment is not included: rays that escape are added to `escaped`
 /// under `slot`, and [`add_escaped`] adds their light.

@@ -99,11 +99,14 @@ impl Environment {
     ) -> (Vec3A, f32, [f32; 3]) {
         match self {
             Environment::Map(env) => {
-                let s = match cells {
+                let (d, pdf, radiance) = match cells {
                     Some((cells, bits)) => cells.sample(env, bits, u),
-                    None => env.sample(u.map(f64::from)).cast(),
+                    None => {
+                        let s = env.sample(u.map(f64::from)).cast::<f32>();
+                        (s.direction, s.pdf, s.radiance())
+                    }
                 };
-                (Vec3A::from(s.direction), s.pdf, s.weight.map(|w| w * s.pdf))
+                (Vec3A::from(d), pdf, radiance)
             }
             Environment::Constant(l) => {
                 let d = warp::square_to_uniform_sphere(u);
