@@ -313,10 +313,10 @@ fn stream_copy<T: Copy>(dst: &mut [T], src: &[T], width: Level) {
 }
 
 /// Defines a function that copies `len` bytes (whole lines) from `s` to the
-/// line-aligned `d` with non-temporal stores of one vector type. It stays
-/// out of line: inlined, LLVM folds the block's transpose into the copy and
-/// assembles each vector from single floats, several times slower than the
-/// call it saves.
+/// line-aligned `d` with non-temporal stores of one vector type. Marked
+/// `#[inline(never)]`: with `#[inline]`, LLVM folded the block's transpose
+/// into the copy and assembled each vector from single floats, which ran
+/// the streamed warps several times slower.
 macro_rules! stream_lines {
     ($name:ident, $feature:literal, $vector:ident, $load:ident, $store:ident) => {
         #[cfg(target_arch = "x86_64")]
