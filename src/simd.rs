@@ -89,16 +89,7 @@ fn avx2_fma<R>(f: impl FnOnce() -> R) -> R {
 /// nothing on targets without the instruction.
 #[inline(always)]
 pub fn prefetch<T>(data: &[T], index: usize) {
-    #[cfg(target_arch = "x86_64")]
-    #[allow(unsafe_code)]
-    // SAFETY: a prefetch reads nothing the program can observe and never
-    // faults, whatever the address.
-    unsafe {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        _mm_prefetch::<_MM_HINT_T0>(data.as_ptr().wrapping_add(index).cast());
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (data, index);
+    prefetch_address(data.as_ptr().wrapping_add(index).cast());
 }
 
 /// Asks the CPU to bring every cache line of `data` into the caches ahead
@@ -107,16 +98,24 @@ pub fn prefetch<T>(data: &[T], index: usize) {
 pub fn prefetch_lines<T>(data: &[T]) {
     let start = data.as_ptr().cast::<u8>();
     for offset in (0..size_of_val(data)).step_by(LINE) {
-        #[cfg(target_arch = "x86_64")]
-        #[allow(unsafe_code)]
-        // SAFETY: as in `prefetch`, the address is only a hint.
-        unsafe {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            _mm_prefetch::<_MM_HINT_T0>(start.wrapping_add(offset).cast());
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = (start, offset);
+        prefetch_address(start.wrapping_add(offset));
     }
+}
+
+/// The prefetch hint of [`prefetch`] and [`prefetch_lines`], for any
+/// address.
+#[inline(always)]
+fn prefetch_address(address: *const u8) {
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    // SAFETY: a prefetch reads nothing the program can observe and never
+    // faults, whatever the address.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>(address.cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = address;
 }
 
 /// Cache line size in bytes (x86-64 and most other targets).
@@ -175,9 +174,10 @@ where
                 Some(_) => out.as_ptr().align_offset(LINE),
                 None => 0,
             };
-            let (head, streaming) = match head < BLOCK {
-                true => (head.min(out.len()), streaming),
-                false => (0, None),
+            let (head, streaming) = if head < BLOCK {
+                (head.min(out.len()), streaming)
+            } else {
+                (0, None)
             };
             let (out_head, out) = out.split_at_mut(head);
             let (in_head, inputs) = inputs.split_at(head);
