@@ -487,25 +487,48 @@ impl EnvMap {
         let mut ok = true;
         let blocks = out.chunks_mut(BATCH_BLOCK).zip(d.chunks(BATCH_BLOCK));
         if let Some(table) = &self.polar {
-            let mut queries = [[F::zero(); 3]; BATCH_BLOCK];
-            let mut cells = [0usize; BATCH_BLOCK];
+            // Two blocks in flight: each block's cells are located and their
+            // densities prefetched, then the densities of the block before
+            // are read (by now in the caches), so that the table reads
+            // overlap the next block's arithmetic instead of waiting on it.
+            let mut queries = [[[F::zero(); 3]; BATCH_BLOCK]; 2];
+            let mut cells = [[0usize; BATCH_BLOCK]; 2];
             let densities = F::densities(table);
             let query = {
                 #[inline(always)]
                 |x| table.query(x)
             };
-            for (o, x) in blocks {
-                let q = &mut queries[..x.len()];
-                ok &= simd::map_rows(q, x, &query, &valid, false);
-                // Indices first, then a short loop of loads, so that many
-                // table reads are in flight at once.
-                for (c, q) in cells.iter_mut().zip(q.iter()) {
-                    *c = table.cell(*q);
+            let read = {
+                #[inline(always)]
+                |o: &mut [F], q: &[[F; 3]; BATCH_BLOCK], c: &[usize; BATCH_BLOCK]| {
+                    for ((o, q), &c) in o.iter_mut().zip(q).zip(c) {
+                        *o = densities.get(c).copied().unwrap_or(F::zero()) * q[2];
+                    }
                 }
-                for ((o, q), &c) in o.iter_mut().zip(q.iter()).zip(&cells) {
-                    *o = densities.get(c).copied().unwrap_or(F::zero()) * q[2];
-                }
-            }
+            };
+            ok = simd::dispatch(
+                #[inline(always)]
+                || {
+                    let mut ok = true;
+                    let mut previous: Option<&mut [F]> = None;
+                    for (b, (o, x)) in blocks.enumerate() {
+                        let (q, c) = (&mut queries[b % 2], &mut cells[b % 2]);
+                        ok &= simd::map_rows(&mut q[..x.len()], x, &query, &valid, false);
+                        for (c, q) in c.iter_mut().zip(&q[..x.len()]) {
+                            *c = table.cell(*q);
+                            simd::prefetch(densities, *c);
+                        }
+                        if let Some(p) = previous.replace(o) {
+                            read(p, &queries[(b + 1) % 2], &cells[(b + 1) % 2]);
+                        }
+                    }
+                    if let Some(p) = previous {
+                        let last = d.len().div_ceil(BATCH_BLOCK) - 1;
+                        read(p, &queries[last % 2], &cells[last % 2]);
+                    }
+                    ok
+                },
+            );
         } else {
             let mut queries = [PdfQuery::default(); BATCH_BLOCK];
             for (o, x) in blocks {

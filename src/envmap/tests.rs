@@ -157,6 +157,28 @@ fn batch_sampling_agrees_with_single_draws() {
 }
 
 #[test]
+fn batch_pdfs_agree_with_single_queries() {
+    // Lengths around the block size, so that the last block (read after the
+    // loop) is empty, partial or whole.
+    let mut rng = crate::rng::Rng::new(11, 1);
+    let d: Vec<[f64; 3]> = (0..3 * BATCH_BLOCK + 1)
+        .map(|_| warp::square_to_uniform_sphere([rng.next_float(), rng.next_float()]))
+        .collect();
+    for m in all_maps() {
+        for n in [0, 1, BATCH_BLOCK - 1, BATCH_BLOCK, BATCH_BLOCK + 1, 3 * BATCH_BLOCK + 1] {
+            let mut out = vec![-1.0; n];
+            assert!(m.pdf_into(&d[..n], &mut out, |_| true));
+            for (x, o) in d.iter().zip(&out) {
+                assert_eq!(*o, m.pdf(*x), "{:?}: n = {n}, d = {x:?}", m.options());
+            }
+        }
+        let invalid = |x: &[f64; 3]| x[0] < 0.9;
+        let mut out = vec![0.0; d.len()];
+        assert!(!m.pdf_into(&d, &mut out, invalid));
+    }
+}
+
+#[test]
 fn polar_tables_give_the_table_pdf() {
     // The branch-free polar query (f64 and f32) against the table's own
     // density at the same point, on random directions.
