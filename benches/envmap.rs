@@ -3,7 +3,7 @@
 //! at a time, and in batches):
 //! `cargo bench --bench envmap`.
 
-use mcsample::envmap::{EnvMap, EnvSample, Options};
+use mcsample::envmap::{EnvMap, EnvSamples, Options};
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -71,13 +71,19 @@ fn main() {
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
     let random: Vec<[f64; 2]> = (0..n).map(|_| [next(), next()]).collect();
-    let mut samples = vec![EnvSample::default(); n];
-    let t = best(3, || env.sample_into(black_box(&random), &mut samples));
-    println!("sample_into (random u): {:.1} ns", t / n as f64 * 1e9);
-    let d32: Vec<[f32; 3]> = samples
-        .iter()
-        .map(|s| s.direction.map(|x| x as f32))
-        .collect();
+    // In f32, as Python's float32 batches run.
+    let random: Vec<[f32; 2]> = random.iter().map(|u| u.map(|x| x as f32)).collect();
+    let (mut d32, mut pdfs, mut weights) =
+        (vec![[0.0f32; 3]; n], vec![0.0f32; n], vec![[0.0f32; 3]; n]);
+    let t = best(3, || {
+        let out = EnvSamples {
+            direction: &mut d32,
+            pdf: &mut pdfs,
+            weight: &mut weights,
+        };
+        env.sample_into(black_box(&random), out);
+    });
+    println!("sample_into f32 (random u): {:.1} ns", t / n as f64 * 1e9);
     let mut pdf32 = vec![0.0f32; n];
     let t = best(3, || {
         env.pdf_into(black_box(&d32), &mut pdf32, |_| true);

@@ -129,7 +129,7 @@ impl Image {
 
     /// The texels around `p` (in the mapping's domain, lat-long `s` in
     /// `[0, 1]`) and their weights (see the module docs), computed in `F`.
-    #[inline]
+    #[inline(always)]
     pub fn corners<F: Real>(&self, mapping: Mapping, p: [F; 2]) -> Corners<F> {
         let (w, h) = (self.width, self.height);
         let (zero, one) = (F::zero(), F::one());

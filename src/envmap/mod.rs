@@ -294,6 +294,26 @@ pub struct EnvSample<F = f64> {
     pub weight: V3<F>,
 }
 
+/// The arrays a batch of [`EnvMap::sample_into`] writes: each sample's
+/// parts into their own array, as a caller's separate outputs want them.
+#[derive(Debug)]
+pub struct EnvSamples<'a, F> {
+    /// The directions.
+    pub direction: &'a mut [V3<F>],
+    /// Their densities per steradian.
+    pub pdf: &'a mut [F],
+    /// `L/pdf` per RGB channel.
+    pub weight: &'a mut [V3<F>],
+}
+
+impl<F: Copy> EnvSamples<'_, F> {
+    /// Writes sample `k`.
+    #[inline(always)]
+    fn set(&mut self, k: usize, s: EnvSample<F>) {
+        (self.direction[k], self.pdf[k], self.weight[k]) = (s.direction, s.pdf, s.weight);
+    }
+}
+
 impl<F: Real> EnvSample<F> {
     /// The radiance arriving along the direction, `weight · pdf`.
     pub fn radiance(&self) -> V3<F> {
@@ -601,7 +621,10 @@ impl EnvMap {
     /// in `f64`, the same bits as [`EnvMap::sample`]. In `f32` a direction
     /// and its density are good to a few ulps of `f32` (the density near a
     /// pole of a polar table to about `10⁻⁷/sin θ`).
-    pub fn sample_into<F: Real>(&self, us: &[[F; 2]], out: &mut [EnvSample<F>]) {
+    ///
+    /// # Panics
+    /// If an array of `out` is shorter than `us`.
+    pub fn sample_into<F: Real>(&self, us: &[[F; 2]], mut out: EnvSamples<'_, F>) {
         // One loop per mapping, each with its own formulas inlined (see
         // `eval_into`).
         macro_rules! frame {
@@ -617,8 +640,9 @@ impl EnvMap {
         let mut corners = [([0; 4], [zero; 4]); GROUP];
         let mut bilinear = [([0.0; 2], 0.0); GROUP];
         let mapping = self.options.mapping;
-        for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
+        for (g, us) in us.chunks(GROUP).enumerate() {
             let n = us.len();
+            let first = g * GROUP;
             let drawn = &mut drawn[..n];
             match &self.distribution {
                 Distribution::Piecewise(table) => table.sample_into(us, drawn),
@@ -633,8 +657,8 @@ impl EnvMap {
                     }
                 }
                 Distribution::Black => {
-                    for (o, &u) in out.iter_mut().zip(us) {
-                        *o = self.sample_black(u.map(F::f64)).cast();
+                    for (k, &u) in (first..).zip(us) {
+                        out.set(k, self.sample_black(u.map(F::f64)).cast());
                     }
                     continue;
                 }
@@ -657,8 +681,8 @@ impl EnvMap {
                     simd::map_rows(frames, points, &frame!(Mapping::Cube), |_| true, false)
                 }
             };
-            for ((o, f), c) in out.iter_mut().zip(frames.iter()).zip(&corners) {
-                *o = self.sample_from(f, c);
+            for ((k, f), c) in (first..).zip(frames.iter()).zip(&corners) {
+                out.set(k, self.sample_from(f, c));
             }
         }
     }

@@ -114,6 +114,29 @@ fn samples_carry_their_own_pdf_and_weight() {
     }
 }
 
+/// `m.sample_into(us)` as samples.
+fn batch<F: Real>(m: &EnvMap, us: &[[F; 2]]) -> Vec<EnvSample<F>> {
+    let n = us.len();
+    let (mut direction, mut pdf, mut weight) = (
+        vec![[F::zero(); 3]; n],
+        vec![F::zero(); n],
+        vec![[F::zero(); 3]; n],
+    );
+    let out = EnvSamples {
+        direction: &mut direction,
+        pdf: &mut pdf,
+        weight: &mut weight,
+    };
+    m.sample_into(us, out);
+    (0..n)
+        .map(|k| EnvSample {
+            direction: direction[k],
+            pdf: pdf[k],
+            weight: weight[k],
+        })
+        .collect()
+}
+
 #[test]
 fn batch_sampling_agrees_with_single_draws() {
     let black = EnvMap::new(2, 2, &[0.0; 12], Options::default()).unwrap();
@@ -122,16 +145,14 @@ fn batch_sampling_agrees_with_single_draws() {
         let us: Vec<[f64; 2]> = (0..=300)
             .map(|k| [(k as f64 * 0.618_033_988_749_895).fract(), k as f64 / 300.0])
             .collect();
-        let mut out = vec![EnvSample::default(); us.len()];
-        m.sample_into(&us, &mut out);
+        let out = batch(&m, &us);
         for (&u, o) in us.iter().zip(&out) {
             assert_eq!(*o, m.sample(u), "{:?}: u = {u:?}", m.options());
         }
         // In f32: the same directions and densities to f32 precision, away
         // from the poles and seams (where rounding u may pick a neighbour).
         let u32s: Vec<[f32; 2]> = us.iter().map(|u| u.map(|x| x as f32)).collect();
-        let mut out32 = vec![EnvSample::<f32>::default(); us.len()];
-        m.sample_into(&u32s, &mut out32);
+        let out32 = batch(&m, &u32s);
         let mut far = 0;
         for (&u, o) in u32s.iter().zip(&out32) {
             let s = m.sample(u.map(f64::from));
@@ -165,7 +186,14 @@ fn batch_pdfs_agree_with_single_queries() {
         .map(|_| warp::square_to_uniform_sphere([rng.next_float(), rng.next_float()]))
         .collect();
     for m in all_maps() {
-        for n in [0, 1, BATCH_BLOCK - 1, BATCH_BLOCK, BATCH_BLOCK + 1, 3 * BATCH_BLOCK + 1] {
+        for n in [
+            0,
+            1,
+            BATCH_BLOCK - 1,
+            BATCH_BLOCK,
+            BATCH_BLOCK + 1,
+            3 * BATCH_BLOCK + 1,
+        ] {
             let mut out = vec![-1.0; n];
             assert!(m.pdf_into(&d[..n], &mut out, |_| true));
             for (x, o) in d.iter().zip(&out) {

@@ -6,7 +6,7 @@ use super::arrays::{
 };
 use super::parallel::{detached, run_batch};
 use crate::distr::GROUP;
-use crate::envmap::{EnvMap, EnvSample, Mapping, Matrix3, Options, Sampling};
+use crate::envmap::{EnvMap, EnvSamples, Mapping, Matrix3, Options, Sampling};
 use crate::error::{Error, shape_str};
 use crate::io;
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
@@ -331,17 +331,19 @@ impl PyEnvMap {
                 let mut ok = true;
                 let (zero, one) = (F::zero(), F::one());
                 let mut us = [[zero; 2]; GROUP];
-                let mut samples = [EnvSample::<F>::default(); GROUP];
                 for (g, rows) in rows[range].chunks(GROUP).enumerate() {
-                    let (us, samples) = (&mut us[..rows.len()], &mut samples[..rows.len()]);
+                    let us = &mut us[..rows.len()];
                     for (u, x) in us.iter_mut().zip(rows) {
                         ok &= Check::Unit.holds_all(x);
                         *u = x.map(|v| v.max(zero).min(one));
                     }
-                    env.sample_into(us, samples);
-                    for (k, s) in (g * GROUP..).zip(samples.iter()) {
-                        (o_d[k], o_p[k], o_w[k]) = (s.direction, s.pdf, s.weight);
-                    }
+                    let first = g * GROUP;
+                    let out = EnvSamples {
+                        direction: &mut o_d[first..],
+                        pdf: &mut o_p[first..],
+                        weight: &mut o_w[first..],
+                    };
+                    env.sample_into(us, out);
                 }
                 ok
             })?;
