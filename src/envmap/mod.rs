@@ -494,9 +494,10 @@ impl EnvMap {
 
     /// `out[i] = pdf(d[i])` for a batch, in `F`, in blocks of
     /// [`BATCH_BLOCK`]: for polar tables, every direction's cell by the
-    /// branch-free [`PolarTable::query`] at full SIMD width, then the table
-    /// reads of the block, which overlap; for the others [`EnvMap::pdf_query`]
-    /// then [`EnvMap::pdf_at`]. Returns whether `valid` held for every
+    /// branch-free [`PolarTable::query`] at full SIMD width and its density
+    /// prefetched, then the densities of the block before read (one block
+    /// behind, so that the reads wait on no cache miss); for the others
+    /// [`EnvMap::pdf_query`] then [`EnvMap::pdf_at`]. Returns whether `valid` held for every
     /// direction (it is checked in the same pass).
     pub fn pdf_into<F: TableFloat>(
         &self,
