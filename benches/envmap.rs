@@ -61,18 +61,16 @@ fn main() {
             [x, (i as f64 + 0.5) / n as f64]
         })
         .collect();
-    // Batches on random numbers, as Python's EnvMap.sample and .pdf run them
-    // (on each thread).
+    // Batches on random numbers in f32, as Python's float32 EnvMap.sample
+    // and .pdf run them (on each thread).
     let mut state = 0x853c_49e6_748f_ea9b_u64;
     let mut next = || {
         state = state
             .wrapping_mul(6_364_136_223_846_793_005)
             .wrapping_add(1_442_695_040_888_963_407);
-        (state >> 11) as f64 / (1u64 << 53) as f64
+        (state >> 40) as f32 / (1u64 << 24) as f32
     };
-    let random: Vec<[f64; 2]> = (0..n).map(|_| [next(), next()]).collect();
-    // In f32, as Python's float32 batches run.
-    let random: Vec<[f32; 2]> = random.iter().map(|u| u.map(|x| x as f32)).collect();
+    let random: Vec<[f32; 2]> = (0..n).map(|_| [next(), next()]).collect();
     let (mut d32, mut pdfs, mut weights) =
         (vec![[0.0f32; 3]; n], vec![0.0f32; n], vec![[0.0f32; 3]; n]);
     let t = best(3, || {

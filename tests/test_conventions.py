@@ -168,7 +168,7 @@ def test_out_receives_the_result_as_numpy_ufuncs_do():
 
 @pytest.mark.parametrize("out,exc,fragment", [
     (np.empty((1000, 3), np.float32), TypeError, "dtype float64"),
-    (np.empty((999, 3)), ValueError, "out must have shape a writeable C-ordered array of shape (1000, 3)"),
+    (np.empty((999, 3)), ValueError, "out must have shape (1000, 3) (a writeable C-ordered array), got (999, 3)"),
     (np.empty((3, 1000)).T, ValueError, "C-ordered"),
     ([[0.0] * 3] * 1000, TypeError, "out must be a numpy array"),
 ])

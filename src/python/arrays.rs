@@ -360,7 +360,7 @@ pub fn output<'py, T: Element>(
     if !fits {
         return Err(Error::Shape {
             arg: "out",
-            expected: format!("a writeable C-ordered array of shape {}", shape_str(shape)),
+            expected: format!("{} (a writeable C-ordered array)", shape_str(shape)),
             got: shape_str(array.shape()),
         }
         .into());
