@@ -43,6 +43,11 @@ pub trait Real: Float + FloatConst + Debug + Default + Send + Sync + 'static {
     /// `f64`, 10 in `f32`), evaluated by Estrin's scheme: branch-free,
     /// without library calls.
     fn atan_reduced(r: Self) -> Self;
+
+    /// `⌊x⌋` as an index clamped to `[0, last]` (0 for NaN), for `last`
+    /// below 2³²: the float is converted to `u32` (saturating), which takes
+    /// fewer instructions than a conversion to `usize`.
+    fn floor_index(self, last: usize) -> usize;
 }
 
 /// The first `N` Taylor coefficients of `atan r / r` in powers of `r²`:
@@ -260,6 +265,10 @@ impl Real for f32 {
         self as f64
     }
     #[inline(always)]
+    fn floor_index(self, last: usize) -> usize {
+        (self as u32 as usize).min(last)
+    }
+    #[inline(always)]
     fn from_random_bits(bits: u32) -> f32 {
         f32::from_bits((bits >> 9) | 0x3f80_0000) - 1.0
     }
@@ -285,6 +294,10 @@ impl Real for f64 {
     #[inline(always)]
     fn f64(self) -> f64 {
         self
+    }
+    #[inline(always)]
+    fn floor_index(self, last: usize) -> usize {
+        (self as u32 as usize).min(last)
     }
     #[inline(always)]
     fn from_random_bits(bits: u32) -> f64 {

@@ -472,7 +472,7 @@ impl AliasTable {
     fn locate<F: Real>(&self, u: F) -> (usize, u32) {
         let n = self.cells.len();
         let t = u.f64() * n as f64;
-        let c = (t as usize).min(n - 1);
+        let c = t.floor_index(n - 1);
         (c, ((t - c as f64) * ONE) as u32)
     }
 

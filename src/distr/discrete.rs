@@ -282,6 +282,21 @@ pub(crate) fn fill_table(
     Some((sum, range.0, range.1))
 }
 
+/// Brackets of at most this many running sums are searched by counting
+/// the sums below the value, all at once (branch-free, one vector compare),
+/// instead of by a binary search whose branches the CPU cannot predict.
+const SCAN: usize = 8;
+
+/// The number of entries of `window` below `value`, for sorted entries:
+/// the bits set in the mask of the compares are its lowest ones, so their
+/// count is the position of the highest one.
+#[inline(always)]
+fn count_below(window: &[f64; SCAN], value: f64) -> usize {
+    let below =
+        (window.iter().enumerate()).fold(0u32, |m, (j, &c)| m | (u32::from(c < value) << j));
+    (u32::BITS - below.leading_zeros()) as usize
+}
+
 /// A [`Discrete1D`]'s tables as plain slices, and a draw in steps that a
 /// batch can interleave: [`Search::locate`] the guide cell (prefetched),
 /// [`Search::prefetch_bracket`], then [`Search::index`] or
@@ -331,7 +346,7 @@ impl<'a> Search<'a> {
     #[inline(always)]
     fn guide_cell(&self, u: f64) -> usize {
         let cells = self.guide.len().saturating_sub(1);
-        ((u * cells as f64) as usize).min(cells.saturating_sub(1))
+        (u * cells as f64).floor_index(cells.saturating_sub(1))
     }
 
     /// The index and the rescaled `u` in one go (see
@@ -360,13 +375,20 @@ impl<'a> Search<'a> {
         }
     }
 
-    /// Step 3: the index for `u` by binary search within the bracket of
-    /// guide cell `k` (see [`Search::bracket`]).
+    /// Step 3: the index for `u` within the bracket of guide cell `k` (see
+    /// [`Search::bracket`]): a bracket of at most [`SCAN`] entries by
+    /// counting the sums below `u·Σw` in the [`SCAN`] from its start (those
+    /// past its end are not below: the one at the end is at least `u·Σw`,
+    /// or it is the last entry of positive weight, after which every sum
+    /// is `Σw`); a longer one by binary search.
     #[inline(always)]
     pub(crate) fn index(&self, u: f64, k: usize) -> usize {
         let value = u * self.sum;
         let (lo, hi) = self.bracket(k, value);
-        lo + self.cdf[lo..hi].partition_point(|&c| c < value)
+        match self.cdf.get(lo..).and_then(<[f64]>::first_chunk) {
+            Some(window) if hi - lo <= SCAN => lo + count_below(window, value),
+            _ => lo + self.cdf[lo..hi].partition_point(|&c| c < value),
+        }
     }
 
     /// Step 3 of [`Discrete1D::sample_reuse`]: the index and the rescaled

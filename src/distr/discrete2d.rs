@@ -5,7 +5,7 @@ use super::{Discrete1D, GROUP, check_weights};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
-use crate::parallel;
+use crate::{parallel, simd};
 use rayon::prelude::*;
 
 /// A discrete distribution over the cells `(row, col)` of a `rows × cols`
@@ -212,6 +212,20 @@ impl Discrete2D {
     /// their brackets, the columns (prefetching their weights), then the
     /// rescaled `u` of each column; the cache misses of a group overlap.
     pub fn sample_reuse_into<F: Real>(&self, us: &[[F; 2]], out: &mut [((usize, usize), [F; 2])]) {
+        simd::dispatch(
+            #[inline(always)]
+            || self.sample_groups(us, out),
+        )
+    }
+
+    /// [`Discrete2D::sample_reuse_into`] without the dispatch, for the batch
+    /// loops of samplers built on this table (which dispatch themselves).
+    #[inline(always)]
+    pub(crate) fn sample_groups<F: Real>(
+        &self,
+        us: &[[F; 2]],
+        out: &mut [((usize, usize), [F; 2])],
+    ) {
         let marginal = self.marginal.search();
         let tables = self.tables();
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
@@ -293,6 +307,48 @@ mod tests {
         d.sample_reuse_into(&us, &mut out);
         for (&u, &o) in us.iter().zip(&out) {
             assert_eq!(o, d.sample_reuse(u), "u = {u:?}");
+        }
+    }
+
+    /// The reference: `C_{i−1} < u·Σw ≤ C_i` by a linear scan of running
+    /// sums taken in order, among the entries of positive weight.
+    fn linear(weights: &[f64], u: f64) -> usize {
+        let sum: f64 = weights.iter().sum();
+        let (mut acc, value) = (0.0, u * sum);
+        let positive: Vec<usize> = (0..weights.len()).filter(|&i| weights[i] > 0.0).collect();
+        for &i in &positive {
+            acc = weights[..=i].iter().sum();
+            if acc >= value {
+                return i;
+            }
+        }
+        *positive.last().unwrap()
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn draws_agree_with_a_linear_scan(
+            cols in 1..300usize,
+            cells in proptest::collection::vec(
+                proptest::prop_oneof![proptest::strategy::Just(0.0), 0.0..10.0f64], 1..1500),
+            us in proptest::collection::vec([0.0..=1.0f64, 0.0..=1.0f64], 40),
+        ) {
+            // Long rows (guided, searched in windows near their ends), rows
+            // and runs of weight 0.
+            let rows = cells.len().div_ceil(cols);
+            let mut w = cells.clone();
+            w.resize(rows * cols, 0.0);
+            let Ok(d) = Discrete2D::new(&w, rows, cols) else { return Ok(()) };
+            let sums: Vec<f64> = w.chunks(cols).map(|r| r.iter().sum()).collect();
+            let us: Vec<[f64; 2]> = us.into_iter().chain([[0.0, 0.0], [1.0, 1.0], [0.0, 1.0], [1.0, 0.0]]).collect();
+            let mut batch = vec![((0, 0), [0.0; 2]); us.len()];
+            d.sample_reuse_into(&us, &mut batch);
+            for (&u, &b) in us.iter().zip(&batch) {
+                let row = linear(&sums, u[1]);
+                let col = linear(&w[row * cols..(row + 1) * cols], u[0]);
+                proptest::prop_assert_eq!(d.sample(u), (row, col), "u = {:?}", u);
+                proptest::prop_assert_eq!(b, d.sample_reuse(u));
+            }
         }
     }
 

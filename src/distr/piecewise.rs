@@ -5,6 +5,7 @@ use super::discrete::Search;
 use super::{Discrete1D, Discrete2D, GROUP};
 use crate::error::{Error, Result};
 use crate::math::Real;
+use crate::simd;
 
 /// Checks an interval `[a, b]` given as `arg`.
 fn check_interval(arg: &'static str, a: f64, b: f64) -> Result<()> {
@@ -48,7 +49,7 @@ impl Axis {
     #[inline(always)]
     fn locate(self, x: f64) -> (f64, usize) {
         let t = (x - self.lo) * self.cells_per_unit;
-        (t, (t.max(0.0) as usize).min(self.n - 1))
+        (t, t.floor_index(self.n - 1))
     }
 
     /// The cell holding `x`, or `None` outside `[lo, hi]` (or NaN).
@@ -261,12 +262,23 @@ impl PiecewiseConstant2D {
     }
 
     /// `out[i] = sample(us[i])` for a batch, drawing the cells with
-    /// [`Discrete2D::sample_reuse_into`] (whose cache misses overlap).
+    /// [`Discrete2D::sample_reuse_into`] (whose cache misses overlap),
+    /// compiled for the widest vector unit.
     pub fn sample_into<F: Real>(&self, us: &[[F; 2]], out: &mut [([F; 2], F)]) {
+        simd::dispatch(
+            #[inline(always)]
+            || self.sample_groups(us, out),
+        )
+    }
+
+    /// [`PiecewiseConstant2D::sample_into`] without the dispatch, for the
+    /// batch loops of samplers built on this density.
+    #[inline(always)]
+    pub(crate) fn sample_groups<F: Real>(&self, us: &[[F; 2]], out: &mut [([F; 2], F)]) {
         let mut cells = [((0, 0), [F::zero(); 2]); GROUP];
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
             let cells = &mut cells[..us.len()];
-            self.table.sample_reuse_into(us, cells);
+            self.table.sample_groups(us, cells);
             for (o, &(cell, r)) in out.iter_mut().zip(cells.iter()) {
                 *o = self.sample_in_cell(cell, r);
             }

@@ -4,6 +4,7 @@
 
 use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;
+use crate::math::Real;
 use crate::simd;
 
 /// The bilinear interpolant of `cols × rows` non-negative vertex values,
@@ -67,7 +68,7 @@ impl BilinearGrid {
         let (px, py) = (self.cols - 1, self.rows - 1);
         let x = q[0].clamp(0.0, 1.0) * px as f64;
         let y = q[1].clamp(0.0, 1.0) * py as f64;
-        let (col, row) = ((x as usize).min(px - 1), (y as usize).min(py - 1));
+        let (col, row) = (x.floor_index(px - 1), y.floor_index(py - 1));
         bilerp(self.corners(row, col), x - col as f64, y - row as f64) * self.inv_mean
     }
 

@@ -139,7 +139,7 @@ impl Image {
                 let x = p[0] - F::c(0.5 / w as f64);
                 let x = (x + if x < zero { one } else { zero }) * F::c(w as f64);
                 let y = p[1].max(zero).min(one) * F::c((h - 1) as f64);
-                let (x0, y0) = ((x.f64() as usize).min(w - 1), (y.f64() as usize).min(h - 2));
+                let (x0, y0) = (x.floor_index(w - 1), y.floor_index(h - 2));
                 let fx = (x - F::c(x0 as f64)).max(zero).min(one);
                 let fy = y - F::c(y0 as f64);
                 let x1 = if x0 + 1 == w { 0 } else { x0 + 1 };
@@ -149,7 +149,7 @@ impl Image {
                 let face_rows = w;
                 let (face, t) = match mapping {
                     Mapping::Cube => {
-                        let face = (p[1].max(zero).f64() as usize).min(5);
+                        let face = p[1].floor_index(5);
                         (face, p[1] - F::c(face as f64))
                     }
                     _ => (0, p[1]),
@@ -204,7 +204,7 @@ fn clamped_axis<F: Real>(s: F, n: usize) -> ([usize; 2], F) {
     let x = (s * F::c(n as f64) - F::c(0.5))
         .max(F::zero())
         .min(F::c((n - 1) as f64));
-    let x0 = (x.f64() as usize).min(n.saturating_sub(2));
+    let x0 = x.floor_index(n.saturating_sub(2));
     let x1 = (x0 + 1).min(n - 1);
     ([x0, x1], x - F::c(x0 as f64))
 }

@@ -201,7 +201,7 @@ impl Mapping {
 /// `[−1, 1]²`: `(2s − 1, 2(t − face) − 1)`.
 #[inline(always)]
 fn cube_face<F: Real>([s, t]: [F; 2]) -> (usize, F, F) {
-    let face = (t.max(F::zero()).f64() as usize).min(5);
+    let face = t.floor_index(5);
     let (one, two) = (F::one(), F::c(2.0));
     (face, two * s - one, two * (t - F::c(face as f64)) - one)
 }

@@ -261,7 +261,7 @@ impl PolarTable {
     /// The index in [`PolarTable::density`] of a query's cell.
     #[inline(always)]
     pub fn cell<F: Real>(&self, [row, col, _]: PolarQuery<F>) -> usize {
-        row.f64() as usize * self.cols + col.f64() as usize
+        row.floor_index(self.rows - 1) * self.cols + col.floor_index(self.cols - 1)
     }
 
     /// The density of every cell per unit table area, row-major.
@@ -625,7 +625,15 @@ impl EnvMap {
     ///
     /// # Panics
     /// If an array of `out` is shorter than `us`.
-    pub fn sample_into<F: Real>(&self, us: &[[F; 2]], mut out: EnvSamples<'_, F>) {
+    pub fn sample_into<F: Real>(&self, us: &[[F; 2]], out: EnvSamples<'_, F>) {
+        simd::dispatch(
+            #[inline(always)]
+            || self.sample_groups(us, out),
+        )
+    }
+
+    #[inline(always)]
+    fn sample_groups<F: Real>(&self, us: &[[F; 2]], mut out: EnvSamples<'_, F>) {
         // One loop per mapping, each with its own formulas inlined (see
         // `eval_into`).
         macro_rules! frame {
@@ -646,7 +654,7 @@ impl EnvMap {
             let first = g * GROUP;
             let drawn = &mut drawn[..n];
             match &self.distribution {
-                Distribution::Piecewise(table) => table.sample_into(us, drawn),
+                Distribution::Piecewise(table) => table.sample_groups(us, drawn),
                 Distribution::Bilinear(grid) => {
                     let (u64s, b) = (&mut [[0.0; 2]; GROUP][..n], &mut bilinear[..n]);
                     for (u, x) in u64s.iter_mut().zip(us) {
