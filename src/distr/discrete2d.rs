@@ -313,16 +313,10 @@ mod tests {
     /// The reference: `C_{i−1} < u·Σw ≤ C_i` by a linear scan of running
     /// sums taken in order, among the entries of positive weight.
     fn linear(weights: &[f64], u: f64) -> usize {
-        let sum: f64 = weights.iter().sum();
-        let (mut acc, value) = (0.0, u * sum);
+        let value = u * weights.iter().sum::<f64>();
         let positive: Vec<usize> = (0..weights.len()).filter(|&i| weights[i] > 0.0).collect();
-        for &i in &positive {
-            acc = weights[..=i].iter().sum();
-            if acc >= value {
-                return i;
-            }
-        }
-        *positive.last().unwrap()
+        let below = |&i: &usize| weights[..=i].iter().sum::<f64>() < value;
+        positive[positive.partition_point(below).min(positive.len() - 1)]
     }
 
     proptest::proptest! {
