@@ -626,14 +626,35 @@ impl EnvMap {
     /// # Panics
     /// If an array of `out` is shorter than `us`.
     pub fn sample_into<F: Real>(&self, us: &[[F; 2]], out: EnvSamples<'_, F>) {
+        self.sample_rows(us, |&u| u, out);
+    }
+
+    /// [`EnvMap::sample_into`] of `prepare(row)` for each of `rows`: the
+    /// numbers `u` of a group are made (checked, clamped) as the group is
+    /// drawn, in the same pass, so that a caller needs no pass of its own
+    /// over its input.
+    ///
+    /// # Panics
+    /// If an array of `out` is shorter than `rows`.
+    pub fn sample_rows<F: Real, R>(
+        &self,
+        rows: &[R],
+        prepare: impl FnMut(&R) -> [F; 2],
+        out: EnvSamples<'_, F>,
+    ) {
         simd::dispatch(
             #[inline(always)]
-            || self.sample_groups(us, out),
+            || self.sample_groups(rows, prepare, out),
         )
     }
 
     #[inline(always)]
-    fn sample_groups<F: Real>(&self, us: &[[F; 2]], mut out: EnvSamples<'_, F>) {
+    fn sample_groups<F: Real, R>(
+        &self,
+        rows: &[R],
+        mut prepare: impl FnMut(&R) -> [F; 2],
+        mut out: EnvSamples<'_, F>,
+    ) {
         // One loop per mapping, each with its own formulas inlined (see
         // `eval_into`).
         macro_rules! frame {
@@ -648,10 +669,16 @@ impl EnvMap {
         let mut frames = [[zero; 5]; GROUP];
         let mut corners = [([0; 4], [zero; 4]); GROUP];
         let mut bilinear = [([0.0; 2], 0.0); GROUP];
+        let mut group = [[zero; 2]; GROUP];
         let mapping = self.options.mapping;
-        for (g, us) in us.chunks(GROUP).enumerate() {
-            let n = us.len();
+        for (g, rows) in rows.chunks(GROUP).enumerate() {
+            let n = rows.len();
             let first = g * GROUP;
+            let us = &mut group[..n];
+            for (u, row) in us.iter_mut().zip(rows) {
+                *u = prepare(row);
+            }
+            let us = &*us;
             let drawn = &mut drawn[..n];
             match &self.distribution {
                 Distribution::Piecewise(table) => table.sample_groups(us, drawn),

@@ -5,7 +5,6 @@ use super::arrays::{
     Check, Points, PyFloat, finish, map, map_each, output, with_precision, writable,
 };
 use super::parallel::{detached, run_batch};
-use crate::distr::GROUP;
 use crate::envmap::{EnvMap, EnvSamples, Mapping, Matrix3, Options, Sampling};
 use crate::error::{Error, shape_str};
 use crate::io;
@@ -330,21 +329,16 @@ impl PyEnvMap {
             let valid = run_batch(py, u.n, outputs, |range, (o_d, o_p, o_w)| {
                 let mut ok = true;
                 let (zero, one) = (F::zero(), F::one());
-                let mut us = [[zero; 2]; GROUP];
-                for (g, rows) in rows[range].chunks(GROUP).enumerate() {
-                    let us = &mut us[..rows.len()];
-                    for (u, x) in us.iter_mut().zip(rows) {
-                        ok &= Check::Unit.holds_all(x);
-                        *u = x.map(|v| v.max(zero).min(one));
-                    }
-                    let first = g * GROUP;
-                    let out = EnvSamples {
-                        direction: &mut o_d[first..],
-                        pdf: &mut o_p[first..],
-                        weight: &mut o_w[first..],
-                    };
-                    env.sample_into(us, out);
-                }
+                let out = EnvSamples {
+                    direction: o_d,
+                    pdf: o_p,
+                    weight: o_w,
+                };
+                let check = |x: &[F; 2]| {
+                    ok &= Check::Unit.holds_all(x);
+                    x.map(|v| v.max(zero).min(one))
+                };
+                env.sample_rows(&rows[range], check, out);
                 ok
             })?;
             if !valid {
