@@ -282,9 +282,9 @@ pub(crate) fn fill_table(
     Some((sum, range.0, range.1))
 }
 
-/// Brackets of at most this many running sums are searched by counting
-/// the sums below the value, all at once (branch-free, one vector compare),
-/// instead of by a binary search whose branches the CPU cannot predict.
+/// The running sums from a guide cell's first entry that [`Search::index`]
+/// compares with the value all at once (one vector compare, no branch),
+/// instead of a binary search whose branches the CPU cannot predict.
 const SCAN: usize = 8;
 
 /// The number of entries of `window` below `value`, for sorted entries:
@@ -364,31 +364,43 @@ impl<'a> Search<'a> {
         k
     }
 
-    /// Step 2: prefetches the running sums at both ends of guide cell `k`'s
-    /// bracket and the weight at its start.
+    /// Step 2: prefetches what [`Search::index`] reads for guide cell `k`:
+    /// the running sum before its first entry `lo`, the window of [`SCAN`]
+    /// sums from `lo` (at most two cache lines with it), and the weight at
+    /// `lo`.
     #[inline(always)]
     pub(crate) fn prefetch_bracket(&self, k: usize) {
-        if let Some(&[lo, hi]) = self.guide.get(k..k + 2) {
-            simd::prefetch(self.cdf, (lo as usize).saturating_sub(1));
-            simd::prefetch(self.cdf, hi as usize);
-            simd::prefetch(self.weights, lo as usize);
+        if let Some(&lo) = self.guide.get(k) {
+            let lo = lo as usize;
+            simd::prefetch(self.cdf, lo.saturating_sub(1));
+            simd::prefetch(self.cdf, lo + SCAN - 1);
+            simd::prefetch(self.weights, lo);
         }
     }
 
-    /// Step 3: the index for `u` within the bracket of guide cell `k` (see
-    /// [`Search::bracket`]): a bracket of at most [`SCAN`] entries by
-    /// counting the sums below `u·Σw` in the [`SCAN`] from its start (those
-    /// past its end are not below: the one at the end is at least `u·Σw`,
-    /// or it is the last entry of positive weight, after which every sum
-    /// is `Σw`); a longer one by binary search.
+    /// Step 3: the index for `u`, starting from the first entry `lo` of
+    /// guide cell `k`. Where the sum before `lo` is below `u·Σw` (or `lo`
+    /// is the first entry of positive weight), the answer is the first of
+    /// the [`SCAN`] sums from `lo` that reaches `u·Σw`, found by counting
+    /// those below it in one vector compare; they are sorted, and past the
+    /// last entry of positive weight every sum is `Σw`. Otherwise (the
+    /// guide cell missed by round-off, or an answer further on) a binary
+    /// search of the cell's bracket (see [`Search::bracket`]).
     #[inline(always)]
     pub(crate) fn index(&self, u: f64, k: usize) -> usize {
         let value = u * self.sum;
-        let (lo, hi) = self.bracket(k, value);
-        match self.cdf.get(lo..).and_then(<[f64]>::first_chunk) {
-            Some(window) if hi - lo <= SCAN => lo + count_below(window, value),
-            _ => lo + self.cdf[lo..hi].partition_point(|&c| c < value),
+        if let Some(&lo) = self.guide.get(k) {
+            let lo = lo as usize;
+            let lo_ok = lo == self.first || self.cdf[lo - 1] < value;
+            if let Some(window) = self.cdf.get(lo..).and_then(<[f64]>::first_chunk) {
+                let below = count_below(window, value);
+                if lo_ok && below < SCAN {
+                    return lo + below;
+                }
+            }
         }
+        let (lo, hi) = self.bracket(k, value);
+        lo + self.cdf[lo..hi].partition_point(|&c| c < value)
     }
 
     /// Step 3 of [`Discrete1D::sample_reuse`]: the index and the rescaled

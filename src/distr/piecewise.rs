@@ -64,7 +64,19 @@ impl Axis {
     #[inline(always)]
     fn point<F: Real>(self, cell: usize, r: f64) -> F {
         let x = self.lo + (cell as f64 + r) * self.width;
-        let mut p = F::c(x.clamp(self.lo, self.hi));
+        let p = F::c(x.clamp(self.lo, self.hi));
+        if self.cell_of(p.f64()) == Some(cell) {
+            p
+        } else {
+            self.mend(cell, p)
+        }
+    }
+
+    /// The point `p` that rounding put outside cell `cell`, moved inward by
+    /// a few ulps (rare: out of line).
+    #[cold]
+    #[inline(never)]
+    fn mend<F: Real>(self, cell: usize, mut p: F) -> F {
         let mut step = self.lo.abs().max(self.hi.abs()) * F::epsilon().f64();
         for _ in 0..16 {
             let x = p.f64();
