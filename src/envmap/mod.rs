@@ -261,7 +261,7 @@ impl PolarTable {
     /// The index in [`PolarTable::density`] of a query's cell.
     #[inline(always)]
     pub fn cell<F: Real>(&self, [row, col, _]: PolarQuery<F>) -> usize {
-        row.floor_index(self.rows - 1) * self.cols + col.floor_index(self.cols - 1)
+        row.f64() as usize * self.cols + col.f64() as usize
     }
 
     /// The density of every cell per unit table area, row-major.
