@@ -467,4 +467,25 @@ mod tests {
         assert!(in_unit_interval(1.0f32));
         assert!((luminance([1.0f64, 1.0, 1.0]) - 1.0).abs() < 1e-12);
     }
+
+    #[test]
+    fn floor_index_floors_and_clamps() {
+        for (x, last, want) in [
+            (2.7, 10, 2),
+            (3.0, 10, 3),
+            (0.3, 10, 0),
+            (-0.5, 10, 0),
+            (-7.0, 10, 0),
+            (f64::NAN, 10, 0),
+            (10.5, 10, 10),
+            (1e12, 10, 10),
+            (f64::INFINITY, 10, 10),
+            (4_294_967_294.5, u32::MAX as usize, 4_294_967_294),
+        ] {
+            assert_eq!(x.floor_index(last), want, "{x}");
+            if x.abs() < 1e6 || !x.is_finite() {
+                assert_eq!((x as f32).floor_index(last), want, "{x} in f32");
+            }
+        }
+    }
 }

@@ -347,6 +347,39 @@ mod tests {
     }
 
     #[test]
+    fn guided_rows_and_marginal_agree_with_a_linear_scan() {
+        // Both the marginal and the rows guided (at least 64 entries), with
+        // rows of weight 0, runs of zeros and a few heavy cells.
+        let (rows, cols) = (90, 130);
+        let w: Vec<f64> = (0..rows * cols)
+            .map(|i| match (i / cols, (i * 7919) % 23) {
+                (r, _) if r % 11 == 4 => 0.0,
+                (_, 0) => 500.0,
+                (_, k) if k < 9 => 0.0,
+                (_, k) => k as f64,
+            })
+            .collect();
+        let d = Discrete2D::new(&w, rows, cols).unwrap();
+        let sums: Vec<f64> = w.chunks(cols).map(|r| r.iter().sum()).collect();
+        let us: Vec<[f64; 2]> = (0..=4000)
+            .map(|k| {
+                [
+                    (k as f64 * 0.618_033_988_749_895).fract(),
+                    k as f64 / 4000.0,
+                ]
+            })
+            .collect();
+        let mut batch = vec![((0, 0), [0.0; 2]); us.len()];
+        d.sample_reuse_into(&us, &mut batch);
+        for (&u, &b) in us.iter().zip(&batch) {
+            let row = linear(&sums, u[1]);
+            let col = linear(&w[row * cols..(row + 1) * cols], u[0]);
+            assert_eq!(b.0, (row, col), "u = {u:?}");
+            assert_eq!(b, d.sample_reuse(u));
+        }
+    }
+
+    #[test]
     fn zero_rows_and_cells_are_never_drawn() {
         let d = Discrete2D::new(&[0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0], 3, 3).unwrap();
         for u in [[0.0, 0.0], [1.0, 1.0], [0.5, 0.0], [0.0, 1.0]] {
