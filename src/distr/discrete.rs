@@ -168,9 +168,9 @@ impl Discrete1D {
     }
 
     /// `out[i] = sample(us[i])` for a batch. Groups of draws go in three
-    /// sweeps: locate their guide cells (prefetched), prefetch both ends of
-    /// each bracket, then search; so the cache misses of a group overlap
-    /// rather than queue.
+    /// sweeps: locate their guide cells (prefetched), prefetch the running
+    /// sums each search reads, then search; so the cache misses of a group
+    /// overlap rather than queue.
     pub fn sample_into<F: Real, I: From<u32>>(&self, us: &[F], out: &mut [I]) {
         let search = self.search();
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
@@ -179,7 +179,7 @@ impl Discrete1D {
                 *k = search.locate(u.f64());
             }
             for &k in &cells[..us.len()] {
-                search.prefetch_bracket(k);
+                search.prefetch_window(k);
             }
             for ((o, &u), &k) in out.iter_mut().zip(us).zip(&cells) {
                 *o = I::from(search.index(u.f64(), k) as u32);
@@ -299,7 +299,7 @@ fn count_below(window: &[f64; SCAN], value: f64) -> usize {
 
 /// A [`Discrete1D`]'s tables as plain slices, and a draw in steps that a
 /// batch can interleave: [`Search::locate`] the guide cell (prefetched),
-/// [`Search::prefetch_bracket`], then [`Search::index`] or
+/// [`Search::prefetch_window`], then [`Search::index`] or
 /// [`Search::index_reuse`].
 #[derive(Clone, Copy)]
 pub(crate) struct Search<'a> {
@@ -369,7 +369,7 @@ impl<'a> Search<'a> {
     /// sums from `lo` (at most two cache lines with it), and the weight at
     /// `lo`.
     #[inline(always)]
-    pub(crate) fn prefetch_bracket(&self, k: usize) {
+    pub(crate) fn prefetch_window(&self, k: usize) {
         if let Some(&lo) = self.guide.get(k) {
             let lo = lo as usize;
             simd::prefetch(self.cdf, lo.saturating_sub(1));
@@ -412,7 +412,7 @@ impl<'a> Search<'a> {
     }
 
     /// Prefetches the weight of index `i`, which [`Search::rescale`] reads
-    /// (the running sum before it is in the bracket just searched).
+    /// (the running sum before it is among those just searched).
     #[inline(always)]
     pub(crate) fn prefetch_weight(&self, i: usize) {
         simd::prefetch(self.weights, i);

@@ -208,8 +208,8 @@ impl Discrete2D {
 
     /// `out[i] = sample_reuse(us[i])` for a batch, in groups whose steps are
     /// interleaved as [`Discrete1D::sample_into`]'s: the marginal's guide
-    /// cells, its brackets, the rows, their rescaled `u` (and the
-    /// conditionals' guide cells), their brackets, the columns (prefetching
+    /// cells, its search windows, the rows, their rescaled `u` (and the
+    /// conditionals' guide cells), their windows, the columns (prefetching
     /// their weights), then the rescaled `u` of each column. The cache
     /// misses of a group overlap, and each step is a short loop of
     /// independent draws (a row's search and its division in one loop ran
@@ -237,7 +237,7 @@ impl Discrete2D {
                 *k = marginal.locate(u[1].f64());
             }
             for &k in &cells[..us.len()] {
-                marginal.prefetch_bracket(k);
+                marginal.prefetch_window(k);
             }
             for ((o, u), &k) in out.iter_mut().zip(us).zip(&cells) {
                 o.0.0 = marginal.index(u[1].f64(), k);
@@ -255,7 +255,7 @@ impl Discrete2D {
             let searches = &searches[..us.len()];
             for (c, &k) in searches.iter().zip(&cells) {
                 if let Some(c) = c {
-                    c.prefetch_bracket(k);
+                    c.prefetch_window(k);
                 }
             }
             for (((o, u), &k), c) in out.iter_mut().zip(us).zip(&cells).zip(searches) {
