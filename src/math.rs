@@ -32,7 +32,8 @@ pub trait Real: Float + FloatConst + Debug + Default + Send + Sync + 'static {
     /// [`sin_cos_turn`].
     fn sin_cos_turn(t: Self) -> (Self, Self);
 
-    /// `xʸ` for finite `x ≥ 0` and `y ≥ 0`, as `2^(y·log₂x)` with
+    /// `xʸ` for finite `x ≥ 0` and `y ≥ 0` with `xʸ < 2¹⁰²³` (the callers
+    /// have `x ≤ 1`: cosines, uniform numbers), as `2^(y·log₂x)` with
     /// polynomials (no branches, no library calls, so loops vectorise):
     /// relative error below 2e-13 (computed in `f64` for both types); exact at
     /// `x = 1` and `y = 0`; 0 for `x = 0` (or a subnormal `x`) unless
@@ -139,43 +140,50 @@ macro_rules! sin_cos_turn {
     };
 }
 
-/// `Real::pow_positive` for a float type, its same-width unsigned and
-/// signed integers, its exponent bias and the coefficients of its
-/// polynomials.
+/// `xʸ` in `f64` (see [`Real::pow_positive`]).
 ///
 /// `log₂x = e + log₂m` with `x = m·2ᵉ`, `m ∈ [√½, √2)`, and
 /// `log₂m = (2/ln 2)·atanh(s)`, `s = (m − 1)/(m + 1)` (odd series in `s`);
 /// `2ᵗ = 2ᵏ·e^(f·ln 2)` with `k` the nearest whole number and `|f| ≤ ½`
-/// (Taylor series), `2ᵏ` built from its bits.
-macro_rules! pow_positive {
-    ($F:ty, $U:ty, $I:ty, $bias:expr, $atanh:expr, $exp:expr) => {
-        #[inline(always)]
-        fn pow_positive(x: $F, y: $F) -> $F {
-            let mant_bits = <$F>::MANTISSA_DIGITS - 1;
-            let bits = x.to_bits();
-            let e = ((bits >> mant_bits) as $I) - $bias;
-            let m = <$F>::from_bits((bits & ((1 << mant_bits) - 1)) | (($bias as $U) << mant_bits));
-            let big = m > std::f64::consts::SQRT_2 as $F;
-            let (m, e) = (if big { 0.5 * m } else { m }, if big { e + 1 } else { e });
-            let s = (m - 1.0) / (m + 1.0);
-            let log2_m = s * horner(s * s, &$atanh) * (2.0 * std::f64::consts::LOG2_E) as $F;
-            let t = (y * (e as $F + log2_m)).max(-($bias as $F) + 1.0);
-            let k = (t + 0.5).floor();
-            let p = horner((t - k) * std::f64::consts::LN_2 as $F, &$exp);
-            let scale = <$F>::from_bits(((k as $I + $bias) as $U) << mant_bits);
-            let result = p * scale;
-            // x = 0 or subnormal: 0ʸ (1 for y = 0); underflow: 0.
-            let tiny = x < <$F>::MIN_POSITIVE;
-            let underflow = t <= -($bias as $F) + 1.0;
-            if y == 0.0 {
-                1.0
-            } else if tiny | underflow {
-                0.0
-            } else {
-                result
-            }
-        }
-    };
+/// (Taylor series), `2ᵏ` built from its bits. The whole numbers `e` and
+/// `k` stay floats: a biased exponent field is read as a float by placing
+/// it in the mantissa of `2⁵²` (and written back the same way), because
+/// AVX2 has no conversion between `f64` and 64-bit integers and a loop
+/// that needs one runs one lane at a time.
+#[inline(always)]
+fn pow_unit(x: f64, y: f64) -> f64 {
+    const MANTISSA_BITS: u32 = 52;
+    const BIAS: f64 = 1023.0;
+    /// `2⁵²`: adding it to a whole number `n` in `[0, 2⁵²)` leaves `n` in the
+    /// low mantissa bits.
+    const SHIFTER: f64 = (1u64 << MANTISSA_BITS) as f64;
+    let bits = x.to_bits();
+    let field = f64::from_bits((bits >> MANTISSA_BITS) | SHIFTER.to_bits()) - SHIFTER;
+    let m = f64::from_bits((bits & ((1 << MANTISSA_BITS) - 1)) | 1.0f64.to_bits());
+    let big = m > std::f64::consts::SQRT_2;
+    let (m, e) = (
+        if big { 0.5 * m } else { m },
+        field - BIAS + if big { 1.0 } else { 0.0 },
+    );
+    let s = (m - 1.0) / (m + 1.0);
+    let log2_m = s * horner(s * s, &ATANH_OVER_S) * (2.0 * std::f64::consts::LOG2_E);
+    let t = (y * (e + log2_m)).max(1.0 - BIAS);
+    let k = (t + 0.5).floor();
+    let p = horner((t - k) * std::f64::consts::LN_2, &EXP);
+    // k + BIAS in [1, 2046] (results below 2¹⁰²³): the low mantissa bits
+    // of k + BIAS + 2⁵², shifted into the exponent field.
+    let scale = f64::from_bits((k + (BIAS + SHIFTER)).to_bits() << MANTISSA_BITS);
+    let result = p * scale;
+    // x = 0 or subnormal: 0ʸ (1 for y = 0); underflow: 0.
+    let tiny = x < f64::MIN_POSITIVE;
+    let underflow = t <= 1.0 - BIAS;
+    if y == 0.0 {
+        1.0
+    } else if tiny | underflow {
+        0.0
+    } else {
+        result
+    }
 }
 
 /// `1/(2k + 1)`: the series of `atanh(s)/s` in `s²`.
@@ -264,7 +272,7 @@ impl Real for f32 {
     /// precision for large `y`.
     #[inline(always)]
     fn pow_positive(x: f32, y: f32) -> f32 {
-        f64::pow_positive(x as f64, y as f64) as f32
+        pow_unit(x as f64, y as f64) as f32
     }
     #[inline(always)]
     fn atan_reduced(r: f32) -> f32 {
@@ -296,7 +304,10 @@ impl Real for f64 {
         (x * horner(y, &SIN_OVER_X), horner(y, &COS))
     }
     sin_cos_turn!(f64, u64);
-    pow_positive!(f64, u64, i64, 1023, ATANH_OVER_S, EXP);
+    #[inline(always)]
+    fn pow_positive(x: f64, y: f64) -> f64 {
+        pow_unit(x, y)
+    }
     #[inline(always)]
     fn atan_reduced(r: f64) -> f64 {
         r * estrin(r * r, &const { atan_series::<21>() })

@@ -7,6 +7,7 @@
 use crate::error::{Error, Result};
 use crate::frame::Frame;
 use crate::math::{Real, luminance};
+use crate::simd;
 use crate::warp::{self, V3};
 
 /// How [`Phong::sample`] picks the diffuse or the glossy part.
@@ -60,6 +61,25 @@ pub struct PhongSample<F> {
     /// 0 for the diffuse part, 1 for the glossy part.
     pub component: u8,
 }
+
+/// The arrays a batch of [`PhongView::sample_rows`] writes: each sample's
+/// parts into their own array, as a caller's separate outputs want them;
+/// the component in any integer type `C`.
+#[derive(Debug)]
+pub struct PhongSamples<'a, F, C> {
+    /// The sampled directions.
+    pub wo: &'a mut [V3<F>],
+    /// Their densities per steradian.
+    pub pdf: &'a mut [F],
+    /// `f_r·cos θo / pdf` per RGB channel.
+    pub weight: &'a mut [V3<F>],
+    /// 0 for the diffuse part, 1 for the glossy part.
+    pub component: &'a mut [C],
+}
+
+/// Rows per block of [`PhongView::sample_rows`]: its numbers and samples
+/// stay in the L1 cache.
+const SAMPLE_BLOCK: usize = 256;
 
 impl Phong {
     /// A Phong BRDF with RGB reflectances `diffuse` (ρd) and `specular` (ρs)
@@ -244,6 +264,45 @@ impl<F: Real> PhongView<F> {
         self.finish_sample(wo, self.lobe(wo), diffuse)
     }
 
+    /// [`PhongView::sample`] of `prepare(row)` for each of `rows` into
+    /// `out`, in blocks of [`SAMPLE_BLOCK`] rows: the numbers of a block
+    /// made (a caller checks and clamps them there), its samples computed
+    /// at SIMD width ([`simd::map_rows`]), then spread into the arrays of
+    /// `out`.
+    ///
+    /// # Panics
+    /// If an array of `out` is shorter than `rows`.
+    pub fn sample_rows<R, C: From<u8>>(
+        &self,
+        rows: &[R],
+        mut prepare: impl FnMut(&R) -> [F; 3],
+        out: PhongSamples<'_, F, C>,
+    ) {
+        let kernel = {
+            #[inline(always)]
+            |u: [F; 3]| {
+                let s = self.sample(u);
+                let ([x, y, z], [r, g, b]) = (s.wo, s.weight);
+                [x, y, z, s.pdf, r, g, b, F::c(f64::from(s.component))]
+            }
+        };
+        let mut us = [[F::zero(); 3]; SAMPLE_BLOCK];
+        let mut samples = [[F::zero(); 8]; SAMPLE_BLOCK];
+        for (b, rows) in rows.chunks(SAMPLE_BLOCK).enumerate() {
+            let (us, samples) = (&mut us[..rows.len()], &mut samples[..rows.len()]);
+            for (u, row) in us.iter_mut().zip(rows) {
+                *u = prepare(row);
+            }
+            simd::map_rows(samples, us, &kernel, |_| true, false);
+            for (k, s) in (b * SAMPLE_BLOCK..).zip(samples.iter()) {
+                out.wo[k] = [s[0], s[1], s[2]];
+                out.pdf[k] = s[3];
+                out.weight[k] = [s[4], s[5], s[6]];
+                out.component[k] = C::from(u8::from(s[7] > F::zero()));
+            }
+        }
+    }
+
     /// The sample at `wo`, drawn by the diffuse part or not, where the lobe
     /// is `lobe`: its mixture density and weight.
     #[inline(always)]
@@ -374,6 +433,34 @@ mod tests {
                 assert_eq!((f, pdf), (view.eval(a.wo), view.pdf(a.wo)));
             }
         }
+    }
+
+    #[test]
+    fn sample_rows_writes_the_samples_of_sample() {
+        let view = phong(20.0).view([0.3f32, -0.2, 0.932_737_9]);
+        // Two blocks and a part, the rows made by `prepare`.
+        let n = 2 * SAMPLE_BLOCK + 37;
+        let rows: Vec<u32> = (0..n as u32).collect();
+        let u = |k: &u32| [0.618_034, 0.414_214, 0.732_051].map(|a: f32| (*k as f32 * a) % 1.0);
+        let (mut wo, mut pdf, mut weight) = (vec![[0.0; 3]; n], vec![0.0; n], vec![[0.0; 3]; n]);
+        let mut component = vec![9i64; n];
+        let out = PhongSamples {
+            wo: &mut wo,
+            pdf: &mut pdf,
+            weight: &mut weight,
+            component: &mut component,
+        };
+        view.sample_rows(&rows, u, out);
+        for (k, row) in rows.iter().enumerate() {
+            let s = view.sample(u(row));
+            assert_eq!(
+                (wo[k], pdf[k], weight[k]),
+                (s.wo, s.pdf, s.weight),
+                "row {k}"
+            );
+            assert_eq!(component[k], i64::from(s.component));
+        }
+        assert!(component.contains(&0) && component.contains(&1));
     }
 
     #[test]

@@ -5,8 +5,7 @@ use super::arrays::{
     Check, Points, PyFloat, finish, map_pair, pair_len, run_batch_pair, with_precision, zeros,
 };
 use crate::error::Error;
-use crate::phong::{Phong, Selection};
-use crate::simd::map_rows;
+use crate::phong::{Phong, PhongSamples, Selection};
 use numpy::PyArrayMethods;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -252,41 +251,27 @@ impl PyPhong {
             let (ok_wi, ok_u) =
                 run_batch_pair(py, n, outputs, |range, (o_wo, o_pdf, o_w, o_c)| {
                     if step_wi == 0 {
-                        // One wi for all rows: the vectorised block loop, into
-                        // rows of (wo, pdf, weight, component), then split.
+                        // One wi for all rows: the core's vectorised batch.
                         let w = rows_wi[0];
-                        let ok_wi = Check::Finite.holds_all(&w);
-                        let mut rows = vec![[F::zero(); 8]; range.len()];
                         // A single u (then n = 1) or one per row.
                         let inputs = if step_u == 0 {
                             &rows_u[..1]
                         } else {
                             &rows_u[range]
                         };
-                        let view = phong.view(w);
-                        let sample = {
-                            #[inline(always)]
-                            |x: [F; 3]| {
-                                let s = view.sample(x);
-                                let [a, b, c] = s.wo;
-                                let [d, e, f] = s.weight;
-                                [a, b, c, s.pdf, d, e, f, F::c(f64::from(s.component))]
-                            }
+                        let mut ok_u = true;
+                        let check = |x: &[F; 3]| {
+                            ok_u &= Check::Unit.holds_all(x);
+                            *x
                         };
-                        let ok_u = map_rows(
-                            &mut rows,
-                            inputs,
-                            &sample,
-                            |x| Check::Unit.holds_all(x),
-                            false,
-                        );
-                        for (k, r) in rows.iter().enumerate() {
-                            o_wo[k] = [r[0], r[1], r[2]];
-                            o_pdf[k] = r[3];
-                            o_w[k] = [r[4], r[5], r[6]];
-                            o_c[k] = r[7].f64() as i64;
-                        }
-                        return (ok_wi, ok_u);
+                        let out = PhongSamples {
+                            wo: o_wo,
+                            pdf: o_pdf,
+                            weight: o_w,
+                            component: o_c,
+                        };
+                        phong.view(w).sample_rows(inputs, check, out);
+                        return (Check::Finite.holds_all(&w), ok_u);
                     }
                     let (mut ok_wi, mut ok_u) = (true, true);
                     for (k, i) in range.enumerate() {
