@@ -270,6 +270,14 @@ impl<F: Real> PhongView<F> {
     /// at SIMD width ([`simd::map_rows`]), then spread into the arrays of
     /// `out`.
     ///
+    /// The kernel is large (two powers, two sines and cosines, a frame),
+    /// and whether LLVM vectorises it for AVX2 has been seen to depend on
+    /// code elsewhere in the crate (a binding that filled an `N`-row buffer
+    /// through the same kernel ran one lane at a time, 3–5× slower). After
+    /// a change, compare `python -m mcsample bench --only phong` with the
+    /// same run under `MCSAMPLE_SIMD=baseline`: the vectorised build is
+    /// about twice as fast.
+    ///
     /// # Panics
     /// If an array of `out` is shorter than `rows`.
     pub fn sample_rows<R, C: From<u8>>(
