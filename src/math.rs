@@ -145,7 +145,11 @@ macro_rules! sin_cos_turn {
 /// `log₂x = e + log₂m` with `x = m·2ᵉ`, `m ∈ [√½, √2)`, and
 /// `log₂m = (2/ln 2)·atanh(s)`, `s = (m − 1)/(m + 1)` (odd series in `s`);
 /// `2ᵗ = 2ᵏ·e^(f·ln 2)` with `k` the nearest whole number and `|f| ≤ ½`
-/// (Taylor series), `2ᵏ` built from its bits. The whole numbers `e` and
+/// (Taylor series), `2ᵏ` built from its bits. Both polynomials are
+/// evaluated by Estrin's scheme: the loops that call `pow` (the
+/// cosine-power warp, Phong) wait on the chain of dependent operations,
+/// and Horner's is 24 steps long (Estrin's: 8; measured, the cosine-power
+/// warp 1.4–2× faster at the same accuracy). The whole numbers `e` and
 /// `k` stay floats: a biased exponent field is read as a float by placing
 /// it in the mantissa of `2⁵²` (and written back the same way), because
 /// AVX2 has no conversion between `f64` and 64-bit integers and a loop
@@ -166,10 +170,10 @@ fn pow_unit(x: f64, y: f64) -> f64 {
         field - BIAS + if big { 1.0 } else { 0.0 },
     );
     let s = (m - 1.0) / (m + 1.0);
-    let log2_m = s * horner(s * s, &ATANH_OVER_S) * (2.0 * std::f64::consts::LOG2_E);
+    let log2_m = s * estrin(s * s, &ATANH_OVER_S) * (2.0 * std::f64::consts::LOG2_E);
     let t = (y * (e + log2_m)).max(1.0 - BIAS);
     let k = (t + 0.5).floor();
-    let p = horner((t - k) * std::f64::consts::LN_2, &EXP);
+    let p = estrin((t - k) * std::f64::consts::LN_2, &EXP);
     // k + BIAS in [1, 2046] (results below 2¹⁰²³): the low mantissa bits
     // of k + BIAS + 2⁵², shifted into the exponent field.
     let scale = f64::from_bits((k + (BIAS + SHIFTER)).to_bits() << MANTISSA_BITS);
