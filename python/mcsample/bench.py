@@ -61,17 +61,43 @@ def measure_side_by_side(fns: list[Callable[[], object]], repeat: int = 7,
     return [statistics.median(t) for t in times]
 
 
-def _numpy_cosine_hemisphere(u: np.ndarray) -> np.ndarray:
-    """Malley's method on the concentric disk, vectorised with numpy."""
+def _numpy_concentric_disk(u: np.ndarray) -> np.ndarray:
+    """Shirley and Chiu's concentric disk, vectorised with numpy: (N, 2)."""
     a, b = 2 * u[:, 0] - 1, 2 * u[:, 1] - 1
     horizontal = np.abs(a) >= np.abs(b)
     with np.errstate(divide="ignore", invalid="ignore"):
         r = np.where(horizontal, a, b)
         phi = np.where(horizontal, (np.pi / 4) * (b / a), np.pi / 2 - (np.pi / 4) * (a / b))
     phi = np.where(r == 0, 0, phi)
-    x, y = r * np.cos(phi), r * np.sin(phi)
-    z = np.sqrt(np.maximum(0, 1 - x * x - y * y))
-    return np.stack([x, y, z], axis=1)
+    return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)
+
+
+def _numpy_cosine_hemisphere(u: np.ndarray) -> np.ndarray:
+    """Malley's method on the concentric disk, vectorised with numpy."""
+    p = _numpy_concentric_disk(u)
+    z = np.sqrt(np.maximum(0, 1 - p[:, 0] ** 2 - p[:, 1] ** 2))
+    return np.concatenate([p, z[:, None]], axis=1)
+
+
+def _numpy_uniform_cone(u: np.ndarray, cos_cutoff: float) -> np.ndarray:
+    """The uniform cone on the concentric disk (as mi.warp), with numpy; the
+    hemisphere is the cone of cos_cutoff = 0."""
+    p = _numpy_concentric_disk(u)
+    r2 = p[:, 0] ** 2 + p[:, 1] ** 2
+    one_minus_c = 1 - cos_cutoff
+    scale = np.sqrt(np.maximum(0, one_minus_c * (2 - one_minus_c * r2)))
+    return np.concatenate([p * scale[:, None], (1 - one_minus_c * r2)[:, None]], axis=1)
+
+
+def _numpy_uniform_hemisphere(u: np.ndarray) -> np.ndarray:
+    return _numpy_uniform_cone(u, 0.0)
+
+
+def _numpy_cosine_power_hemisphere(u: np.ndarray, exponent: float) -> np.ndarray:
+    cos_t = u[:, 1] ** (1 / (exponent + 1))
+    sin_t = np.sqrt(np.maximum(0, 1 - cos_t ** 2))
+    phi = 2 * np.pi * u[:, 0]
+    return np.stack([np.cos(phi) * sin_t, np.sin(phi) * sin_t, cos_t], axis=1)
 
 
 def _numpy_uniform_sphere(u: np.ndarray) -> np.ndarray:
@@ -131,16 +157,18 @@ def suite_warps(n: int, repeat: int, mi) -> list[Timing]:
     w = mcs.warp
     cases = [
         ("square_to_uniform_disk", w.square_to_uniform_disk, _numpy_uniform_disk, ()),
-        ("square_to_uniform_disk_concentric", w.square_to_uniform_disk_concentric, None, ()),
+        ("square_to_uniform_disk_concentric", w.square_to_uniform_disk_concentric,
+         _numpy_concentric_disk, ()),
         ("square_to_uniform_sphere", w.square_to_uniform_sphere, _numpy_uniform_sphere, ()),
-        ("square_to_uniform_hemisphere", w.square_to_uniform_hemisphere, None, ()),
+        ("square_to_uniform_hemisphere", w.square_to_uniform_hemisphere,
+         _numpy_uniform_hemisphere, ()),
         ("square_to_cosine_hemisphere", w.square_to_cosine_hemisphere,
          _numpy_cosine_hemisphere, ()),
-        ("square_to_uniform_cone", w.square_to_uniform_cone, None, (0.3,)),
+        ("square_to_uniform_cone", w.square_to_uniform_cone, _numpy_uniform_cone, (0.3,)),
         ("square_to_uniform_triangle", w.square_to_uniform_triangle,
          _numpy_uniform_triangle, ()),
-        ("square_to_cosine_power_hemisphere", w.square_to_cosine_power_hemisphere, None,
-         (10.0,)),
+        ("square_to_cosine_power_hemisphere", w.square_to_cosine_power_hemisphere,
+         _numpy_cosine_power_hemisphere, (10.0,)),
     ]
     out = []
     for name, ours, numpy_impl, args in cases:
@@ -154,7 +182,7 @@ def suite_warps(n: int, repeat: int, mi) -> list[Timing]:
                               measure(lambda: ours(u, *args, out=buffer), repeat)))
             if numpy_impl is not None:
                 out.append(Timing(name, "numpy", dtype, n,
-                                  measure(lambda: numpy_impl(u), repeat)))
+                                  measure(lambda: numpy_impl(u, *args), repeat)))
         fn = getattr(mi.warp, name, None) if mi is not None else None
         if fn is not None and not name.endswith("power_hemisphere"):
             import drjit as dr
