@@ -103,12 +103,20 @@ fn estrin<F: Real, const N: usize>(y: F, c: &[f64; N]) -> F {
     terms[0]
 }
 
-/// Horner evaluation of `c[0] + c[1] y + c[2] y² + …`. Plain multiply and
+/// Horner evaluation of `c[0] + c[1] y + c[2] y² + …`, from the last
+/// coefficient (a fold from 0 costs a multiply and an add that the compiler
+/// may not drop: `0·y` is not 0 for an infinite `y`). Plain multiply and
 /// add (no `mul_add`, which becomes a library call wherever the code is not
 /// compiled for FMA hardware): the same bits on every path.
 #[inline(always)]
 fn horner<F: Real>(y: F, c: &[f64]) -> F {
-    c.iter().rev().fold(F::zero(), |acc, &k| acc * y + F::c(k))
+    match c.split_last() {
+        Some((&last, rest)) => rest
+            .iter()
+            .rev()
+            .fold(F::c(last), |acc, &k| acc * y + F::c(k)),
+        None => F::zero(),
+    }
 }
 
 /// [`Real::sin_cos_turn`] for one float type and its same-width unsigned
