@@ -198,14 +198,10 @@ impl Discrete1D {
     /// The tables as slices, for the steps of a draw.
     #[inline(always)]
     pub(crate) fn search(&self) -> Search<'_> {
-        Search {
-            weights: &self.weights,
-            cdf: &self.cdf,
-            guide: &self.guide,
-            sum: self.sum,
-            first: self.first,
-            last: self.last,
-        }
+        Search::new(
+            (&self.weights, &self.cdf, &self.guide),
+            (self.sum, self.first, self.last),
+        )
     }
 }
 
@@ -302,18 +298,37 @@ fn count_below(window: &[f64; SCAN], value: f64) -> usize {
         .sum::<u64>() as usize
 }
 
-/// A [`Discrete1D`]'s tables as plain slices, and a draw in steps that a
-/// batch can interleave: [`Search::locate`] the guide cell (prefetched),
+/// A table's weights, running sums and guide cells, as plain slices of a
+/// store that may hold several tables (the rows of a
+/// [`super::Discrete2D`], row after row), and a draw in steps that a batch
+/// can interleave: [`Search::locate`] the guide cell (prefetched),
 /// [`Search::prefetch_window`], then [`Search::index`] or
-/// [`Search::index_reuse`].
+/// [`Search::index_reuse`]. Indices are the table's own (from 0); the
+/// table starts at `start` in `weights` and `cdf`, and its guide at
+/// `guide_start` in `guide`, so that cutting one table out of the store
+/// costs no slicing (and no bounds checks) per draw.
 #[derive(Clone, Copy)]
 pub(crate) struct Search<'a> {
     weights: &'a [f64],
     cdf: &'a [f64],
     guide: &'a [u32],
+    start: usize,
+    guide_start: usize,
+    len: usize,
+    guide_len: usize,
     sum: f64,
     first: usize,
     last: usize,
+}
+
+/// Where a table lies in a store of tables (see [`Search::within`]): its
+/// first entry in the weights and running sums, its first guide cell, and
+/// its number of entries.
+#[derive(Clone, Copy)]
+pub(crate) struct Place {
+    pub(crate) start: usize,
+    pub(crate) guide_start: usize,
+    pub(crate) len: usize,
 }
 
 impl<'a> Search<'a> {
@@ -322,12 +337,33 @@ impl<'a> Search<'a> {
     #[inline(always)]
     pub(crate) fn new(
         (weights, cdf, guide): (&'a [f64], &'a [f64], &'a [u32]),
+        span: (f64, usize, usize),
+    ) -> Self {
+        let place = Place {
+            start: 0,
+            guide_start: 0,
+            len: weights.len(),
+        };
+        Self::within((weights, cdf, guide), place, span)
+    }
+
+    /// The search of the table at `place` in a store of tables that
+    /// [`fill_table`] wrote one after another (each guide [`guide_len`]
+    /// cells long).
+    #[inline(always)]
+    pub(crate) fn within(
+        (weights, cdf, guide): (&'a [f64], &'a [f64], &'a [u32]),
+        place: Place,
         (sum, first, last): (f64, usize, usize),
     ) -> Self {
         Search {
             weights,
             cdf,
             guide,
+            start: place.start,
+            guide_start: place.guide_start,
+            len: place.len,
+            guide_len: guide_len(place.len),
             sum,
             first,
             last,
@@ -343,14 +379,31 @@ impl<'a> Search<'a> {
     /// The weight of entry `i` (0 outside the table).
     #[inline(always)]
     pub(crate) fn weight(&self, i: usize) -> f64 {
-        self.weights.get(i).copied().unwrap_or(0.0)
+        if i < self.len {
+            self.weights[self.start + i]
+        } else {
+            0.0
+        }
+    }
+
+    /// The running sum `C_i` of entry `i` of the table (`i < len`).
+    #[inline(always)]
+    fn running(&self, i: usize) -> f64 {
+        self.cdf[self.start + i]
+    }
+
+    /// The first entry of guide cell `k` (`None` past the guide, or without
+    /// one).
+    #[inline(always)]
+    fn guide_entry(&self, k: usize) -> Option<usize> {
+        (k < self.guide_len).then(|| self.guide[self.guide_start + k] as usize)
     }
 
     /// The guide cell `⌊u·G⌋` of `u` (clamped to the last cell; 0 without a
     /// guide table).
     #[inline(always)]
     fn guide_cell(&self, u: f64) -> usize {
-        let cells = self.guide.len().saturating_sub(1);
+        let cells = self.guide_len.saturating_sub(1);
         (u * cells as f64).floor_index(cells.saturating_sub(1))
     }
 
@@ -365,7 +418,7 @@ impl<'a> Search<'a> {
     #[inline(always)]
     pub(crate) fn locate(&self, u: f64) -> usize {
         let k = self.guide_cell(u);
-        simd::prefetch(self.guide, k);
+        simd::prefetch(self.guide, self.guide_start + k);
         k
     }
 
@@ -375,8 +428,8 @@ impl<'a> Search<'a> {
     /// `lo`.
     #[inline(always)]
     pub(crate) fn prefetch_window(&self, k: usize) {
-        if let Some(&lo) = self.guide.get(k) {
-            let lo = lo as usize;
+        if let Some(lo) = self.guide_entry(k) {
+            let lo = self.start + lo;
             simd::prefetch(self.cdf, lo.saturating_sub(1));
             simd::prefetch(self.cdf, lo + SCAN - 1);
             simd::prefetch(self.weights, lo);
@@ -394,18 +447,20 @@ impl<'a> Search<'a> {
     #[inline(always)]
     pub(crate) fn index(&self, u: f64, k: usize) -> usize {
         let value = u * self.sum;
-        if let Some(&lo) = self.guide.get(k) {
-            let lo = lo as usize;
-            let lo_ok = lo == self.first || self.cdf[lo - 1] < value;
-            if let Some(window) = self.cdf.get(lo..).and_then(<[f64]>::first_chunk) {
-                let below = count_below(window, value);
-                if lo_ok && below < SCAN {
-                    return lo + below;
+        if let Some(lo) = self.guide_entry(k) {
+            let lo_ok = lo == self.first || self.running(lo - 1) < value;
+            if lo + SCAN <= self.len {
+                let at = self.start + lo;
+                if let Some(window) = self.cdf[at..].first_chunk() {
+                    let below = count_below(window, value);
+                    if lo_ok && below < SCAN {
+                        return lo + below;
+                    }
                 }
             }
         }
         let (lo, hi) = self.bracket(k, value);
-        lo + self.cdf[lo..hi].partition_point(|&c| c < value)
+        lo + self.cdf[self.start + lo..self.start + hi].partition_point(|&c| c < value)
     }
 
     /// Step 3 of [`Discrete1D::sample_reuse`]: the index and the rescaled
@@ -420,14 +475,14 @@ impl<'a> Search<'a> {
     /// (the running sum before it is among those just searched).
     #[inline(always)]
     pub(crate) fn prefetch_weight(&self, i: usize) {
-        simd::prefetch(self.weights, i);
+        simd::prefetch(self.weights, self.start + i);
     }
 
     /// The leftover of `u` past the running sum before index `i`, rescaled
     /// to `[0, 1)` by its weight.
     #[inline(always)]
     pub(crate) fn rescale<F: Real>(&self, u: F, i: usize) -> F {
-        let rescaled = (u.f64() * self.sum - self.sum_before(i)) / self.weights[i];
+        let rescaled = (u.f64() * self.sum - self.sum_before(i)) / self.weights[self.start + i];
         F::c(rescaled.clamp(0.0, f64::ONE_MINUS_EPSILON))
     }
 
@@ -436,7 +491,8 @@ impl<'a> Search<'a> {
     pub(crate) fn sum_before(&self, i: usize) -> f64 {
         match i {
             0 => 0.0,
-            _ => self.cdf.get(i - 1).copied().unwrap_or(self.sum),
+            _ if i <= self.len => self.running(i - 1),
+            _ => self.sum,
         }
     }
 
@@ -446,14 +502,13 @@ impl<'a> Search<'a> {
     #[inline(always)]
     fn bracket(&self, k: usize, value: f64) -> (usize, usize) {
         let full = (self.first, self.last);
-        let Some(&[lo, hi]) = self.guide.get(k..k + 2) else {
+        let (Some(lo), Some(hi)) = (self.guide_entry(k), self.guide_entry(k + 1)) else {
             return full;
         };
-        let (lo, hi) = (lo as usize, hi as usize);
         // Round-off in u·G against the guide's thresholds can miss by one
         // cell: check the bracket and fall back to the full range.
-        let lo_ok = lo == self.first || self.cdf[lo - 1] < value;
-        let hi_ok = hi == self.last || self.cdf[hi] >= value;
+        let lo_ok = lo == self.first || self.running(lo - 1) < value;
+        let hi_ok = hi == self.last || self.running(hi) >= value;
         if lo_ok && hi_ok { (lo, hi) } else { full }
     }
 }

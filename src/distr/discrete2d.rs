@@ -1,6 +1,6 @@
 //! [`Discrete2D`]: a discrete distribution over the cells of a table.
 
-use super::discrete::{Search, fill_table, guide_len};
+use super::discrete::{Place, Search, fill_table, guide_len};
 use super::{Discrete1D, GROUP, check_weights};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
@@ -54,17 +54,21 @@ struct Rows<'a> {
 }
 
 impl<'a> Rows<'a> {
-    /// The conditional of `row` (`None` for a row of weight 0).
+    /// The conditional of `row` (`None` for a row of weight 0): its place
+    /// in the flat tables, found by arithmetic.
     #[inline(always)]
     fn search(&self, row: usize) -> Option<Search<'a>> {
         let span = (*self.rows.get(row)?)?;
-        let (start, g) = (row * self.cols, guide_len(self.cols));
-        let tables = (
-            &self.weights[start..start + self.cols],
-            &self.cdf[start..start + self.cols],
-            &self.guide[row * g..(row + 1) * g],
-        );
-        Some(Search::new(tables, span))
+        let place = Place {
+            start: row * self.cols,
+            guide_start: row * guide_len(self.cols),
+            len: self.cols,
+        };
+        Some(Search::within(
+            (self.weights, self.cdf, self.guide),
+            place,
+            span,
+        ))
     }
 }
 
@@ -242,31 +246,29 @@ impl Discrete2D {
             for ((o, u), &k) in out.iter_mut().zip(us).zip(&cells) {
                 o.0.0 = marginal.index(u[1].f64(), k);
             }
-            // Each row's search, cut once per draw.
-            let mut searches = [None; GROUP];
-            for (((o, u), k), search) in out.iter_mut().zip(us).zip(&mut cells).zip(&mut searches) {
+            // Each row's search is found by arithmetic on its index, in each
+            // step (no per-draw copy of it to store and reload).
+            for ((o, u), k) in out.iter_mut().zip(us).zip(&mut cells) {
                 let row = o.0.0;
                 *o = ((row, 0), [u[0], marginal.rescale(u[1], row)]);
-                *search = tables.search(row);
-                if let Some(c) = search {
+                if let Some(c) = tables.search(row) {
                     *k = c.locate(u[0].f64());
                 }
             }
-            let searches = &searches[..us.len()];
-            for (c, &k) in searches.iter().zip(&cells) {
-                if let Some(c) = c {
+            for (o, &k) in out.iter().zip(&cells) {
+                if let Some(c) = tables.search(o.0.0) {
                     c.prefetch_window(k);
                 }
             }
-            for (((o, u), &k), c) in out.iter_mut().zip(us).zip(&cells).zip(searches) {
+            for ((o, u), &k) in out.iter_mut().zip(us).zip(&cells) {
                 // The marginal never draws a row of weight 0.
-                if let Some(c) = c {
+                if let Some(c) = tables.search(o.0.0) {
                     o.0.1 = c.index(u[0].f64(), k);
                     c.prefetch_weight(o.0.1);
                 }
             }
-            for ((o, u), c) in out.iter_mut().zip(us).zip(searches) {
-                if let Some(c) = c {
+            for (o, u) in out.iter_mut().zip(us) {
+                if let Some(c) = tables.search(o.0.0) {
                     o.1[0] = c.rescale(u[0], o.0.1);
                 }
             }
