@@ -61,6 +61,26 @@ def measure_side_by_side(fns: list[Callable[[], object]], repeat: int = 7,
     return [statistics.median(t) for t in times]
 
 
+def measure_alternating(fns: list[Callable[[], object]], repeat: int = 7,
+                        rounds: int = 3) -> list[float]:
+    """Median wall time of each of ``fns`` in seconds, timed in blocks that
+    alternate: each round runs every function once untimed (a warm-up, which
+    also lets the other runtime's worker threads go idle) and then
+    ``repeat`` times, for ``rounds`` rounds; the median is over every timed
+    run. For calls of a few milliseconds, where one call right after
+    another runtime's is slowed by its spinning threads, yet a single block
+    each would leave the comparison to whichever ran in a quiet spell."""
+    times: list[list[float]] = [[] for _ in fns]
+    for _ in range(rounds):
+        for fn, t in zip(fns, times):
+            fn()
+            for _ in range(repeat):
+                start = time.perf_counter()
+                fn()
+                t.append(time.perf_counter() - start)
+    return [statistics.median(t) for t in times]
+
+
 def _numpy_concentric_disk(u: np.ndarray) -> np.ndarray:
     """Shirley and Chiu's concentric disk, vectorised with numpy: (N, 2)."""
     a, b = 2 * u[:, 0] - 1, 2 * u[:, 1] - 1
@@ -172,14 +192,19 @@ def suite_warps(n: int, repeat: int, mi) -> list[Timing]:
     ]
     out = []
     for name, ours, numpy_impl, args in cases:
+        # float32 into a reused array (out=, as Dr.Jit reuses its memory: no
+        # page faults on a fresh result) and Mitsuba, timed in alternating
+        # blocks.
+        pair: list[tuple[str, Callable[[], object]]] = []
         for dtype, u in (("float64", u64), ("float32", u32)):
             out.append(Timing(name, "mcsample", dtype, n,
                               measure(lambda: ours(u, *args), repeat)))
-            # Into a reused array (out=), as Dr.Jit reuses its memory: no
-            # page faults on a fresh result.
             buffer = np.empty_like(ours(u[:2], *args), shape=(n,) + ours(u[:1], *args).shape[1:])
-            out.append(Timing(name, "mcsample out=", dtype, n,
-                              measure(lambda: ours(u, *args, out=buffer), repeat)))
+            reused = (lambda u=u, buffer=buffer: ours(u, *args, out=buffer))
+            if dtype == "float32":
+                pair.append(("mcsample out=", reused))
+            else:
+                out.append(Timing(name, "mcsample out=", dtype, n, measure(reused, repeat)))
             if numpy_impl is not None:
                 out.append(Timing(name, "numpy", dtype, n,
                                   measure(lambda: numpy_impl(u, *args), repeat)))
@@ -194,7 +219,9 @@ def suite_warps(n: int, repeat: int, mi) -> list[Timing]:
                 dr.eval(d)
                 dr.sync_thread()
 
-            out.append(Timing(name, "Mitsuba 3 llvm", "float32", n, measure(run, repeat)))
+            pair.append(("Mitsuba 3 llvm", run))
+        seconds = measure_alternating([f for _, f in pair], repeat)
+        out += [Timing(name, impl, "float32", n, t) for (impl, _), t in zip(pair, seconds)]
     return out
 
 
