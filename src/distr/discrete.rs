@@ -306,7 +306,7 @@ fn count_below(window: &[f64; SCAN], value: f64) -> usize {
 /// [`Search::index_reuse`]. Indices are the table's own (from 0); the
 /// table starts at `start` in `weights` and `cdf`, and its guide at
 /// `guide_start` in `guide`, so that cutting one table out of the store
-/// costs no slicing (and no bounds checks) per draw.
+/// is arithmetic on its place (no sub-slices to cut and check per draw).
 #[derive(Clone, Copy)]
 pub(crate) struct Search<'a> {
     weights: &'a [f64],
