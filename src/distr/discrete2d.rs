@@ -221,7 +221,7 @@ impl Discrete2D {
     pub fn sample_reuse_into<F: Real>(&self, us: &[[F; 2]], out: &mut [((usize, usize), [F; 2])]) {
         simd::dispatch(
             #[inline(always)]
-            || self.sample_groups(us, out),
+            |_| self.sample_groups(us, out),
         )
     }
 

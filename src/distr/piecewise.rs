@@ -279,7 +279,7 @@ impl PiecewiseConstant2D {
     pub fn sample_into<F: Real>(&self, us: &[[F; 2]], out: &mut [([F; 2], F)]) {
         simd::dispatch(
             #[inline(always)]
-            || self.sample_groups(us, out),
+            |_| self.sample_groups(us, out),
         )
     }
 

@@ -529,7 +529,7 @@ impl EnvMap {
             };
             ok = simd::dispatch(
                 #[inline(always)]
-                || {
+                |_| {
                     let mut ok = true;
                     let mut previous: Option<&mut [F]> = None;
                     for (b, (o, x)) in blocks.enumerate() {
@@ -644,7 +644,7 @@ impl EnvMap {
     ) {
         simd::dispatch(
             #[inline(always)]
-            || self.sample_groups(rows, prepare, out),
+            |_| self.sample_groups(rows, prepare, out),
         )
     }
 
