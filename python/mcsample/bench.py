@@ -227,21 +227,47 @@ def suite_warps(n: int, repeat: int, mi) -> list[Timing]:
 
 def suite_distr(n: int, repeat: int, mi) -> list[Timing]:
     """Discrete tables of 10^6 weights: building (reported per entry) and
-    sampling n indices, beside numpy, scipy and Mitsuba 3 llvm."""
+    sampling n indices, beside numpy, scipy and Mitsuba 3 llvm. The builds
+    and the samplers of mcsample and Mitsuba are timed in alternating blocks
+    (builds with builds, samplers with samplers), as the warps are."""
     size = 1_000_000
     weights = np.random.default_rng(0).random(size)
     u = mcs.uniform(n, 1, seed=2)[:, 0]
-    out = [
-        Timing("build 10^6 (entries/s)", "mcsample Discrete1D", "float64", size,
-               measure(lambda: mcs.Discrete1D(weights), repeat)),
-        Timing("build 10^6 (entries/s)", "mcsample AliasTable", "float64", size,
-               measure(lambda: mcs.AliasTable(weights), repeat)),
-    ]
     d, a = mcs.Discrete1D(weights), mcs.AliasTable(weights)
-    out.append(Timing("sample 10^6 table", "mcsample Discrete1D", "float64", n,
-                      measure(lambda: d.sample(u), repeat)))
-    out.append(Timing("sample 10^6 table", "mcsample AliasTable", "float64", n,
-                      measure(lambda: a.sample(u), repeat)))
+    builds: list[tuple[str, str, Callable[[], object]]] = [
+        ("mcsample Discrete1D", "float64", lambda: mcs.Discrete1D(weights)),
+        ("mcsample AliasTable", "float64", lambda: mcs.AliasTable(weights)),
+    ]
+    samplers: list[tuple[str, str, Callable[[], object]]] = [
+        ("mcsample Discrete1D", "float64", lambda: d.sample(u)),
+        ("mcsample AliasTable", "float64", lambda: a.sample(u)),
+    ]
+    if mi is not None:
+        import drjit as dr
+
+        w32 = weights.astype(np.float32)
+        def mi_build():
+            # The constructor only records the running sums: evaluate them.
+            built = mi.DiscreteDistribution(w32)
+            dr.eval(built.cdf)
+            dr.sync_thread()
+
+        dist = mi.DiscreteDistribution(w32)
+        uf = mi.Float(u.astype(np.float32))
+
+        def mi_sample():
+            i = dist.sample(uf)
+            dr.eval(i)
+            dr.sync_thread()
+
+        builds.append(("Mitsuba 3 llvm", "float32", mi_build))
+        samplers.append(("Mitsuba 3 llvm", "float32", mi_sample))
+    out = []
+    for case, count, runs in (("build 10^6 (entries/s)", size, builds),
+                              ("sample 10^6 table", n, samplers)):
+        seconds = measure_alternating([f for _, _, f in runs], repeat)
+        out += [Timing(case, impl, dtype, count, t)
+                for (impl, dtype, _), t in zip(runs, seconds)]
     cdf = np.cumsum(weights)
     out.append(Timing("sample 10^6 table", "numpy searchsorted", "float64", n,
                       measure(lambda: np.searchsorted(cdf, u * cdf[-1]), repeat)))
@@ -260,28 +286,6 @@ def suite_distr(n: int, repeat: int, mi) -> list[Timing]:
                           measure(lambda: urn.rvs(n), repeat)))
     except ImportError:
         pass
-    if mi is not None:
-        import drjit as dr
-
-        w32 = weights.astype(np.float32)
-        def mi_build():
-            # The constructor only records the running sums: evaluate them.
-            built = mi.DiscreteDistribution(w32)
-            dr.eval(built.cdf)
-            dr.sync_thread()
-
-        out.append(Timing("build 10^6 (entries/s)", "Mitsuba 3 llvm", "float32", size,
-                          measure(mi_build, repeat)))
-        dist = mi.DiscreteDistribution(w32)
-        uf = mi.Float(u.astype(np.float32))
-
-        def run():
-            i = dist.sample(uf)
-            dr.eval(i)
-            dr.sync_thread()
-
-        out.append(Timing("sample 10^6 table", "Mitsuba 3 llvm", "float32", n,
-                          measure(run, repeat)))
     return out
 
 
