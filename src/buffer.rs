@@ -10,7 +10,7 @@
 //! Even so, touching fresh memory costs more than writing it again (the
 //! kernel zeroes each page on its first fault): a dropped map is therefore
 //! kept for the next large buffer of about its size, as Dr.Jit's allocator
-//! keeps its arrays, up to [`RECYCLE_MAX_BYTES`] in all. A buffer that its
+//! keeps its arrays, up to `RECYCLE_MAX_BYTES` in all. A buffer that its
 //! maker overwrites whole ([`Buffer::for_overwrite`]) reuses one as it is.
 
 use bytemuck::Pod;

@@ -41,7 +41,7 @@ pub trait Real: Float + FloatConst + Debug + Default + Send + Sync + 'static {
     fn pow_positive(x: Self, y: Self) -> Self;
     /// `atan r` for `|r| ≤ tan(π/8)`: in `f64` by its Taylor series
     /// `Σ (−1)ᵏ r²ᵏ⁺¹/(2k+1)` cut where the next term is below the precision
-    /// (21 terms); in `f32` by a fitted polynomial of 6 terms ([`ATAN_F32`],
+    /// (21 terms); in `f32` by a fitted polynomial of 6 terms (`ATAN_F32`,
     /// where the series needs 10: a fifth of `EnvMap.pdf`'s time). Evaluated
     /// by Estrin's scheme: branch-free, without library calls.
     fn atan_reduced(r: Self) -> Self;

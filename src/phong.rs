@@ -265,7 +265,7 @@ impl<F: Real> PhongView<F> {
     }
 
     /// [`PhongView::sample`] of `prepare(row)` for each of `rows` into
-    /// `out`, in blocks of [`SAMPLE_BLOCK`] rows: the numbers of a block
+    /// `out`, in blocks of `SAMPLE_BLOCK` rows: the numbers of a block
     /// made (a caller checks and clamps them there), its samples computed
     /// at SIMD width ([`simd::map_rows`]), then spread into the arrays of
     /// `out`.

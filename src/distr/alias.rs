@@ -43,13 +43,13 @@ const ONE: f64 = 4_294_967_296.0;
 /// closes it as a cell of its own, topped up by the next heavy entry. With
 /// the deficits `σ_L(k) = Σ_{k'<k} (1 − s_{L_k'})` of the first `k` light
 /// entries and the surpluses `σ_H(j) = Σ_{j'<j} (s_{H_j'} − 1)` of the first
-/// `j` heavy ones, that sweep is a merge (see [`Orders`]):
+/// `j` heavy ones, that sweep is a merge (see `Orders`):
 /// - light `k` takes as alias the heavy `j` with `σ_H(j) ≤ σ_L(k) < σ_H(j+1)`;
 /// - heavy `j` closes after the `i` light entries with `σ_L(k) < σ_H(j+1)`,
 ///   keeping `1 − (σ_L(i) − σ_H(j+1))` of its cell, and takes heavy `j+1` as
 ///   alias.
 ///
-/// The build sweeps each block of [`BLOCK`] entries on its own, in parallel
+/// The build sweeps each block of `BLOCK` entries on its own, in parallel
 /// and in cache, and leaves over what the block cannot settle: when its
 /// heavies' surplus `S` exceeds its lights' deficit `D`, the heavies from
 /// the first with `σ_H(j+1) > D` on (the first with its residual surplus

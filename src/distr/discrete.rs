@@ -24,7 +24,7 @@ const SUM_BLOCK: usize = 1 << 16;
 ///
 /// # Probability
 /// `P(i) = w_i / Σ w`. The running sums `C_i = w_0 + … + w_i` are
-/// accumulated in `f64` (by blocks of [`SUM_BLOCK`] entries).
+/// accumulated in `f64` (by blocks of `SUM_BLOCK` entries).
 ///
 /// # Sampling
 /// `sample(u)` returns the index `i` with `C_{i−1} < u·Σw ≤ C_i` (as

@@ -493,7 +493,7 @@ impl EnvMap {
     }
 
     /// `out[i] = pdf(d[i])` for a batch, in `F`, in blocks of
-    /// [`BATCH_BLOCK`]: for polar tables, every direction's cell by the
+    /// `BATCH_BLOCK`: for polar tables, every direction's cell by the
     /// branch-free [`PolarTable::query`] at full SIMD width and its density
     /// prefetched, then the densities of the block before read (one block
     /// behind, so that the reads wait on no cache miss); for the others

@@ -10,7 +10,7 @@
 //! so the image does not depend on the thread count or on the order in which
 //! rows are rendered.
 //!
-//! Samples are rendered in batches of about [`BATCH`] (whole pixels of one
+//! Samples are rendered in batches of about `BATCH` (whole pixels of one
 //! row): each pixel's film and lens positions are drawn first, the camera
 //! rays of the batch are made at SIMD width, each path is traced, and the
 //! light of every ray that left the scene is looked up for the whole batch

@@ -22,7 +22,7 @@ pub struct Ray {
     pub tmax: f32,
 }
 
-/// Where a ray meets a primitive, before shading ([`Intersection`] follows
+/// Where a ray meets a primitive, before shading (the [`SurfacePoint`] follows
 /// from it).
 #[derive(Clone, Copy, Debug)]
 pub struct Candidate {

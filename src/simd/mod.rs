@@ -148,7 +148,7 @@ pub const STREAM_MIN_BYTES: usize = 16 << 20;
 /// decline for a large body).
 ///
 /// Rows are interleaved (`[x, y]`, `[x, y, z]`), which the vectoriser
-/// handles only at half width inside a kernel loop; each block of [`BLOCK`]
+/// handles only at half width inside a kernel loop; each block of `BLOCK`
 /// rows is therefore transposed into one array per component, mapped at
 /// full width, and transposed back. With `stream` (for outputs of
 /// [`STREAM_MIN_BYTES`] or more), whole cache lines of `out` are written
@@ -461,13 +461,25 @@ mod tests {
     #[test]
     fn map_rows_writes_every_row_at_any_alignment() {
         let f = |i: usize| i as f32;
-        check_every_row(|i| [f(i), 0.5 * f(i)], |x| [x[0] + x[1], 2.0 * x[0], -x[1]], f32::NAN);
+        check_every_row(
+            |i| [f(i), 0.5 * f(i)],
+            |x| [x[0] + x[1], 2.0 * x[0], -x[1]],
+            f32::NAN,
+        );
         check_every_row(|i| [f(i), 0.5 * f(i)], |x| [x[1], x[0] - 1.0], f32::NAN);
         check_every_row(|i| [f(i), -f(i), 3.0], |x| [x[2] * x[0], x[1]], f32::NAN);
-        check_every_row(|i| [f(i), -f(i), 3.0], |x| [x[2], x[0], x[1] + 1.0], f32::NAN);
+        check_every_row(
+            |i| [f(i), -f(i), 3.0],
+            |x| [x[2], x[0], x[1] + 1.0],
+            f32::NAN,
+        );
         check_every_row(|i| [f(i)], |x| [x[0] * 0.25], f32::NAN);
         check_every_row(|i| [i as u32, 7], |x| [x[1], x[0], x[0] ^ x[1]], u32::MAX);
-        check_every_row(|i| [i as f64, 1.5], |x| [x[0] * x[1], x[1], -x[0]], f64::NAN);
+        check_every_row(
+            |i| [i as f64, 1.5],
+            |x| [x[0] * x[1], x[1], -x[0]],
+            f64::NAN,
+        );
     }
 
     #[test]
