@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs everything the test suite needs on a fresh Debian machine
 # (libLLVM for Mitsuba's llvm variant, Python packages, this package) and
-# runs the whole suite: Rust format / lint / unit tests, then pytest.
+# runs the whole suite: Rust format / lint / unit tests / docs, then pytest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -20,6 +20,7 @@ rustup component add rustfmt clippy >/dev/null 2>&1 || true
 cargo fmt --check
 cargo clippy --all-targets --all-features --quiet -- -D warnings
 cargo test --quiet
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 python -m mypy.stubtest mcsample._core --allowlist scripts/stubtest-allowlist.txt
 
 # Run pytest from outside the source tree so it imports the installed
