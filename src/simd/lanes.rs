@@ -155,3 +155,57 @@ pub(super) fn columns_to_rows<T: Copy, const M: usize, const B: usize>(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`pick`] on plain arrays: `_mm512_permutex2var_epi32(a, index, b)`
+    /// takes lane `index & 15` of `a`, or of `b` when bit 4 is set.
+    fn pick_scalar(sources: &[[u32; LANES]], v: usize, to_rows: bool) -> [u32; LANES] {
+        let tables = if to_rows { &TO_ROWS } else { &TO_COLUMNS };
+        let [first, second] = tables[sources.len() - 2][v];
+        let permute = |a: &[u32; LANES], index: &[i32; LANES], b: &[u32; LANES]| {
+            index.map(|i| {
+                if i & 16 == 0 {
+                    a[(i & 15) as usize]
+                } else {
+                    b[(i & 15) as usize]
+                }
+            })
+        };
+        let two = permute(&sources[0], &first, &sources[1]);
+        match sources.get(2) {
+            Some(third) => permute(&two, &second, third),
+            None => two,
+        }
+    }
+
+    /// The lane tables transpose 16 rows of two or three components both
+    /// ways, on any CPU (the AVX-512 code runs only where the CPU has it).
+    #[test]
+    fn tables_transpose_rows_and_columns() {
+        for m in [2, 3] {
+            // Row s, component c holds 100·s + c.
+            let rows: Vec<[u32; LANES]> = (0..m)
+                .map(|v| {
+                    std::array::from_fn(|j| {
+                        let flat = LANES * v + j;
+                        100 * (flat / m) as u32 + (flat % m) as u32
+                    })
+                })
+                .collect();
+            let columns: Vec<[u32; LANES]> = (0..m)
+                .map(|c| std::array::from_fn(|s| 100 * s as u32 + c as u32))
+                .collect();
+            for v in 0..m {
+                assert_eq!(
+                    pick_scalar(&rows, v, false),
+                    columns[v],
+                    "m {m}, column {v}"
+                );
+                assert_eq!(pick_scalar(&columns, v, true), rows[v], "m {m}, line {v}");
+            }
+        }
+    }
+}
