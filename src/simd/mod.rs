@@ -337,11 +337,10 @@ fn interleave<T: Copy, const M: usize>(columns: &[[T; BLOCK]; M], rows: &mut [[T
 /// widest kind the CPU has ([`level`]), when `dst` is whole cache lines (as
 /// [`map_rows`] arranges, and as the blocks of a page-aligned
 /// [`crate::buffer::Buffer`] are); otherwise with plain stores. For copies
-/// that are not read again soon: they skip reading each line before
-/// writing it. The width is read
-/// at run time on purpose: given as the dispatch's constant, LLVM merged
-/// the copy into the block's transpose and the AVX2 warps of three
-/// components ran 15% more instructions per row.
+/// that are not read again soon: such stores skip reading each line before
+/// writing it. The width is read at run time on purpose: given as the
+/// dispatch's constant, LLVM merged the copy into the block's transpose and
+/// the AVX2 warps of three components ran 15% more instructions per row.
 #[inline(always)]
 pub(crate) fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
     #[cfg(target_arch = "x86_64")]
