@@ -283,10 +283,10 @@ impl PiecewiseConstant2D {
         )
     }
 
-    /// [`PiecewiseConstant2D::sample_into`] without the dispatch, for the
-    /// batch loops of samplers built on this density.
+    /// The loop of [`PiecewiseConstant2D::sample_into`], within its
+    /// dispatch: each group's cells, then their points.
     #[inline(always)]
-    pub(crate) fn sample_groups<F: Real>(&self, us: &[[F; 2]], out: &mut [([F; 2], F)]) {
+    fn sample_groups<F: Real>(&self, us: &[[F; 2]], out: &mut [([F; 2], F)]) {
         let mut cells = [((0, 0), [F::zero(); 2]); GROUP];
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
             let cells = &mut cells[..us.len()];

@@ -58,9 +58,8 @@ impl CellSampler {
             return (s.direction, s.pdf, s.radiance());
         };
         let c = self.cells.sample_bits(bits);
-        let (q, pdf_q) = table.sample_in_cell((c / self.cols, c % self.cols), r);
-        let (mapping, p) = (env.options.mapping, env.table_to_uv(q));
-        let [x, y, z, pdf, _] = env.frame_at(mapping, p, pdf_q);
-        ([x, y, z], pdf, env.radiance_at(p))
+        let (p, pdf_q, corners) = env.place_in_cell(table, (c / self.cols, c % self.cols), r);
+        let [x, y, z, pdf, _] = env.frame_at(env.options.mapping, p, pdf_q);
+        ([x, y, z], pdf, env.radiance_of(&corners))
     }
 }

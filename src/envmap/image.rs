@@ -169,6 +169,16 @@ impl Image {
         }
     }
 
+    /// The texels of a lat-long map's table cell `(row, col)` (the patch
+    /// between texel centres `row, row + 1` and `col, col + 1`, wrapped) and
+    /// their weights at fractions `r` of the cell: the corners of the point
+    /// there, without locating it again.
+    #[inline(always)]
+    pub fn cell_corners<F: Real>(&self, (row, col): (usize, usize), r: [F; 2]) -> Corners<F> {
+        let next = if col + 1 == self.width { 0 } else { col + 1 };
+        quad([col, next], [row, row + 1], self.width, r[0], r[1])
+    }
+
     /// Prefetches the texels of `corners`.
     #[inline(always)]
     pub fn prefetch<F: Real>(&self, corners: &Corners<F>) {
@@ -244,6 +254,29 @@ mod tests {
         assert_eq!(img.lookup(Mapping::LatLong, [0.875, 1.0])[0], 11.0);
         // Periodic in s: half way between the last column and the first.
         assert_eq!(img.lookup(Mapping::LatLong, [0.0, 0.0])[0], 1.5);
+    }
+
+    #[test]
+    fn a_latlong_cell_has_the_corners_of_its_points() {
+        // The table cell (row, col) spans texel centres row..row + 1 and
+        // col..col + 1 (wrapped); its point at fractions r lies at domain
+        // s = (col + ½ + r0)/W, t = (row + r1)/(H − 1).
+        let (w, h) = (5, 4);
+        let img = Image::new(Mapping::LatLong, w, h, &ramp(w, h)).unwrap();
+        for (row, col) in [(0, 0), (1, 3), (2, 4)] {
+            for r in [[0.0, 0.0], [0.3, 0.8], [0.999, 0.5]] {
+                let s = (col as f64 + 0.5 + r[0]) / w as f64;
+                let p = [s - s.floor(), (row as f64 + r[1]) / (h - 1) as f64];
+                let (a, b) = (
+                    img.blend(&img.cell_corners((row, col), r)),
+                    img.lookup(Mapping::LatLong, p),
+                );
+                assert!(
+                    (a[0] - b[0]).abs() < 1e-12,
+                    "cell ({row}, {col}), r = {r:?}: {a:?} against {b:?}"
+                );
+            }
+        }
     }
 
     #[test]

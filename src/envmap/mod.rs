@@ -421,10 +421,14 @@ impl EnvMap {
     /// Radiance at domain point `p`: the bilinear image value times scale.
     #[inline(always)]
     fn radiance_at<F: Real>(&self, p: [F; 2]) -> V3<F> {
+        self.radiance_of(&self.image.corners(self.options.mapping, p))
+    }
+
+    /// The blend of the texels `corners` times scale.
+    #[inline(always)]
+    fn radiance_of<F: Real>(&self, corners: &Corners<F>) -> V3<F> {
         let scale = F::c(self.options.scale);
-        self.image
-            .lookup(self.options.mapping, p)
-            .map(|v| v * scale)
+        self.image.blend(corners).map(|v| v * scale)
     }
 
     /// Radiance arriving from the world direction `d`, per RGB channel,
@@ -605,17 +609,47 @@ impl EnvMap {
     /// A direction drawn with density [`EnvMap::pdf`], for `u` in `[0, 1]²`.
     #[inline]
     pub fn sample(&self, u: [f64; 2]) -> EnvSample {
-        let (q, pdf_q) = match &self.distribution {
-            Distribution::Piecewise(table) => table.sample(u),
-            Distribution::Bilinear(grid) => grid.sample(u),
+        let mapping = self.options.mapping;
+        let (p, pdf_q, corners) = match &self.distribution {
+            Distribution::Piecewise(table) => {
+                let (cell, r) = table.table().sample_reuse(u);
+                self.place_in_cell(table, cell, r)
+            }
+            Distribution::Bilinear(grid) => {
+                let (q, pdf_q) = grid.sample(u);
+                let p = self.table_to_uv(q);
+                (p, pdf_q, self.image.corners(mapping, p))
+            }
             Distribution::Black => return self.sample_black(u),
         };
-        self.sample_at(self.table_to_uv(q), pdf_q)
+        self.sample_from(&self.frame_at(mapping, p, pdf_q), &corners)
+    }
+
+    /// The point at fractions `r` of cell `cell` of the piecewise `table`
+    /// (this map's): its domain point, its density per unit table area and
+    /// the texels under it. A lat-long map's cells are the patches between
+    /// texel centres, so its texels are the cell's corners weighted by `r`,
+    /// found without locating the point again.
+    #[inline(always)]
+    fn place_in_cell<F: Real>(
+        &self,
+        table: &PiecewiseConstant2D,
+        cell: (usize, usize),
+        r: [F; 2],
+    ) -> ([F; 2], F, Corners<F>) {
+        let (q, pdf_q) = table.sample_in_cell(cell, r);
+        let p = self.table_to_uv(q);
+        let corners = match self.options.mapping {
+            Mapping::LatLong => self.image.cell_corners(cell, r),
+            mapping => self.image.corners(mapping, p),
+        };
+        (p, pdf_q, corners)
     }
 
     /// `out[i] = sample(us[i])` for a batch, in groups: the table points by
     /// the tables' batch samplers (whose cache misses overlap), then the
-    /// texels under them located and prefetched, the directions and
+    /// texels under them located (a lat-long map's from the drawn cell, see
+    /// `place_in_cell`) and prefetched, the directions and
     /// densities of the group in one loop at SIMD width, and last the
     /// radiance. Computed in `F` past the table draw (whose searches run in
     /// `f64`; Mitsuba's bilinear density is sampled in `f64` and rounded);
@@ -664,7 +698,7 @@ impl EnvMap {
             }};
         }
         let zero = F::zero();
-        let mut drawn = [([zero; 2], zero); GROUP];
+        let mut cells = [((0, 0), [zero; 2]); GROUP];
         let mut points = [[zero; 3]; GROUP];
         let mut frames = [[zero; 5]; GROUP];
         let mut corners = [([0; 4], [zero; 4]); GROUP];
@@ -679,17 +713,29 @@ impl EnvMap {
                 *u = prepare(row);
             }
             let us = &*us;
-            let drawn = &mut drawn[..n];
+            // Each point's domain point and density, and its texels
+            // (prefetched).
+            let mut place = |k: usize, (p, pdf_q, c): ([F; 2], F, Corners<F>)| {
+                self.image.prefetch(&c);
+                (points[k], corners[k]) = ([p[0], p[1], pdf_q], c);
+            };
             match &self.distribution {
-                Distribution::Piecewise(table) => table.sample_groups(us, drawn),
+                Distribution::Piecewise(table) => {
+                    let cells = &mut cells[..n];
+                    table.table().sample_groups(us, cells);
+                    for (k, &(cell, r)) in cells.iter().enumerate() {
+                        place(k, self.place_in_cell(table, cell, r));
+                    }
+                }
                 Distribution::Bilinear(grid) => {
                     let (u64s, b) = (&mut [[0.0; 2]; GROUP][..n], &mut bilinear[..n]);
                     for (u, x) in u64s.iter_mut().zip(us) {
                         *u = x.map(F::f64);
                     }
                     grid.sample_into(u64s, b);
-                    for (d, &(q, pdf)) in drawn.iter_mut().zip(b.iter()) {
-                        *d = (q.map(F::c), F::c(pdf));
+                    for (k, &(q, pdf)) in b.iter().enumerate() {
+                        let p = self.table_to_uv(q.map(F::c));
+                        place(k, (p, F::c(pdf), self.image.corners(mapping, p)));
                     }
                 }
                 Distribution::Black => {
@@ -698,12 +744,6 @@ impl EnvMap {
                     }
                     continue;
                 }
-            }
-            for ((point, c), &(q, pdf_q)) in points.iter_mut().zip(&mut corners).zip(drawn.iter()) {
-                let p = self.table_to_uv(q);
-                *c = self.image.corners(mapping, p);
-                self.image.prefetch(c);
-                *point = [p[0], p[1], pdf_q];
             }
             let (points, frames) = (&points[..n], &mut frames[..n]);
             match mapping {
@@ -731,15 +771,6 @@ impl EnvMap {
             pdf: 0.0,
             weight: [0.0; 3],
         }
-    }
-
-    /// The sample at domain point `p`, drawn with density `pdf_q` per unit
-    /// area of the sampling table, computed in `F`.
-    #[inline(always)]
-    fn sample_at<F: Real>(&self, p: [F; 2], pdf_q: F) -> EnvSample<F> {
-        let mapping = self.options.mapping;
-        let frame = self.frame_at(mapping, p, pdf_q);
-        self.sample_from(&frame, &self.image.corners(mapping, p))
     }
 
     /// The world direction at domain point `p` of `mapping` (this map's),
@@ -771,12 +802,11 @@ impl EnvMap {
     /// blend of `corners` times scale.
     #[inline(always)]
     fn sample_from<F: Real>(&self, frame: &[F; 5], corners: &Corners<F>) -> EnvSample<F> {
-        let scale = F::c(self.options.scale);
         let [x, y, z, pdf, inv_pdf] = *frame;
         EnvSample {
             direction: [x, y, z],
             pdf,
-            weight: self.image.blend(corners).map(|l| l * scale * inv_pdf),
+            weight: self.radiance_of(corners).map(|l| l * inv_pdf),
         }
     }
 
