@@ -550,8 +550,14 @@ SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
 def main(n: int = 10_000_000, repeat: int = 7, only: list[str] | None = None) -> list[Timing]:
     """Runs the suites (all, or those named in ``only``) and prints a table."""
     mi = _mitsuba()
-    print(f"mcsample {mcs.__version__}, {mcs.get_num_threads()} threads, n = {n:,}; "
-          f"Mitsuba: {'llvm_ad_rgb' if mi is not None else 'not available (llvm variant)'}")
+    if mi is not None:
+        import drjit as dr
+
+        # The versions, since Mitsuba's speed changes from release to release.
+        other = f"Mitsuba {mi.__version__} (Dr.Jit {dr.__version__}) llvm_ad_rgb"
+    else:
+        other = "Mitsuba: not available (llvm variant)"
+    print(f"mcsample {mcs.__version__}, {mcs.get_num_threads()} threads, n = {n:,}; {other}")
     timings: list[Timing] = []
     for name, suite in SUITES.items():
         if only and name not in only:
