@@ -617,8 +617,7 @@ impl EnvMap {
             }
             Distribution::Bilinear(grid) => {
                 let (q, pdf_q) = grid.sample(u);
-                let p = self.table_to_uv(q);
-                (p, pdf_q, self.image.corners(mapping, p))
+                self.place_at(q, pdf_q)
             }
             Distribution::Black => return self.sample_black(u),
         };
@@ -638,12 +637,18 @@ impl EnvMap {
         r: [F; 2],
     ) -> ([F; 2], F, Corners<F>) {
         let (q, pdf_q) = table.sample_in_cell(cell, r);
+        match self.options.mapping {
+            Mapping::LatLong => (self.table_to_uv(q), pdf_q, self.image.cell_corners(cell, r)),
+            _ => self.place_at(q, pdf_q),
+        }
+    }
+
+    /// The table point `q`, drawn with density `pdf_q` per unit table area:
+    /// its domain point, that density and the texels under it.
+    #[inline(always)]
+    fn place_at<F: Real>(&self, q: [F; 2], pdf_q: F) -> ([F; 2], F, Corners<F>) {
         let p = self.table_to_uv(q);
-        let corners = match self.options.mapping {
-            Mapping::LatLong => self.image.cell_corners(cell, r),
-            mapping => self.image.corners(mapping, p),
-        };
-        (p, pdf_q, corners)
+        (p, pdf_q, self.image.corners(self.options.mapping, p))
     }
 
     /// `out[i] = sample(us[i])` for a batch, in groups: the table points by
@@ -734,8 +739,7 @@ impl EnvMap {
                     }
                     grid.sample_into(u64s, b);
                     for (k, &(q, pdf)) in b.iter().enumerate() {
-                        let p = self.table_to_uv(q.map(F::c));
-                        place(k, (p, F::c(pdf), self.image.corners(mapping, p)));
+                        place(k, self.place_at(q.map(F::c), F::c(pdf)));
                     }
                 }
                 Distribution::Black => {
