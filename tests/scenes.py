@@ -96,3 +96,67 @@ def icosphere(subdivisions=2):
              ([a, mid(a, b), mid(c, a)], [b, mid(b, c), mid(a, b)],
               [c, mid(c, a), mid(b, c)], [mid(a, b), mid(b, c), mid(c, a)])]
     return np.array(verts), np.array(f, dtype=np.int64)
+
+
+def transform(translate=(0.0, 0.0, 0.0), rotate=(), scale=(1.0, 1.0, 1.0)) -> np.ndarray:
+    """The 4×4 matrix T·R·S: scale first, then the rotations ``rotate``
+    ((axis, degrees) pairs, applied in order), then the translation."""
+    m = np.diag([*map(float, scale), 1.0])
+    for axis, degrees in rotate:
+        c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
+        i, j = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}[axis]
+        r = np.eye(4)
+        r[i, i], r[i, j], r[j, i], r[j, j] = c, -s, s, c
+        m = r @ m
+    m[:3, 3] = translate
+    return m
+
+
+#: Where an area light sits over the floor y = 0: its centre, its size (the
+#: largest half-extent) and the turn that faces a flat light (Mitsuba's
+#: rectangle and disk face +z) toward the floor.
+#: - near: as high as it is wide;
+#: - far: 15 sizes up;
+#: - grazing: low beside the lit part of the floor, facing along it (10°
+#:   down), so that light reaches the floor at grazing angles.
+LIGHT_PLACES = {
+    "near": ((0.0, 0.3, 0.0), 0.25, [("x", 90.0)]),
+    "far": ((0.0, 3.0, 0.0), 0.2, [("x", 90.0)]),
+    "grazing": ((-1.4, 0.2, 0.0), 0.2, [("y", 90.0), ("z", -10.0)]),
+}
+
+LIGHT_SHAPES = ("rectangle", "disk", "sphere", "cube", "mesh")
+
+
+def area_light(shape: str, place: str, radiance: float = 1.0) -> dict:
+    """An area light of ``shape`` at ``place`` (:data:`LIGHT_PLACES`),
+    under a non-uniform scale and a turn about its own axis (a sphere,
+    which takes a uniform scale only, is placed by centre and radius).
+    Its radiance is scaled with the square of the distance over its size,
+    so that the floor under it is lit alike in every place."""
+    center, size, turn = LIGHT_PLACES[place]
+    emitter = {"type": "area", "radiance": radiance * (max(center[1], 0.3) / size) ** 2 / 4}
+    bsdf = {"type": "diffuse", "reflectance": 0.3}
+    if shape == "sphere":
+        return {"type": "sphere", "center": list(center), "radius": size * 0.6,
+                "emitter": emitter, "bsdf": bsdf}
+    flat = shape in ("rectangle", "disk")
+    scale = (size, 0.6 * size, 1.0) if flat else (size, 0.6 * size, 0.8 * size)
+    rotate = [("z", 30.0)] + (turn if flat else [("x", 20.0), ("y", 35.0)])
+    m = transform(center, rotate, scale)
+    if shape == "mesh":
+        v, f = icosphere(1)
+        v = v @ m[:3, :3].T + m[:3, 3]
+        return {"type": "mesh", "vertices": v, "faces": f, "emitter": emitter, "bsdf": bsdf}
+    return {"type": shape, "to_world": m, "emitter": emitter, "bsdf": bsdf}
+
+
+def area_lit_floor(shape: str, place: str, width: int = 32, height: int = 24) -> dict:
+    """A diffuse floor lit by one area light (:func:`area_light`), seen
+    from above so that the lit floor fills the frame."""
+    target = (0.0, 0.0, 0.0) if place != "grazing" else (-0.4, 0.0, 0.0)
+    return {"type": "scene",
+            "sensor": sensor(origin=(target[0] + 0.3, 2.4, 2.0), target=target, fov=50.0,
+                             width=width, height=height),
+            "floor": ground(size=6.0, reflectance=0.6),
+            "light": area_light(shape, place)}

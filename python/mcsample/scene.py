@@ -45,7 +45,7 @@ from ._core import EnvMap, Phong
 from ._core.io import read_mesh
 from ._core.render import CompiledScene, SceneBuilder
 
-__all__ = ["Scene", "look_at"]
+__all__ = ["EmitterSample", "Scene", "look_at"]
 
 #: Mitsuba's default film size and field of view (focal length 50 mm on a
 #: 36 mm wide film).
@@ -368,6 +368,26 @@ def _camera(d: Mapping[str, Any], key: str) -> Camera:
     return cam
 
 
+@dataclass(frozen=True, repr=False)
+class EmitterSample:
+    """Directions toward the lights, from :meth:`Scene.sample_emitter`."""
+
+    direction: np.ndarray
+    pdf: np.ndarray
+    radiance: np.ndarray
+    distance: np.ndarray
+
+    @property
+    def weight(self) -> np.ndarray:
+        """radiance / pdf, 0 where pdf is 0."""
+        pdf = np.asarray(self.pdf)[..., None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(pdf > 0, self.radiance / np.where(pdf > 0, pdf, 1.0), 0.0)
+
+    def __repr__(self) -> str:
+        return f"EmitterSample(direction, pdf, radiance, distance: {np.shape(self.pdf)})"
+
+
 @dataclass
 class Scene:
     """A scene mcsample can render and Mitsuba 3 can render too.
@@ -470,6 +490,39 @@ class Scene:
                          c.near_clip, c.far_clip, c.aperture_radius, c.focus_distance)
             self._compiled = b.build()
         return self._compiled
+
+    def sample_emitter(self, x: Any, u: Any) -> "EmitterSample":
+        """Emitter sampling as the renderer's next-event estimation does it.
+
+        Parameters
+        ----------
+        x : array_like, shape (N, 3) or (3,)
+            Points the light is sampled from (world space).
+        u : array_like, shape (N, 3) or (3,), in [0, 1]
+            Uniform numbers: the light's choice (by power), then two for the
+            point on it (uniform by area; a sphere seen from outside: uniform
+            in the cone it subtends) or the environment direction.
+
+        Returns
+        -------
+        EmitterSample
+            ``.direction`` (N, 3) unit vectors toward the light, ``.pdf``
+            (N,) per steradian (the light's choice included), ``.radiance``
+            (N, 3) arriving along it (no visibility test), ``.distance``
+            (N,) to the light point (inf for the environment), ``.weight``
+            = radiance / pdf; all 0 where a sample carries no light (a point
+            on the back of a one-sided light).
+        """
+        out = np.asarray(self.compiled.sample_emitter(x, u))
+        return EmitterSample(out[..., :3], out[..., 3], out[..., 4:7], out[..., 7])
+
+    def emitter_pdf(self, x: Any, d: Any) -> Any:
+        """The density per steradian with which :meth:`sample_emitter` from
+        points ``x`` (N, 3) or (3,) draws the unit directions ``d`` (N, 3) or
+        (3,): float64 (N,) or a scalar. An area light counts where ``d``
+        first meets its front side (other shapes do not block it: this is
+        the sampler's density, not visibility)."""
+        return self.compiled.emitter_pdf(x, d)
 
     @property
     def size(self) -> tuple[int, int]:

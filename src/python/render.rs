@@ -9,7 +9,9 @@ use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use super::arrays::index_arg;
+use glam::Vec3A;
+
+use super::arrays::{Check, Points, index_arg, map_pair};
 use super::envmap::PyEnvMap;
 use super::error::guarded;
 use super::phong::PyPhong;
@@ -218,6 +220,56 @@ impl PyScene {
     #[getter]
     fn film(&self) -> (usize, usize) {
         self.0.film()
+    }
+
+    /// Emitter sampling, as the renderer's next-event estimation does it:
+    /// from points ``x`` (N, 3) or (3,), with uniform numbers ``u`` (N, 3)
+    /// or (3,) in [0, 1] (the light's choice, then two for the point or
+    /// direction on it). Returns float64 (N, 8) or (8,): the unit
+    /// direction (3), its density per steradian (the light's choice
+    /// included), the radiance arriving along it (3, no visibility test)
+    /// and the distance to the light point (inf for the environment);
+    /// all 0 where the sample carries no light (the back of a light).
+    fn sample_emitter<'py>(
+        &self,
+        py: Python<'py>,
+        x: &Bound<'py, PyAny>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let x = Points::<f64, 3>::extract(x, "x")?;
+        let u = Points::<f64, 3>::extract(u, "u")?;
+        let scene = &self.0;
+        map_pair(py, (&x, Check::Finite), (&u, Check::Unit), |x, u| {
+            let x = Vec3A::from(x.map(|v| v as f32));
+            let s = scene.sample_light(x, u.map(|v| v as f32), None::<fn() -> u64>);
+            s.map_or([0.0; 8], |s| {
+                let [dx, dy, dz] = s.d.to_array();
+                let [r, g, b] = s.radiance;
+                [dx, dy, dz, s.pdf, r, g, b, s.dist].map(f64::from)
+            })
+        })
+    }
+
+    /// The density per steradian with which :meth:`sample_emitter` from
+    /// points ``x`` (N, 3) or (3,) draws the unit directions ``d`` (N, 3)
+    /// or (3,): float64 (N,) or a scalar.
+    fn emitter_pdf<'py>(
+        &self,
+        py: Python<'py>,
+        x: &Bound<'py, PyAny>,
+        d: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let x = Points::<f64, 3>::extract(x, "x")?;
+        let d = Points::<f64, 3>::extract(d, "d")?;
+        let scene = &self.0;
+        map_pair(py, (&x, Check::Finite), (&d, Check::Finite), |x, d| {
+            let x = Vec3A::from(x.map(|v| v as f32));
+            let d = Vec3A::from(d.map(|v| v as f32)).normalize_or_zero();
+            if d == Vec3A::ZERO {
+                return [0.0];
+            }
+            [f64::from(scene.emitter_pdf(x, d))]
+        })
     }
 }
 

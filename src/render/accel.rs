@@ -25,8 +25,9 @@ pub enum Primitive {
 }
 
 impl Primitive {
+    /// The hit of `ray` in `(0, ray.tmax)`, if any.
     #[inline(always)]
-    fn intersect(&self, ray: &Ray) -> Option<Candidate> {
+    pub fn intersect(&self, ray: &Ray) -> Option<Candidate> {
         match self {
             Primitive::Triangle(t) => t.intersect(ray),
             Primitive::Sphere(s) => s.intersect(ray),

@@ -18,7 +18,7 @@
 use glam::Vec3A;
 
 use super::accel::Hit;
-use super::scene::Scene;
+use super::scene::{LightSample, Scene};
 use super::shape::Ray;
 use crate::frame::Frame;
 use crate::mis;
@@ -94,6 +94,34 @@ fn offset(p: Vec3A, n: Vec3A, toward: Vec3A) -> Vec3A {
         p + n * eps
     } else {
         p - n * eps
+    }
+}
+
+/// The shadow ray from a surface point `p` (geometric normal `n`) toward
+/// the light sample `ls`. Toward an area light it runs between the two
+/// points, each moved off its own surface toward the other by [`offset`],
+/// so that neither the receiver nor the light itself can block it (a ray
+/// kept along `ls.d` from the moved origin would cross the light's surface
+/// before its end at grazing angles); toward the environment it is
+/// unbounded.
+#[inline]
+pub(crate) fn shadow_ray(p: Vec3A, n: Vec3A, ls: &LightSample) -> Ray {
+    let o = offset(p, n, ls.d);
+    match ls.point {
+        None => Ray {
+            o,
+            d: ls.d,
+            tmax: f32::INFINITY,
+        },
+        Some(y) => {
+            let to = offset(y.p, y.ng, -ls.d) - o;
+            let tmax = to.length();
+            Ray {
+                o,
+                d: if tmax > 0.0 { to / tmax } else { ls.d },
+                tmax,
+            }
+        }
     }
 }
 
@@ -218,6 +246,9 @@ fn path(
     let mut l = [0.0f32; 3];
     let mut beta = [1.0f32; 3];
     let mut bsdf_pdf = 0.0f32;
+    // The shading point the ray left (emitter sampling's densities are
+    // seen from there).
+    let mut from = ray.o;
     let mut depth = 0u32;
     loop {
         let shape = scene.accel().shape_of(hit.primitive);
@@ -226,7 +257,7 @@ fn path(
         let wi = -ray.d;
         if let Some(le) = scene.emitted(shape, sp.ng, wi) {
             let w = emission_weight(settings, depth, bsdf_pdf, || {
-                scene.area_pdf(shape, sp.ng, ray.d, hit.t)
+                scene.light_pdf(shape, from, sp.ng, ray.d, hit.t)
             });
             add_scaled(&mut l, beta, le, w);
         }
@@ -244,30 +275,19 @@ fn path(
 
         if settings.strategy != Strategy::Bsdf {
             let u = [rng.next_float(), rng.next_float(), rng.next_float()];
-            if let Some(ls) = scene.sample_light(sp.p, u, || rng.next_u64()) {
+            if let Some(ls) = scene.sample_light(sp.p, u, Some(|| rng.next_u64())) {
                 let wo = frame.to_local(ls.d.to_array());
                 let (f, pdf_wo) = view.eval_pdf_one(wo);
-                if f.iter().any(|&v| v > 0.0) {
-                    let origin = offset(sp.p, sp.ng, ls.d);
-                    let tmax = if ls.dist.is_finite() {
-                        (ls.d.dot(sp.p + ls.d * ls.dist - origin)) * (1.0 - 1e-4)
+                if f.iter().any(|&v| v > 0.0)
+                    && !scene.accel().occluded(&shadow_ray(sp.p, sp.ng, &ls))
+                {
+                    let w = if settings.strategy == Strategy::Mis {
+                        settings.weight(ls.pdf, pdf_wo)
                     } else {
-                        f32::INFINITY
+                        1.0
                     };
-                    let shadow = Ray {
-                        o: origin,
-                        d: ls.d,
-                        tmax,
-                    };
-                    if !scene.accel().occluded(&shadow) {
-                        let w = if settings.strategy == Strategy::Mis {
-                            settings.weight(ls.pdf, pdf_wo)
-                        } else {
-                            1.0
-                        };
-                        let s = w * wo[2].abs() / ls.pdf;
-                        add_scaled(&mut l, beta, mul(f, ls.radiance), s);
-                    }
+                    let s = w * wo[2].abs() / ls.pdf;
+                    add_scaled(&mut l, beta, mul(f, ls.radiance), s);
                 }
             }
             // Under emitter sampling, the next vertex's emission is not
@@ -285,6 +305,7 @@ fn path(
         beta = mul(beta, s.weight);
         bsdf_pdf = s.pdf;
         let d = Vec3A::from(frame.to_world(s.wo)).normalize();
+        from = sp.p;
         ray = Ray {
             o: offset(sp.p, sp.ng, d),
             d,

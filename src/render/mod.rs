@@ -29,6 +29,8 @@ pub mod integrator;
 pub mod mesh_file;
 pub mod scene;
 pub mod shape;
+#[cfg(test)]
+mod tests;
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 

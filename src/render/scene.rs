@@ -6,7 +6,7 @@ use glam::{DVec3, Vec3A};
 
 use super::accel::{Accel, Primitive};
 use super::camera::Camera;
-use super::shape::{Disk, Sphere, SurfacePoint, Triangle};
+use super::shape::{Disk, Ray, Sphere, SurfacePoint, Triangle};
 use crate::distr::Discrete1D;
 use crate::envmap::{CellSampler, EnvMap};
 use crate::error::{Error, Result};
@@ -137,9 +137,12 @@ impl Environment {
 #[derive(Clone, Debug)]
 enum Light {
     /// The emitting shape `shape`, whose primitives are
-    /// `primitives[first..first + areas.len()]`, one chosen by area.
+    /// `primitives[first..first + count]`, one chosen by area (`areas`,
+    /// when there are several).
     Area {
+        shape: u32,
         first: u32,
+        count: u32,
         areas: Option<Discrete1D>,
         total_area: f32,
         radiance: [f32; 3],
@@ -160,6 +163,9 @@ pub struct LightSample {
     pub pdf: f32,
     /// Radiance arriving along `d` (before the visibility test).
     pub radiance: [f32; 3],
+    /// The point on an area light (where the shadow ray ends), `None` for
+    /// the environment.
+    pub point: Option<SurfacePoint>,
 }
 
 /// A scene ready to render.
@@ -232,7 +238,9 @@ impl Scene {
             if power > 0.0 {
                 light_of_shape.push(Some(lights.len() as u32));
                 lights.push(Light::Area {
+                    shape: id,
                     first,
+                    count: areas.len() as u32,
                     areas: (areas.len() > 1)
                         .then(|| Discrete1D::new(&areas))
                         .transpose()?,
@@ -320,20 +328,32 @@ impl Scene {
         }
     }
 
-    /// Density per steradian with which emitter sampling from a shading point
-    /// draws the direction that reaches shape `shape` at distance `dist`,
-    /// where its geometric normal is `ng` and the direction is `d`.
+    /// Density per steradian with which emitter sampling from the shading
+    /// point `x` draws the direction `d` that reaches shape `shape` at
+    /// distance `dist`, where its geometric normal is `ng`: the choice of
+    /// the light times [`Sphere::cone_pdf`] for a sphere seen from outside,
+    /// else `dist² / (|cos θ_light| A)` (uniform by area `A`, turned into
+    /// solid angle).
     #[inline]
-    pub fn area_pdf(&self, shape: u32, ng: Vec3A, d: Vec3A, dist: f32) -> f32 {
+    pub fn light_pdf(&self, shape: u32, x: Vec3A, ng: Vec3A, d: Vec3A, dist: f32) -> f32 {
         let light = self.light_of_shape[shape as usize];
-        let Some(Light::Area { total_area, .. }) = light.map(|l| &self.lights[l as usize]) else {
+        let Some(Light::Area {
+            first, total_area, ..
+        }) = light.map(|l| &self.lights[l as usize])
+        else {
             return 0.0;
         };
+        let pmf = self.choice_pmf(light);
+        if let Primitive::Sphere(s) = &self.accel.primitives()[*first as usize]
+            && let Some(pdf) = s.cone_pdf(x)
+        {
+            return pmf * pdf;
+        }
         let cos = ng.dot(d).abs();
         if cos <= 0.0 {
             return 0.0;
         }
-        self.choice_pmf(light) * dist * dist / (cos * total_area)
+        pmf * dist * dist / (cos * total_area)
     }
 
     /// `out[i]`: the density per steradian with which emitter sampling
@@ -351,17 +371,61 @@ impl Scene {
         }
     }
 
+    /// The density per steradian with which [`Scene::sample_light`] from
+    /// `x` draws the unit direction `d`: over the lights, the probability of
+    /// choosing each times its density toward `d`. An area light counts
+    /// where `d` first meets it (among its own primitives: other shapes are
+    /// ignored, as the sampler ignores them) on its front side.
+    pub fn emitter_pdf(&self, x: Vec3A, d: Vec3A) -> f32 {
+        let ray = Ray {
+            o: x,
+            d,
+            tmax: f32::INFINITY,
+        };
+        let mut pdf = 0.0;
+        for (index, light) in self.lights.iter().enumerate() {
+            match light {
+                Light::Area {
+                    shape,
+                    first,
+                    count,
+                    ..
+                } => {
+                    let own = &self.accel.primitives()[*first as usize..(first + count) as usize];
+                    let nearest = own
+                        .iter()
+                        .filter_map(|p| p.intersect(&ray).map(|c| (p, c)))
+                        .min_by(|a, b| a.1.t.total_cmp(&b.1.t));
+                    if let Some((p, c)) = nearest {
+                        let y = p.point(x + d * c.t, c.bary);
+                        if self.emitted(*shape, y.ng, -d).is_some() {
+                            pdf += self.light_pdf(*shape, x, y.ng, d, c.t);
+                        }
+                    }
+                }
+                Light::Environment { .. } => {
+                    if let Some(env) = &self.environment {
+                        pdf += self.choice_pmf(Some(index as u32)) * env.pdf(d);
+                    }
+                }
+            }
+        }
+        pdf
+    }
+
     /// Emitter sampling from the shading point `x`: a light chosen by power
-    /// (`u[0]`), then a point on it uniformly by area or an environment
-    /// direction by the environment's own sampling (`u[1..3]`, and 64 bits
-    /// from `bits` for a map's cell). `None` when the scene has no light or
-    /// the sample carries no radiance.
+    /// (`u[0]`), then a point on it (uniformly by area, or for a sphere seen
+    /// from outside by the cone it subtends) or an environment
+    /// direction by the environment's own sampling (`u[1..3]`; a map's
+    /// cell by its [`CellSampler`] from 64 bits of `bits` when given, else
+    /// by [`EnvMap::sample`] of `u[1..3]`, with the same density). `None`
+    /// when the scene has no light or the sample carries no radiance.
     #[inline]
     pub fn sample_light(
         &self,
         x: Vec3A,
         u: [f32; 3],
-        bits: impl FnOnce() -> u64,
+        bits: Option<impl FnOnce() -> u64>,
     ) -> Option<LightSample> {
         let choice = self.light_choice.as_ref()?;
         let index = choice.sample(u[0]);
@@ -369,13 +433,14 @@ impl Scene {
         match &self.lights[index] {
             Light::Environment { cells } => {
                 let env = self.environment.as_ref()?;
-                let cells = cells.as_ref().map(|c| (c, bits()));
+                let cells = cells.as_ref().zip(bits).map(|(c, bits)| (c, bits()));
                 let (d, pdf, radiance) = env.sample([u[1], u[2]], cells);
                 (pdf > 0.0).then_some(LightSample {
                     d,
                     dist: f32::INFINITY,
                     pdf: pdf * pmf,
                     radiance,
+                    point: None,
                 })
             }
             Light::Area {
@@ -383,16 +448,22 @@ impl Scene {
                 areas,
                 total_area,
                 radiance,
+                ..
             } => {
                 let (k, u1) = match areas {
                     Some(a) => a.sample_reuse(u[1]),
                     None => (0, u[1]),
                 };
                 let primitive = &self.accel.primitives()[*first as usize + k];
-                let y: SurfacePoint = match primitive {
-                    Primitive::Triangle(t) => t.sample([u1, u[2]]),
-                    Primitive::Sphere(s) => s.sample([u1, u[2]]),
-                    Primitive::Disk(d) => d.sample([u1, u[2]]),
+                let u2 = [u1, u[2]];
+                // A sphere seen from outside: by the cone it subtends.
+                let (y, cone_pdf) = match primitive {
+                    Primitive::Triangle(t) => (t.sample(u2), None),
+                    Primitive::Sphere(s) => match s.sample_cone(x, u2) {
+                        Some((y, pdf)) => (y, Some(pdf)),
+                        None => (s.sample(u2), None),
+                    },
+                    Primitive::Disk(d) => (d.sample(u2), None),
                 };
                 let to_light = y.p - x;
                 let dist = to_light.length();
@@ -401,11 +472,13 @@ impl Scene {
                 }
                 let d = to_light / dist;
                 let cos = -y.ng.dot(d);
-                (cos > 0.0).then(|| LightSample {
+                let pdf = cone_pdf.unwrap_or(dist * dist / (cos * total_area));
+                (cos > 0.0 && pdf.is_finite()).then_some(LightSample {
                     d,
                     dist,
-                    pdf: pmf * dist * dist / (cos * total_area),
+                    pdf: pmf * pdf,
                     radiance: *radiance,
+                    point: Some(y),
                 })
             }
         }

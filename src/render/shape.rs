@@ -381,6 +381,75 @@ impl Sphere {
         self.point(Vec3A::from(p.as_vec3()))
     }
 
+    /// The cone of directions in which the sphere is seen from `x`: its
+    /// unit axis (toward the centre), `sin² θmax = r²/|c − x|²` and
+    /// `1 − cos θmax` (as `sin² θmax / (1 + cos θmax)`, without
+    /// cancellation for small spheres far away). `None` when `x` is not
+    /// clearly outside the sphere: inside it, or on its surface to within
+    /// rounding (a shading point on the sphere itself, which may round to
+    /// either side).
+    #[inline]
+    fn cone(&self, x: Vec3A) -> Option<(DVec3, f64, f64)> {
+        let to_center = self.center - x.as_dvec3();
+        let dc2 = to_center.length_squared();
+        let r2 = self.radius * self.radius;
+        if dc2.is_nan() || dc2 <= r2 * (1.0 + 1e-4) {
+            return None;
+        }
+        let sin2_max = r2 / dc2;
+        let one_minus_cos_max = sin2_max / (1.0 + (1.0 - sin2_max).sqrt());
+        Some((to_center / dc2.sqrt(), sin2_max, one_minus_cos_max))
+    }
+
+    /// Density per steradian of [`Sphere::sample_cone`] from `x` (for any
+    /// direction toward the sphere): `1 / (2π (1 − cos θmax))`. `None` when
+    /// `x` is not outside the sphere.
+    #[inline]
+    pub fn cone_pdf(&self, x: Vec3A) -> Option<f32> {
+        let (_, _, one_minus_cos_max) = self.cone(x)?;
+        Some(uniform_cone_density(one_minus_cos_max))
+    }
+
+    /// The point of the sphere that `x` (outside it) sees along a direction
+    /// drawn uniformly in the cone the sphere subtends, with that density
+    /// per steradian ([`Sphere::cone_pdf`]); `None` when `x` is not outside
+    /// the sphere (sample by area then).
+    ///
+    /// # Density
+    /// `p(ω) = 1 / (2π (1 − cos θmax))` for the directions that meet the
+    /// sphere, `sin θmax = r / |c − x|`; the point is the nearer hit, so
+    /// every sample is visible from `x`.
+    ///
+    /// # Method
+    /// `1 − cos θ = u₀ (1 − cos θmax)` and `φ = 2π u₁` around the axis; the
+    /// point is placed by its angle `α` at the centre (from the axis back
+    /// toward `x`), `cos α = sin² θ / sin θmax + cos θ √(1 − sin² θ /
+    /// sin² θmax)`, so that it lies on the sphere to rounding.
+    ///
+    /// # References
+    /// M. Pharr, W. Jakob, G. Humphreys, *Physically Based Rendering*, 4th
+    /// ed., §6.2.4 (sampling a sphere by the cone it subtends).
+    pub fn sample_cone(&self, x: Vec3A, u: [f32; 2]) -> Option<(SurfacePoint, f32)> {
+        let (axis, sin2_max, one_minus_cos_max) = self.cone(x)?;
+        let omc = f64::from(u[0]) * one_minus_cos_max;
+        let cos_theta = 1.0 - omc;
+        let sin2_theta = omc * (2.0 - omc);
+        let cos_alpha = sin2_theta / sin2_max.sqrt()
+            + cos_theta * (1.0 - sin2_theta / sin2_max).max(0.0).sqrt();
+        let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+        let phi = 2.0 * std::f64::consts::PI * f64::from(u[1]);
+        let (s, t) = axis.any_orthonormal_pair();
+        let n = -cos_alpha * axis + sin_alpha * (phi.cos() * s + phi.sin() * t);
+        let p = self.center + self.radius * n;
+        let n = Vec3A::from((if self.flip { -n } else { n }).as_vec3());
+        let point = SurfacePoint {
+            p: Vec3A::from(p.as_vec3()),
+            ng: n,
+            ns: n,
+        };
+        Some((point, uniform_cone_density(one_minus_cos_max)))
+    }
+
     /// Bounds.
     pub fn bounds(&self) -> (Vec3A, Vec3A) {
         let r = DVec3::splat(self.radius);
@@ -389,6 +458,13 @@ impl Sphere {
             Vec3A::from((self.center + r).as_vec3()),
         )
     }
+}
+
+/// The density per steradian of directions uniform in a cone of solid angle
+/// `2π (1 − cos θmax)`.
+#[inline]
+fn uniform_cone_density(one_minus_cos_max: f64) -> f32 {
+    (1.0 / (2.0 * std::f64::consts::PI * one_minus_cos_max)) as f32
 }
 
 /// The unit disk `x² + y² ≤ 1, z = 0` (normal +z), placed by an affine

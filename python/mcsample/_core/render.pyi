@@ -1,10 +1,10 @@
 """Stub of ``mcsample._core.render``: see ``mcsample.scene`` and
 ``mcsample.rendering`` for the docs."""
 
-from typing import Callable, Sequence, final
+from typing import Any, Callable, Sequence, final
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from . import EnvMap, Phong
 
@@ -32,6 +32,8 @@ class SceneBuilder:
 class CompiledScene:
     @property
     def film(self) -> tuple[int, int]: ...
+    def sample_emitter(self, x: ArrayLike, u: ArrayLike) -> NDArray[np.float64]: ...
+    def emitter_pdf(self, x: ArrayLike, d: ArrayLike) -> Any: ...
 
 def render(
     scene: CompiledScene, spp: int, seed: int, integrator: str, strategy: str, heuristic: str,

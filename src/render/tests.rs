@@ -1,0 +1,403 @@
+//! The renderer's estimates against closed forms: a diffuse floor lit by
+//! one area light of each shape (near it, far from it and at grazing
+//! angles), by each strategy alone and by MIS; closed rooms that glow
+//! (`L / (1 − ρ)` for paths of any length); and shadow rays that reach the
+//! light samples they aim at.
+
+use glam::{Affine3A, DVec3, Quat, Vec3, Vec3A};
+
+use super::camera::{Camera, FovAxis};
+use super::integrator::{self, Escaped};
+use super::scene::{Environment, Geometry, Material, Shape};
+use super::shape::Ray;
+use super::{Heuristic, Integrator, Scene, Settings, Strategy};
+use crate::phong::{Phong, Selection};
+use crate::rng::Rng;
+
+fn diffuse(rho: f64) -> Material {
+    Material {
+        bsdf: Phong::new([rho; 3], [0.0; 3], 0.0, Selection::Max).unwrap(),
+        two_sided: false,
+    }
+}
+
+fn matrix(m: Affine3A) -> [[f64; 4]; 4] {
+    let c = m.to_cols_array();
+    std::array::from_fn(|r| {
+        std::array::from_fn(|k| match (r, k) {
+            (3, 3) => 1.0,
+            (3, _) => 0.0,
+            _ => f64::from(c[3 * k + r]),
+        })
+    })
+}
+
+fn mesh(m: Affine3A, vertices: &[[f32; 3]], faces: &[[i64; 3]]) -> Geometry {
+    let v: Vec<[f64; 3]> = vertices
+        .iter()
+        .map(|&p| m.transform_point3(Vec3::from(p)).as_dvec3().to_array())
+        .collect();
+    Geometry::mesh(&v, faces, None, true).unwrap()
+}
+
+/// Mitsuba's rectangle `[−1, 1]², z = 0`, facing +z, placed by `m`.
+fn rectangle(m: Affine3A) -> Geometry {
+    let v = [
+        [-1.0, -1.0, 0.0],
+        [1.0, -1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, 1.0, 0.0],
+    ];
+    mesh(m, &v, &[[0, 1, 2], [2, 3, 0]])
+}
+
+/// Mitsuba's cube `[−1, 1]³`, facing out, placed by `m`.
+fn cube(m: Affine3A) -> Geometry {
+    let mut v = Vec::new();
+    let mut f = Vec::new();
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let (mut a, mut b) = ((axis + 1) % 3, (axis + 2) % 3);
+            if sign < 0.0 {
+                std::mem::swap(&mut a, &mut b);
+            }
+            let base = v.len() as i64;
+            for (s, t) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                let mut p = [0.0f32; 3];
+                (p[axis], p[a], p[b]) = (sign, s, t);
+                v.push(p);
+            }
+            f.extend([[base, base + 1, base + 2], [base + 2, base + 3, base]]);
+        }
+    }
+    mesh(m, &v, &f)
+}
+
+fn camera() -> Camera {
+    Camera::new(
+        Affine3A::IDENTITY,
+        40.0,
+        FovAxis::X,
+        4,
+        4,
+        0.01,
+        100.0,
+        0.0,
+        0.0,
+    )
+    .unwrap()
+}
+
+/// A diffuse floor `z = 0` (albedo `rho`, facing +z) and `lights`.
+fn floor_scene(rho: f64, lights: Vec<Shape>) -> Scene {
+    let floor = Shape {
+        geometry: rectangle(Affine3A::from_scale(Vec3::splat(50.0))),
+        material: diffuse(rho),
+        emission: None,
+    };
+    let mut shapes = vec![floor];
+    shapes.extend(lights);
+    Scene::new(shapes, None, camera(), 4, 4).unwrap()
+}
+
+fn light(geometry: Geometry, radiance: f64) -> Shape {
+    Shape {
+        geometry,
+        material: diffuse(0.0),
+        emission: Some([radiance; 3]),
+    }
+}
+
+fn settings(integrator: Integrator, strategy: Strategy) -> Settings {
+    Settings {
+        integrator,
+        strategy,
+        heuristic: Heuristic::Power,
+        max_depth: None,
+        rr_depth: 5,
+    }
+}
+
+/// The mean and standard error of `n` samples of the (first channel of
+/// the) radiance leaving `target` toward `from`, as a camera ray sees it.
+fn estimate(scene: &Scene, from: Vec3A, target: Vec3A, s: &Settings, n: usize) -> (f64, f64) {
+    let ray = Ray {
+        o: from,
+        d: (target - from).normalize(),
+        tmax: f32::INFINITY,
+    };
+    let hit = scene.accel().intersect(&ray);
+    let mut rng = Rng::new(17, 5);
+    let mut escaped = Escaped::default();
+    let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
+    let mut l = vec![[0.0f32; 3]; 256];
+    for _ in 0..n / 256 {
+        escaped.clear();
+        for (slot, out) in l.iter_mut().enumerate() {
+            *out = integrator::radiance(scene, ray, hit, &mut rng, s, &mut escaped, slot as u32);
+        }
+        integrator::add_escaped(scene, s, &mut escaped, &mut l);
+        for v in &l {
+            sum += f64::from(v[0]);
+            sum_sq += f64::from(v[0]).powi(2);
+        }
+    }
+    let m = (n / 256 * 256) as f64;
+    let mean = sum / m;
+    (mean, ((sum_sq / m - mean * mean).max(0.0) / m).sqrt())
+}
+
+/// Irradiance at `x` (normal +z) from a convex polygon of radiance 1 facing
+/// it, above the horizon (Lambert): `½ Σ θ_i (n · normalize(a_i × a_{i+1}))`
+/// with `a_i` the unit vectors toward the vertices and `θ_i` their angles.
+fn polygon_irradiance(x: DVec3, vertices: &[DVec3]) -> f64 {
+    let a: Vec<DVec3> = vertices.iter().map(|v| (*v - x).normalize()).collect();
+    let mut sum = 0.0;
+    for i in 0..a.len() {
+        let (p, q) = (a[i], a[(i + 1) % a.len()]);
+        sum += p.angle_between(q) * p.cross(q).normalize().z;
+    }
+    0.5 * sum.abs()
+}
+
+/// The placements (affine maps of the unit shapes) of a light near the
+/// floor point at the origin (as high as it is wide), far from it (20 sizes
+/// up) and at a grazing angle (low and off to the side), each under a
+/// non-uniform scale and a rotation; flat lights face down (−z), tilted.
+fn placements() -> [(&'static str, Affine3A); 3] {
+    let down = Quat::from_rotation_x(std::f32::consts::PI) * Quat::from_rotation_z(0.5);
+    let tilt = Quat::from_rotation_y(0.3);
+    [
+        (
+            "near",
+            Affine3A::from_scale_rotation_translation(
+                Vec3::new(0.3, 0.2, 0.25),
+                tilt * down,
+                Vec3::new(0.1, 0.0, 0.55),
+            ),
+        ),
+        (
+            "far",
+            Affine3A::from_scale_rotation_translation(
+                Vec3::new(0.3, 0.2, 0.25),
+                tilt * down,
+                Vec3::new(0.5, -0.3, 6.0),
+            ),
+        ),
+        (
+            "grazing",
+            Affine3A::from_scale_rotation_translation(
+                Vec3::new(0.15, 0.1, 0.12),
+                // Facing the origin from 1.5 away, 0.2 above the floor.
+                Quat::from_rotation_y(-1.2) * Quat::from_rotation_z(0.4),
+                Vec3::new(1.5, 0.0, 0.32),
+            ),
+        ),
+    ]
+}
+
+/// The lights of every shape at one placement, each with the irradiance it
+/// gives the floor point at the origin (radiance 1).
+fn lights_at(m: Affine3A) -> Vec<(&'static str, Geometry, f64)> {
+    let corners = |m: Affine3A, face: [[f32; 3]; 4]| -> Vec<DVec3> {
+        face.iter()
+            .map(|&p| m.transform_point3(Vec3::from(p)).as_dvec3())
+            .collect()
+    };
+    let square = [
+        [-1.0, -1.0, 0.0],
+        [1.0, -1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, 1.0, 0.0],
+    ];
+    let x = DVec3::ZERO;
+    let rect_e = polygon_irradiance(x, &corners(m, square));
+    // The cube's faces that face the point (their irradiances add up).
+    let mut cube_e = 0.0;
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let mut normal = Vec3::ZERO;
+            normal[axis] = sign;
+            let face: [[f32; 3]; 4] = std::array::from_fn(|k| {
+                let (s, t) = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)][k];
+                let mut p = [0.0; 3];
+                (p[axis], p[(axis + 1) % 3], p[(axis + 2) % 3]) = (sign, s, t);
+                p
+            });
+            let world_n = (m.matrix3.inverse().transpose() * Vec3A::from(normal)).as_dvec3();
+            let center = m.transform_point3(normal).as_dvec3();
+            if world_n.dot(x - center) > 0.0 {
+                cube_e += polygon_irradiance(x, &corners(m, face));
+            }
+        }
+    }
+    // A disk by quadrature of cos θ_x cos θ_l / r² over it (smooth: the
+    // point is off its plane).
+    let disk_e = {
+        let (nr, nphi) = (400, 400);
+        let normal = (m.matrix3.inverse().transpose() * Vec3A::Z)
+            .normalize()
+            .as_dvec3();
+        let jac = f64::from(m.matrix3.x_axis.cross(m.matrix3.y_axis).length());
+        let mut sum = 0.0;
+        for i in 0..nr {
+            let r = (i as f64 + 0.5) / nr as f64;
+            for j in 0..nphi {
+                let phi = 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / nphi as f64;
+                let local = Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, 0.0);
+                let p = m.transform_point3(local).as_dvec3();
+                let to = p - x;
+                let d2 = to.length_squared();
+                let cos_x = to.z / d2.sqrt();
+                let cos_l = -normal.dot(to) / d2.sqrt();
+                sum += cos_x * cos_l / d2 * r;
+            }
+        }
+        sum * jac * 2.0 * std::f64::consts::PI / (nr * nphi) as f64
+    };
+    // A sphere of the placement's mean scale: E = π (r/d)² cos α.
+    let radius = f64::from(m.matrix3.x_axis.length());
+    let center = m.translation.as_dvec3();
+    let d = center - x;
+    let sphere_e = std::f64::consts::PI * (radius / d.length()).powi(2) * d.normalize().z;
+    vec![
+        ("rectangle", rectangle(m), rect_e),
+        ("cube", cube(m), cube_e),
+        ("disk", Geometry::disk(matrix(m)).unwrap(), disk_e),
+        (
+            "sphere",
+            Geometry::sphere(center.to_array(), radius, false).unwrap(),
+            sphere_e,
+        ),
+    ]
+}
+
+/// Every light shape at every placement, rendered by BSDF sampling,
+/// emitter sampling and MIS: the radiance of the lit floor point is
+/// `ρ/π · E` (E the irradiance in closed form or by quadrature), within 5
+/// standard errors and 0.2 %.
+#[test]
+fn direct_light_from_every_shape_matches_its_irradiance() {
+    let rho = 0.6;
+    let from = Vec3A::new(-0.01, 0.004, 0.01);
+    for (place, m) in placements() {
+        for (shape, geometry, e) in lights_at(m) {
+            let scene = floor_scene(rho, vec![light(geometry, 1.0)]);
+            let expected = rho / std::f64::consts::PI * e;
+            for strategy in [Strategy::Emitter, Strategy::Bsdf, Strategy::Mis] {
+                let n = if strategy == Strategy::Bsdf && place != "near" {
+                    1 << 21
+                } else {
+                    1 << 17
+                };
+                let s = settings(Integrator::Direct, strategy);
+                let (mean, se) = estimate(&scene, from, Vec3A::ZERO, &s, n);
+                assert!(
+                    (mean - expected).abs() < 5.0 * se + 2e-3 * expected,
+                    "{shape} {place} {strategy:?}: {mean} ± {se}, expected {expected}"
+                );
+                assert!(
+                    se < 0.05 * expected,
+                    "{shape} {place} {strategy:?}: se {se}"
+                );
+            }
+        }
+    }
+}
+
+/// From a receiver at any distance and angle, the shadow ray toward a
+/// light sample is never blocked by the light itself or by the receiver's
+/// own surface (nothing else is in the scene).
+#[test]
+fn shadow_rays_reach_the_light_samples() {
+    for (place, m) in placements() {
+        for (shape, geometry, _) in lights_at(m) {
+            let scene = floor_scene(0.5, vec![light(geometry, 1.0)]);
+            let mut rng = Rng::new(3, 1);
+            let (mut reached, mut drawn) = (0, 0);
+            for i in 0..4000 {
+                let k = i as f32;
+                let p = Vec3A::new((k * 0.37).sin() * 2.0, (k * 0.91).cos() * 2.0, 0.0);
+                let u = [rng.next_float(), rng.next_float(), rng.next_float()];
+                let Some(ls) = scene.sample_light(p, u, None::<fn() -> u64>) else {
+                    continue;
+                };
+                if ls.d.z <= 0.0 {
+                    continue;
+                }
+                drawn += 1;
+                let ray = integrator::shadow_ray(p, Vec3A::Z, &ls);
+                reached += usize::from(!scene.accel().occluded(&ray));
+            }
+            assert!(drawn > 500, "{shape} {place}: {drawn} samples");
+            assert_eq!(reached, drawn, "{shape} {place}");
+        }
+    }
+}
+
+/// A closed room that glows: inside a sphere of radiance `L` and albedo
+/// `ρ` (normals inward), every point sees `L (1 + ρ + … + ρ^(k−1))` with
+/// paths of at most `k` segments, `L / (1 − ρ)` with any length (Russian
+/// roulette from depth 2), by every strategy.
+#[test]
+fn glowing_room_sums_its_bounces() {
+    let (rho, l) = (0.6, 0.5);
+    let room = Shape {
+        geometry: Geometry::sphere([0.0, 0.0, 0.0], 1.0, true).unwrap(),
+        material: diffuse(rho),
+        emission: Some([l; 3]),
+    };
+    let scene = Scene::new(vec![room], None, camera(), 4, 4).unwrap();
+    let from = Vec3A::new(0.1, 0.2, -0.3);
+    for strategy in [Strategy::Emitter, Strategy::Bsdf, Strategy::Mis] {
+        for (max_depth, expected) in [
+            (Some(1), l),
+            (Some(2), l * (1.0 + rho)),
+            (Some(4), l * (1.0 + rho + rho * rho + rho * rho * rho)),
+            (None, l / (1.0 - rho)),
+        ] {
+            let s = Settings {
+                max_depth,
+                rr_depth: 2,
+                ..settings(Integrator::Path, strategy)
+            };
+            let (mean, se) = estimate(&scene, from, Vec3A::new(1.0, 0.5, 0.2), &s, 1 << 16);
+            assert!(
+                (mean - expected).abs() < 5.0 * se + 1e-4 * expected,
+                "{strategy:?} max_depth {max_depth:?}: {mean} ± {se}, expected {expected}"
+            );
+        }
+    }
+}
+
+/// Under a constant environment of radiance `L` and nothing else, a
+/// diffuse floor reflects `ρ L` by every strategy (BSDF sampling with no
+/// variance at all).
+#[test]
+fn floor_under_a_constant_sky_reflects_its_albedo() {
+    let rho = 0.7;
+    let floor = Shape {
+        geometry: rectangle(Affine3A::from_scale(Vec3::splat(50.0))),
+        material: diffuse(rho),
+        emission: None,
+    };
+    let scene = Scene::new(
+        vec![floor],
+        Some(Environment::Constant([1.5; 3])),
+        camera(),
+        4,
+        4,
+    )
+    .unwrap();
+    for strategy in [Strategy::Emitter, Strategy::Bsdf, Strategy::Mis] {
+        let s = settings(Integrator::Direct, strategy);
+        let (mean, se) = estimate(&scene, Vec3A::new(0.0, 0.3, 1.0), Vec3A::ZERO, &s, 1 << 16);
+        assert!(
+            (mean - rho * 1.5).abs() < 5.0 * se + 1e-5,
+            "{strategy:?}: {mean} ± {se}"
+        );
+        if strategy == Strategy::Bsdf {
+            assert!(se < 1e-6, "{se}");
+        }
+    }
+}
