@@ -102,6 +102,7 @@ fn main() {
                 heuristic: Heuristic::Power,
                 max_depth: None,
                 rr_depth: 5,
+                hide_emitters: false,
             };
             let mut times: Vec<f64> = (0..5)
                 .map(|seed| {

@@ -113,16 +113,18 @@ def transform(translate=(0.0, 0.0, 0.0), rotate=(), scale=(1.0, 1.0, 1.0)) -> np
 
 
 #: Where an area light sits over the floor y = 0: its centre, its size (the
-#: largest half-extent) and the turn that faces a flat light (Mitsuba's
-#: rectangle and disk face +z) toward the floor.
+#: largest half-extent), the turn that faces a flat light (Mitsuba's
+#: rectangle and disk face +z) toward the floor, its radiance, and the
+#: camera (origin, target) that frames the floor it lights:
 #: - near: as high as it is wide;
 #: - far: 15 sizes up;
 #: - grazing: low beside the lit part of the floor, facing along it (10°
 #:   down), so that light reaches the floor at grazing angles.
 LIGHT_PLACES = {
-    "near": ((0.0, 0.3, 0.0), 0.25, [("x", 90.0)]),
-    "far": ((0.0, 3.0, 0.0), 0.2, [("x", 90.0)]),
-    "grazing": ((-1.4, 0.2, 0.0), 0.2, [("y", 90.0), ("z", -10.0)]),
+    "near": ((0.0, 0.4, 0.0), 0.25, [("x", 90.0)], 4.0, ((0.4, 1.3, 1.1), (0.0, 0.0, 0.0))),
+    "far": ((0.0, 3.0, 0.0), 0.2, [("x", 90.0)], 60.0, ((0.3, 2.4, 2.0), (0.0, 0.0, 0.0))),
+    "grazing": ((-1.4, 0.3, 0.0), 0.2, [("y", 90.0), ("z", -10.0)], 12.0,
+                ((-0.1, 1.6, 1.4), (-0.7, 0.0, 0.0))),
 }
 
 LIGHT_SHAPES = ("rectangle", "disk", "sphere", "cube", "mesh")
@@ -131,32 +133,53 @@ LIGHT_SHAPES = ("rectangle", "disk", "sphere", "cube", "mesh")
 def area_light(shape: str, place: str, radiance: float = 1.0) -> dict:
     """An area light of ``shape`` at ``place`` (:data:`LIGHT_PLACES`),
     under a non-uniform scale and a turn about its own axis (a sphere,
-    which takes a uniform scale only, is placed by centre and radius).
-    Its radiance is scaled with the square of the distance over its size,
-    so that the floor under it is lit alike in every place."""
-    center, size, turn = LIGHT_PLACES[place]
-    emitter = {"type": "area", "radiance": radiance * (max(center[1], 0.3) / size) ** 2 / 4}
+    which takes a uniform scale only, is placed by centre and radius); a
+    mesh (an icosphere) has face normals, as Mitsuba's sampling of a mesh
+    light uses the interpolated normal where it has vertex normals.
+    ``radiance`` scales the place's own."""
+    center, size, turn, place_radiance, _ = LIGHT_PLACES[place]
+    emitter = {"type": "area", "radiance": radiance * place_radiance}
     bsdf = {"type": "diffuse", "reflectance": 0.3}
     if shape == "sphere":
         return {"type": "sphere", "center": list(center), "radius": size * 0.6,
                 "emitter": emitter, "bsdf": bsdf}
     flat = shape in ("rectangle", "disk")
-    scale = (size, 0.6 * size, 1.0) if flat else (size, 0.6 * size, 0.8 * size)
+    scale = (size, 0.6 * size, 1.0) if flat else (size, 0.6 * size, 0.7 * size)
     rotate = [("z", 30.0)] + (turn if flat else [("x", 20.0), ("y", 35.0)])
     m = transform(center, rotate, scale)
     if shape == "mesh":
         v, f = icosphere(1)
         v = v @ m[:3, :3].T + m[:3, 3]
-        return {"type": "mesh", "vertices": v, "faces": f, "emitter": emitter, "bsdf": bsdf}
+        return {"type": "mesh", "vertices": v, "faces": f, "face_normals": True,
+                "emitter": emitter, "bsdf": bsdf}
     return {"type": shape, "to_world": m, "emitter": emitter, "bsdf": bsdf}
 
 
 def area_lit_floor(shape: str, place: str, width: int = 32, height: int = 24) -> dict:
     """A diffuse floor lit by one area light (:func:`area_light`), seen
     from above so that the lit floor fills the frame."""
-    target = (0.0, 0.0, 0.0) if place != "grazing" else (-0.4, 0.0, 0.0)
+    origin, target = LIGHT_PLACES[place][4]
     return {"type": "scene",
-            "sensor": sensor(origin=(target[0] + 0.3, 2.4, 2.0), target=target, fov=50.0,
-                             width=width, height=height),
+            "sensor": sensor(origin=origin, target=target, fov=45.0, width=width,
+                             height=height),
             "floor": ground(size=6.0, reflectance=0.6),
             "light": area_light(shape, place)}
+
+
+def lit_room(strategy_light: str = "rectangle", width: int = 32, height: int = 24) -> dict:
+    """A closed room (the cube [-1, 1]³ seen from inside, diffuse walls)
+    lit only by a small light near the ceiling that faces it: the room is
+    lit by what the ceiling reflects, so every path has three segments or
+    more."""
+    room = {"type": "cube", "flip_normals": True,
+            "bsdf": {"type": "diffuse", "reflectance": [0.7, 0.6, 0.5]}}
+    light = dict(area_light(strategy_light, "near", radiance=5.0))
+    if strategy_light in ("rectangle", "disk"):
+        # Facing up, 0.2 under the ceiling.
+        light["to_world"] = transform((0.1, 0.8, -0.2), [("x", -90.0), ("z", 20.0)],
+                                      (0.15, 0.1, 1.0))
+    return {"type": "scene",
+            "sensor": sensor(origin=(0.0, -0.2, 0.95), target=(0.0, 0.1, -1.0), fov=70.0,
+                             width=width, height=height),
+            "integrator": {"type": "path", "max_depth": 6, "hide_emitters": True},
+            "room": room, "light": light}

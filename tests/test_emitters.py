@@ -26,12 +26,12 @@ from mcsample import stats
 from scenes import LIGHT_SHAPES, area_light, sensor
 
 #: Receiver points around the light of ``area_light(shape, "near")``
-#: (centre (0, 0.3, 0), half-size 0.25; flat lights face down, -y):
+#: (centre (0, 0.4, 0), half-size 0.25; flat lights face down, -y):
 #: below it, far away, and almost in the plane of a flat light.
 RECEIVERS = {
     "near": (0.05, 0.0, 0.1),
     "far": (2.0, -3.0, 1.5),
-    "grazing": (1.2, 0.27, 0.4),
+    "grazing": (1.2, 0.37, 0.4),
 }
 
 N = 400_000

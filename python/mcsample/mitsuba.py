@@ -153,11 +153,14 @@ def register_phong() -> str:
 
 def render_reference(scene: "Scene", spp: int, seed: int = 0, integrator: str | None = None,
                      max_depth: int | None = None, rr_depth: int | None = None,
-                     variant: str | None = None) -> "RenderResult":
+                     variant: str | None = None,
+                     hide_emitters: bool | None = None) -> "RenderResult":
     """Renders ``scene`` in Mitsuba 3 (``variant``: default
     :func:`choose_variant`) with its ``path`` or ``direct`` integrator
     wrapped in ``moment``, so each pixel comes with the variance of its mean
-    luminance. The film uses a box filter, as mcsample's.
+    luminance. The film uses a box filter, as mcsample's. ``integrator``,
+    ``max_depth``, ``rr_depth`` and ``hide_emitters`` default to the scene
+    dict's integrator, as in :func:`mcsample.render`.
 
     Returns a :class:`mcsample.RenderResult` whose ``variance`` is None
     (Mitsuba reports moments in XYZ, from which per-RGB-channel variances
@@ -172,7 +175,9 @@ def render_reference(scene: "Scene", spp: int, seed: int = 0, integrator: str | 
     kind = integrator or defaults.get("integrator", "path")
     if kind not in ("path", "direct"):
         raise ValueError(f"integrator = {kind!r}: must be 'path' or 'direct'")
-    nested: dict = {"type": kind}
+    nested: dict = {"type": kind,
+                    "hide_emitters": bool(hide_emitters if hide_emitters is not None
+                                          else defaults.get("hide_emitters", False))}
     if kind == "path":
         nested["max_depth"] = int(max_depth if max_depth is not None
                                   else defaults.get("max_depth", -1))

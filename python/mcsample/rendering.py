@@ -71,7 +71,8 @@ def _progress_bar(total: int, enabled: bool) -> tuple[Callable[[int], None] | No
 
 def render(scene: Scene, spp: int | None = None, integrator: str | None = None,
            strategy: str = "mis", heuristic: str = "power", max_depth: int | None = None,
-           rr_depth: int | None = None, seed: int = 0, progress: bool = True) -> RenderResult:
+           rr_depth: int | None = None, seed: int = 0, progress: bool = True,
+           hide_emitters: bool | None = None) -> RenderResult:
     """Renders ``scene`` with ``spp`` samples per pixel.
 
     Parameters
@@ -100,6 +101,10 @@ def render(scene: Scene, spp: int | None = None, integrator: str | None = None,
         The same seed gives the same image whatever the thread count.
     progress : bool
         Show a progress bar for renders that take longer than a second.
+    hide_emitters : bool, optional
+        Leave out emitters seen straight from the camera (area lights and
+        the environment), as Mitsuba's ``hide_emitters``. Default: the
+        scene dict's integrator, else False.
 
     Returns
     -------
@@ -113,13 +118,15 @@ def render(scene: Scene, spp: int | None = None, integrator: str | None = None,
     integrator = integrator or defaults.get("integrator", "path")
     max_depth = int(max_depth if max_depth is not None else defaults.get("max_depth", -1))
     rr_depth = int(rr_depth if rr_depth is not None else defaults.get("rr_depth", 5))
+    hide = bool(hide_emitters if hide_emitters is not None
+                else defaults.get("hide_emitters", False))
     width, height = scene.size
     compiled = scene.compiled
     callback, bar = _progress_bar(width * height * max(spp, 1), progress)
     start = time.perf_counter()
     try:
         image, variance, lum_var = _render(compiled, spp, seed, integrator, strategy, heuristic,
-                                  max_depth, rr_depth, callback)
+                                  max_depth, rr_depth, hide, callback)
     finally:
         if bar is not None:
             bar.close()

@@ -22,7 +22,7 @@ The subset (anything else raises ValueError naming the key):
   and ``thinlens`` (also aperture_radius, focus_distance), with an
   ``hdrfilm`` (width, height, box ``rfilter``) and an ``independent``
   sampler (sample_count: the default spp).
-- ``integrator``: ``path`` or ``direct`` (max_depth, rr_depth): the
+- ``integrator``: ``path`` or ``direct`` (max_depth, rr_depth, hide_emitters): the
   defaults of :func:`mcsample.render`.
 
 Colours are a float, an RGB triple or ``{"type": "rgb", "value": ...}``.
@@ -449,11 +449,11 @@ class Scene:
                 camera = _camera(value, key)
             elif kind in ("path", "direct"):
                 _check_keys(value, {"max_depth", "rr_depth", "hide_emitters"}, key)
-                if value.get("hide_emitters", False):
-                    raise ValueError(f"{key}.hide_emitters: not supported by mcsample")
                 integrator = {"integrator": kind,
                               **{k: int(value[k]) for k in ("max_depth", "rr_depth")
                                  if k in value}}
+                if "hide_emitters" in value:
+                    integrator["hide_emitters"] = bool(value["hide_emitters"])
             elif kind in ("diffuse", "mcsample_phong", "twosided"):
                 continue  # a top-level bsdf, referenced by id
             else:

@@ -294,7 +294,7 @@ fn choice<T: Copy>(arg: &str, value: &str, options: &[(&str, T)]) -> PyResult<T>
 /// as Ctrl-C) stops the render and is raised once its threads have stopped.
 #[pyfunction]
 #[allow(clippy::type_complexity)]
-#[pyo3(signature = (scene, spp, seed, integrator, strategy, heuristic, max_depth, rr_depth, callback = None))]
+#[pyo3(signature = (scene, spp, seed, integrator, strategy, heuristic, max_depth, rr_depth, hide_emitters = false, callback = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -306,6 +306,7 @@ pub fn render<'py>(
     heuristic: &str,
     max_depth: i64,
     rr_depth: &Bound<'py, PyAny>,
+    hide_emitters: bool,
     callback: Option<Bound<'py, PyAny>>,
 ) -> PyResult<(
     Bound<'py, PyArray1<f32>>,
@@ -346,6 +347,7 @@ pub fn render<'py>(
         )?,
         max_depth,
         rr_depth,
+        hide_emitters,
     };
     let scene = Arc::clone(&scene.get().0);
     let progress = Arc::new(Progress::default());

@@ -11,7 +11,8 @@
 //! under MIS, 1 under BSDF sampling and 0 under emitter sampling (which
 //! counts it through next-event estimation instead); next-event estimation
 //! adds `β f_r cos θ Le / p_light · h(p_light, p_bsdf)`, with `h = 1` under
-//! emitter sampling. Emission seen straight from the camera always counts.
+//! emitter sampling. Emission seen straight from the camera counts unless
+//! `hide_emitters`.
 //! Path lengths follow Mitsuba's `max_depth`: 1 is emission only, 2 direct
 //! illumination, −1 unbounded.
 
@@ -67,6 +68,10 @@ pub struct Settings {
     pub max_depth: Option<u32>,
     /// Russian roulette starts at this depth (path only).
     pub rr_depth: u32,
+    /// Whether emitters seen straight from the camera are left out, as by
+    /// Mitsuba's `hide_emitters`: camera rays pass through area lights
+    /// ([`skip_emitters`]) and see no environment.
+    pub hide_emitters: bool,
 }
 
 impl Settings {
@@ -201,6 +206,24 @@ pub fn add_escaped(scene: &Scene, settings: &Settings, escaped: &mut Escaped, l:
     }
 }
 
+/// The first hit of the camera ray `ray` (whose first hit is `hit`) that
+/// is not on an area light: the ray passes through them (re-spawned past
+/// each, as Mitsuba's `hide_emitters` does), and `ray` is updated to the
+/// last spawn.
+pub fn skip_emitters(scene: &Scene, ray: &mut Ray, mut hit: Option<Hit>) -> Option<Hit> {
+    while let Some(h) = hit {
+        let shape = scene.accel().shape_of(h.primitive);
+        if !scene.is_emitter(shape) {
+            break;
+        }
+        let primitive = &scene.accel().primitives()[h.primitive as usize];
+        let sp = primitive.point(ray.o + ray.d * h.t, h.bary);
+        ray.o = offset(sp.p, sp.ng, ray.d);
+        hit = scene.accel().intersect(ray);
+    }
+    hit
+}
+
 /// The radiance arriving at the camera along `ray`, whose first hit
 /// ([`super::accel::Accel::intersect`]) is `hit`: one sample of the
 /// estimator above, drawing its random numbers from `rng`. Light from the
@@ -222,7 +245,7 @@ pub fn radiance(
     match hit {
         Some(hit) => path(scene, ray, hit, rng, settings, escaped, slot),
         None => {
-            if scene.environment().is_some() {
+            if scene.environment().is_some() && !settings.hide_emitters {
                 escaped.push(slot, ray.d, [1.0; 3], None);
             }
             [0.0; 3]

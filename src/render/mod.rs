@@ -128,8 +128,14 @@ impl Batch {
         self.rays.resize(self.camera_u.len(), Ray::default());
         scene.camera().rays_into(&self.camera_u, &mut self.rays);
         self.hits.clear();
-        self.hits
-            .extend(self.rays.iter().map(|ray| scene.accel().intersect(ray)));
+        self.hits.extend(self.rays.iter_mut().map(|ray| {
+            let hit = scene.accel().intersect(ray);
+            if settings.hide_emitters {
+                integrator::skip_emitters(scene, ray, hit)
+            } else {
+                hit
+            }
+        }));
         let spp = spp.max(1) as usize;
         let per_pixel = self.rays.chunks(spp).zip(self.hits.chunks(spp));
         for (mut rng, (rays, hits)) in rngs.into_iter().zip(per_pixel) {

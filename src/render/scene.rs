@@ -313,6 +313,12 @@ impl Scene {
         self.environment.as_ref()
     }
 
+    /// Whether shape `shape` is an area light.
+    #[inline]
+    pub fn is_emitter(&self, shape: u32) -> bool {
+        self.emission[shape as usize].is_some()
+    }
+
     /// Radiance emitted by shape `shape` at a point with geometric normal
     /// `ng` toward `w` (unit, away from the surface): its radiance on the
     /// front side, 0 behind it or for a shape that does not emit.

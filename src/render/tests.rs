@@ -115,6 +115,7 @@ fn settings(integrator: Integrator, strategy: Strategy) -> Settings {
         heuristic: Heuristic::Power,
         max_depth: None,
         rr_depth: 5,
+        hide_emitters: false,
     }
 }
 

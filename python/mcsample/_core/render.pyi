@@ -37,5 +37,6 @@ class CompiledScene:
 
 def render(
     scene: CompiledScene, spp: int, seed: int, integrator: str, strategy: str, heuristic: str,
-    max_depth: int, rr_depth: int, callback: Callable[[int], object] | None = None,
+    max_depth: int, rr_depth: int, hide_emitters: bool = False,
+    callback: Callable[[int], object] | None = None,
 ) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32]]: ...

@@ -137,6 +137,10 @@ class RenderZTestResult:
         Per-pixel z-scores, for maps (0 on noise-free pixels); not tested.
     relative_difference : float
         (mean of image) / (mean of reference) − 1.
+    relative_se : float
+        The standard error of the whole-image difference over the
+        reference's mean: the test finds a bias everywhere of about
+        ``(threshold + 2) * relative_se`` or more (with 98 % power).
     """
 
     passed: bool
@@ -145,6 +149,7 @@ class RenderZTestResult:
     threshold: float
     z: np.ndarray
     relative_difference: float
+    relative_se: float
     messages: list[str] = field(default_factory=list)
 
     @property
@@ -241,10 +246,11 @@ def render_ztest(image: Any, reference: Any, block: int = 8, alpha: float = 1e-3
     worst = float(np.nanmax(np.abs(block_z)))
     ref_mean = float(b.mean())
     relative = float(a.mean() / ref_mean - 1.0) if ref_mean != 0 else float("nan")
+    relative_se = float(np.sqrt(var.sum()) / b.size / abs(ref_mean)) if ref_mean else float("nan")
     quiet = int(np.count_nonzero(~noisy))
     messages = [
         f"whole image: z = {mean_z:.3g} (means {a.mean():.6g} and {ref_mean:.6g}, "
-        f"relative difference {relative:+.3%})",
+        f"relative difference {relative:+.3%} ± {relative_se:.3%})",
         f"blocks of {block}x{block}: largest |z| = {worst:.3g} of {tests - 1}; "
         f"threshold {threshold:.3g} (alpha {alpha:g} over {tests} z-tests)",
         f"{quiet} noise-free pixels compared with rtol {rtol:g}",
@@ -259,4 +265,5 @@ def render_ztest(image: Any, reference: Any, block: int = 8, alpha: float = 1e-3
     if not np.allclose(a[~noisy], b[~noisy], rtol=rtol, atol=1e-6):
         failures.append(f"noise-free pixels differ by more than rtol {rtol:g}")
     messages.extend(f"FAILED: {f}" for f in failures)
-    return RenderZTestResult(not failures, mean_z, block_z, threshold, z, relative, messages)
+    return RenderZTestResult(not failures, mean_z, block_z, threshold, z, relative, relative_se,
+                             messages)
