@@ -3,9 +3,12 @@
 - :func:`chi2_test`: Pearson's chi-square goodness of fit of a sampler
   against its density, by the method of Mitsuba 3's ``mitsuba.chi2``: map the
   samples to a 2D parameter box, histogram them, integrate the density over
-  each cell (trapezoid rule, ``ires`` points per cell and axis), pool cells
+  each cell (trapezoid rule, ``ires`` points per cell and axis, or unbiased
+  jittered integration for densities that jump inside cells), pool cells
   with an expected count below 5, and compare the p-value with a
-  Šidák-corrected significance level.
+  Šidák-corrected significance level; the test runs on the histogram and
+  on two coarser ones (8×8 and 32×32 cells merged), which find a small
+  error spread over a large part of the domain that the fine one misses.
 - :func:`two_sample_test`: the chi-square test of homogeneity of two samplers
   that have no density.
 - image comparison: :func:`mse`, :func:`relmse`, :func:`image_ztest`, and
