@@ -38,7 +38,8 @@ each target runs in its own ``pytest -q -x`` and the first failure stops the
 bug's Python stage.
 
 Exit status: 0 only if every bug is caught; 1 otherwise; 2 when the campaign
-cannot run (or ``--check`` finds a defect).
+cannot go on (or ``--check`` finds a defect); 130 on Ctrl-C. An interrupted
+or aborted campaign still reports the bugs it finished.
 """
 
 from __future__ import annotations
@@ -589,8 +590,10 @@ class Stages:
 # --------------------------------------------------------------------------
 
 RUST, PYTHON, MISSED = "rust", "python", "MISSED"
-CAUGHT_BY_COMPILER, SNIPPET_MISSING, CAMPAIGN_ERROR = (
+DOES_NOT_COMPILE, SNIPPET_MISSING, CAMPAIGN_ERROR = (
     "compile-error", "snippet-missing", "campaign-error")
+#: What a plant that fails in one of these ways is: a defect of the campaign.
+DEFECTS = (DOES_NOT_COMPILE, SNIPPET_MISSING, CAMPAIGN_ERROR)
 
 
 @dataclass(frozen=True)
@@ -602,7 +605,7 @@ class Result:
 
     @property
     def caught(self) -> bool:
-        return self.caught_by not in (MISSED, CAUGHT_BY_COMPILER, SNIPPET_MISSING, CAMPAIGN_ERROR)
+        return self.caught_by != MISSED and self.caught_by not in DEFECTS
 
 
 @contextmanager
@@ -615,8 +618,11 @@ def scratch_worktree() -> Iterator[Path]:
     try:
         yield worktree
     finally:
-        git("worktree", "remove", "--force", str(worktree), check=False)
-        git("worktree", "prune", check=False)
+        try:
+            git("worktree", "remove", "--force", str(worktree))
+        except CampaignAbort as e:
+            print(f"warning: {e}\n(remove it by hand: git worktree remove --force {worktree})",
+                  file=sys.stderr)
         shutil.rmtree(tmp, ignore_errors=True)
 
 
@@ -646,7 +652,7 @@ def run_bug(bug: Bug, stages: Stages, keep_going: bool) -> Result:
                 continue
             outcome = run_stage(tests, bug.id)
             if outcome.kind == COMPILE_ERROR:
-                return result(CAUGHT_BY_COMPILER, f"{name}: {outcome.detail}")
+                return result(DOES_NOT_COMPILE, f"{name}: {outcome.detail}")
             if outcome.kind == ERROR:
                 return result(CAMPAIGN_ERROR, f"{name}: {outcome.detail}")
             if outcome.kind == CAUGHT:
@@ -665,16 +671,17 @@ def baseline(bugs: list[Bug], stages: Stages) -> None:
     targets = tuple(dict.fromkeys(t for bug in bugs for t in bug.pytest))
     print(f"baseline: {len(filters)} cargo filters, {len(targets)} pytest targets on HEAD",
           flush=True)
-    for outcome in (stages.rust(filters, "baseline"), stages.python(targets, "baseline")):
+    for name, tests, run_stage in ((RUST, filters, stages.rust), (PYTHON, targets, stages.python)):
+        outcome = run_stage(tests, "baseline") if tests else Outcome(PASSED)
         if outcome.kind != PASSED:
-            raise CampaignAbort(f"the baseline (HEAD, no bug) does not pass: "
+            raise CampaignAbort(f"the baseline (HEAD, no bug) does not pass: {name}: "
                                 f"{outcome.kind}: {outcome.detail}")
 
 
 def announce(index: int, total: int, result: Result) -> None:
     line = (f"[{index}/{total}] {result.bug.id}: {result.caught_by}"
             f" ({format_seconds(result.seconds)}) {result.detail}")
-    if result.caught_by in (CAUGHT_BY_COMPILER, SNIPPET_MISSING, CAMPAIGN_ERROR):
+    if result.caught_by in DEFECTS:
         banner = "!" * 78
         line = (f"{banner}\n{line}\n!!! {result.caught_by}: a defect of the campaign, not a "
                 f"catch; fix the plant (logs in {LOG_DIR})\n{banner}")
@@ -686,7 +693,7 @@ def campaign(bugs: list[Bug], args: argparse.Namespace) -> int:
     print(f"planted-bug campaign: {len(bugs)} bugs at {commit}; target dir {TARGET_DIR}, "
           f"venv {VENV}, logs {LOG_DIR}", flush=True)
     results: list[Result] = []
-    interrupted = False
+    status = None
     try:
         with scratch_worktree() as worktree:
             stages = Stages(worktree, args.timeout * 60)
@@ -697,14 +704,15 @@ def campaign(bugs: list[Bug], args: argparse.Namespace) -> int:
                 announce(index, len(bugs), results[-1])
     except CampaignAbort as e:
         print(f"\ncampaign aborted: {e}", file=sys.stderr)
-        return 2
+        status = 2
     except KeyboardInterrupt:
-        interrupted = True
-        print("\ninterrupted: the results so far", file=sys.stderr)
-    report(results, commit, args.report)
-    if interrupted:
-        return 130
-    return 0 if len(results) == len(bugs) and all(r.caught for r in results) else 1
+        print("\ninterrupted", file=sys.stderr)
+        status = 130
+    if results:
+        report(results, commit, args.report)
+    if status is not None:
+        return status
+    return 0 if all(r.caught for r in results) else 1
 
 
 # --------------------------------------------------------------------------
