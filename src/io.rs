@@ -193,7 +193,18 @@ pub fn tonemap(linear: f32, exposure: f32, srgb: bool) -> u8 {
 /// [`Error::Element`] naming the first NaN sample; [`Error::Io`] if the file
 /// cannot be written.
 pub fn write_png(path: &Path, image: &Raster, exposure: f32, srgb: bool) -> Result<()> {
-    image.check(path)?;
+    let bytes = encode_png(path, image, exposure, srgb)?;
+    std::fs::write(path, bytes).map_err(|e| io_error(path, format!("cannot write PNG: {e}")))
+}
+
+/// The PNG file [`write_png`] writes, in memory (`name` only names the
+/// image in error messages).
+///
+/// # Errors
+/// [`Error::Element`] naming the first NaN sample; [`Error::Io`] for a
+/// raster of the wrong size.
+pub fn encode_png(name: &Path, image: &Raster, exposure: f32, srgb: bool) -> Result<Vec<u8>> {
+    image.check(name)?;
     if let Some(i) = image.data.iter().position(|v| v.is_nan()) {
         let c = image.channels;
         let (pixel, ch) = (i / c, i % c);
@@ -221,15 +232,16 @@ pub fn write_png(path: &Path, image: &Raster, exposure: f32, srgb: bool) -> Resu
     } else {
         image::ExtendedColorType::Rgb8
     };
-    image::save_buffer_with_format(
-        path,
+    let mut png = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut png),
         &bytes,
         image.width as u32,
         image.height as u32,
         color,
-        image::ImageFormat::Png,
     )
-    .map_err(|e| io_error(path, format!("cannot write PNG: {e}")))
+    .map_err(|e| io_error(name, format!("cannot encode PNG: {e}")))?;
+    Ok(png)
 }
 
 #[cfg(test)]

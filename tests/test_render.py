@@ -78,7 +78,7 @@ def test_mesh_vertex_normals_match_mitsubas(mi, tmp_path):
     v, f = icosphere(1)
     v = v * np.array([1.0, 0.6, 1.3])  # not a sphere: normals differ from positions
     path = tmp_path / "blob.ply"
-    mcs.scene.write_ply(str(path), v, f)
+    mcs.io.write_ply(str(path), v, f)
     mesh = mi.load_dict({"type": "ply", "filename": str(path)})
     theirs = np.array(mesh.vertex_normals_buffer()).reshape(-1, 3)
     # mcsample computes them in Rust; recompute here with the same rule.
@@ -99,7 +99,7 @@ def test_mesh_vertex_normals_match_mitsubas(mi, tmp_path):
 def test_mesh_from_arrays_ply_and_obj_render_alike(tmp_path):
     v, f = icosphere(2)
     v = v * 0.6 + [0, 0.6, 0]
-    mcs.scene.write_ply(str(tmp_path / "s.ply"), v, f)
+    mcs.io.write_ply(str(tmp_path / "s.ply"), v, f)
     with open(tmp_path / "s.obj", "w") as fh:
         fh.writelines(f"v {a} {b} {c}\n" for a, b, c in v)
         fh.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f)

@@ -49,7 +49,7 @@ def _angular_sky():
 def _scene_dicts(tmp_path):
     v, f = icosphere(3)
     path = tmp_path / "blob.ply"
-    mcs.scene.write_ply(str(path), v * [0.6, 0.45, 0.6] + [0, 0.45, 0], f)
+    mcs.io.write_ply(str(path), v * [0.6, 0.45, 0.6] + [0, 0.45, 0], f)
     return {
         "diffuse sphere, default sky": diffuse_sphere_under_sky(),
         "phong spheres n = 1..1000, sky with sun": phong_spheres(),

@@ -14,7 +14,7 @@ from mcsample import warp
     ("libLLVM-14.so.1", 14), ("libc.so.6", None),
 ])
 def test_llvm_version_from_file_name(name, major):
-    assert mcs_mitsuba._llvm_major("/usr/lib/" + name) == major
+    assert mcs_mitsuba.variant._llvm_major("/usr/lib/" + name) == major
 
 
 def test_llvm_variant_chosen_when_a_new_libllvm_exists():

@@ -7,7 +7,8 @@ steradian on directions, +z normal) are in the README.
 """
 
 from . import data, distr, estimators, io, mis, mitsuba, plot, stats, warp
-from .rendering import RenderResult, render
+from .rendering import render
+from .results import EmitterSample, RenderResult
 from .scene import Scene, look_at
 from ._core import (
     EnvMap,
@@ -31,6 +32,7 @@ from .distr import (
 )
 
 __all__ = [
+    "EmitterSample",
     "EnvMap",
     "RenderResult",
     "Scene",

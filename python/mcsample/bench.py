@@ -10,7 +10,6 @@ samples per second. Later issues add their cases to :data:`SUITES`.
 from __future__ import annotations
 
 import statistics
-import tempfile
 import time
 from typing import Callable, NamedTuple
 
@@ -469,12 +468,11 @@ def suite_render(n: int, repeat: int, mi, spp: int = 64) -> list[Timing]:
     repeat = min(repeat, 3)
     for name, d in _render_scenes().items():
         scene = mcs.Scene.from_mitsuba(d)
-        w, h = scene.size
+        h, w = scene.shape
         samples = w * h * spp
         mi_scene = None
         if mi is not None:
-            with tempfile.TemporaryDirectory(prefix="mcsample-scene-") as directory:
-                mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp, directory=directory))
+            mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp))
         for integrator in ("direct", "path"):
             case = f"render {name}, {integrator}"
             runs = [("mcsample", lambda: mcs.render(scene, spp, integrator=integrator,
@@ -507,7 +505,7 @@ def suite_convergence(n: int, repeat: int, mi, target: float = 0.01, spp: int = 
     from .demo import demo_scene
 
     scene = mcs.Scene.from_mitsuba(demo_scene(240, 90))
-    w, h = scene.size
+    h, w = scene.shape
 
     def render(strategy: str, count: int, seed: int):
         return mcs.render(scene, count, integrator="direct", strategy=strategy, seed=seed,
@@ -520,8 +518,7 @@ def suite_convergence(n: int, repeat: int, mi, target: float = 0.01, spp: int = 
         seconds = measure(lambda strategy=strategy: render(strategy, spp, 3), repeat, 1)
         runs[f"mcsample {strategy}"] = (render(strategy, spp, 4).image, seconds)
     if mi is not None:
-        with tempfile.TemporaryDirectory(prefix="mcsample-scene-") as directory:
-            mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp, directory=directory))
+        mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp))
         mi_int = mi.load_dict({"type": "direct"})
         seconds = measure(lambda: np.asarray(mi.render(mi_scene, integrator=mi_int, spp=spp)),
                           repeat, 2)

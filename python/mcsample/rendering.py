@@ -9,55 +9,25 @@ KeyboardInterrupt.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
-from typing import Any, Callable
-
-import numpy as np
+import warnings
+from typing import Any, Callable, Literal
 
 from ._core.render import render as _render
+from .results import RenderResult
 from .scene import Scene
-from .stats import luminance
+from .seeds import SeedLike, resolve_seed
 
 __all__ = ["RenderResult", "render"]
-
-
-@dataclass
-class RenderResult:
-    """A rendered image.
-
-    Attributes
-    ----------
-    image : ndarray (H, W, 3) float32
-        Mean radiance per pixel (linear RGB, row 0 at the top).
-    variance : ndarray (H, W, 3) float32, or None
-        Variance of each pixel's mean (sample variance / spp; inf for
-        spp = 1). None for Mitsuba references, whose moments come in XYZ.
-    luminance_variance : ndarray (H, W) float32
-        Variance of each pixel's mean luminance (Rec. 709 Y), the quantity
-        compared with Mitsuba (whose moment integrator reports it).
-    spp : int
-        Samples per pixel.
-    seconds : float
-        Wall-clock time of the render.
-    """
-
-    image: np.ndarray
-    variance: np.ndarray | None
-    luminance_variance: np.ndarray
-    spp: int
-    seconds: float
-
-    @property
-    def luminance(self) -> np.ndarray:
-        """Rec. 709 luminance of :attr:`image`, (H, W)."""
-        return luminance(self.image)
 
 
 def _progress_bar(total: int, enabled: bool) -> tuple[Callable[[int], None] | None, Any]:
     if not enabled:
         return None, None
     try:
-        from tqdm.auto import tqdm
+        with warnings.catch_warnings():
+            # A notebook without ipywidgets: tqdm warns, then draws as text.
+            warnings.simplefilter("ignore")
+            from tqdm.auto import tqdm
     except ImportError:
         return None, None
     bar = tqdm(total=total, unit="spl", unit_scale=True, delay=1.0, desc="render",
@@ -69,9 +39,11 @@ def _progress_bar(total: int, enabled: bool) -> tuple[Callable[[int], None] | No
     return update, bar
 
 
-def render(scene: Scene, spp: int | None = None, integrator: str | None = None,
-           strategy: str = "mis", heuristic: str = "power", max_depth: int | None = None,
-           rr_depth: int | None = None, seed: int = 0, progress: bool = True,
+def render(scene: Scene, spp: int | None = None, *,
+           integrator: Literal["direct", "path"] | None = None,
+           strategy: Literal["bsdf", "emitter", "mis"] = "mis",
+           heuristic: Literal["balance", "power"] = "power", max_depth: int | None = None,
+           rr_depth: int | None = None, seed: SeedLike = 0, progress: bool = True,
            hide_emitters: bool | None = None) -> RenderResult:
     """Renders ``scene`` with ``spp`` samples per pixel.
 
@@ -97,14 +69,18 @@ def render(scene: Scene, spp: int | None = None, integrator: str | None = None,
     rr_depth : int, optional
         Depth from which Russian roulette may end a path (default 5): the
         survival probability is min(max(throughput), 0.95).
-    seed : int
-        The same seed gives the same image whatever the thread count.
+    seed : int, None or numpy.random.Generator
+        The same seed gives the same image whatever the thread count; None
+        draws a fresh seed from the operating system, a Generator draws one
+        from itself.
     progress : bool
         Show a progress bar for renders that take longer than a second.
     hide_emitters : bool, optional
         Leave out emitters seen straight from the camera (area lights and
         the environment), as Mitsuba's ``hide_emitters``. Default: the
         scene dict's integrator, else False.
+
+    Everything after ``spp`` is keyword-only.
 
     Returns
     -------
@@ -113,23 +89,18 @@ def render(scene: Scene, spp: int | None = None, integrator: str | None = None,
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be an mcsample.Scene, got {type(scene).__name__}")
-    defaults = scene.integrator
-    spp = int(spp if spp is not None else scene.camera.sample_count or 16)
-    integrator = integrator or defaults.get("integrator", "path")
-    max_depth = int(max_depth if max_depth is not None else defaults.get("max_depth", -1))
-    rr_depth = int(rr_depth if rr_depth is not None else defaults.get("rr_depth", 5))
-    hide = bool(hide_emitters if hide_emitters is not None
-                else defaults.get("hide_emitters", False))
-    width, height = scene.size
-    compiled = scene.compiled
-    callback, bar = _progress_bar(width * height * max(spp, 1), progress)
+    settings = scene.integrator_settings(integrator, max_depth, rr_depth, hide_emitters)
+    spp = scene.camera.sample_count or 16 if spp is None else spp
+    height, width = scene.shape
+    callback, bar = _progress_bar(width * height * max(int(spp), 1), progress)
     start = time.perf_counter()
     try:
-        image, variance, lum_var = _render(compiled, spp, seed, integrator, strategy, heuristic,
-                                  max_depth, rr_depth, hide, callback)
+        image, variance, lum_var = _render(
+            scene.compiled, spp, resolve_seed(seed), settings["integrator"], strategy, heuristic,
+            settings["max_depth"], settings["rr_depth"], settings["hide_emitters"], callback)
     finally:
         if bar is not None:
             bar.close()
     seconds = time.perf_counter() - start
     return RenderResult(image.reshape(height, width, 3), variance.reshape(height, width, 3),
-                        lum_var.reshape(height, width), spp, seconds)
+                        lum_var.reshape(height, width), int(spp), seconds)

@@ -7,7 +7,8 @@ use crate::error::{Error, shape_str};
 use crate::io::{self, Raster};
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use std::path::PathBuf;
+use pyo3::types::PyBytes;
+use std::path::{Path, PathBuf};
 
 fn to_numpy<'py>(py: Python<'py>, raster: Raster) -> PyResult<Bound<'py, PyAny>> {
     let shape = [raster.height, raster.width, raster.channels];
@@ -120,7 +121,39 @@ pub fn write_png(
     detached(py, || io::write_png(&path, &raster, exposure as f32, srgb))
 }
 
-/// Registers the io functions in module `m`.
+/// The PNG file :func:`write_png` writes, as bytes (for notebooks'
+/// ``_repr_png_``).
+///
+/// Parameters
+/// ----------
+/// image : array_like, shape (H, W, 3) or (H, W, 4), linear RGB(A)
+/// exposure : float
+///     In stops (default 0).
+/// srgb : bool
+///     Apply the sRGB transfer curve (default True).
+#[pyfunction]
+#[pyo3(signature = (image, exposure = 0.0, srgb = true))]
+pub fn encode_png<'py>(
+    py: Python<'py>,
+    image: &Bound<'py, PyAny>,
+    exposure: f64,
+    srgb: bool,
+) -> PyResult<Bound<'py, PyBytes>> {
+    if !exposure.is_finite() {
+        return Err(Error::Parameter {
+            arg: "exposure",
+            value: exposure,
+            requirement: "must be finite",
+        }
+        .into());
+    }
+    let raster = from_numpy(image)?;
+    let bytes = detached(py, || {
+        io::encode_png(Path::new("image"), &raster, exposure as f32, srgb)
+    })?;
+    Ok(PyBytes::new(py, &bytes))
+}
+
 /// Reads a triangle mesh from a PLY (ASCII or binary) or OBJ file.
 ///
 /// Parameters
@@ -161,7 +194,9 @@ fn read_mesh<'py>(
     ))
 }
 
+/// Registers the io functions in module `m`.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(encode_png, m)?)?;
     m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
     m.add_function(wrap_pyfunction!(write_exr, m)?)?;

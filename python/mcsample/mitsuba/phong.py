@@ -1,6 +1,6 @@
 """The energy-normalised Phong BRDF as a Mitsuba 3 BSDF plugin, written in
 Dr.Jit independently of mcsample's Rust implementation (so that each checks
-the other). Register it with :func:`mcsample.mitsuba.register_phong`.
+the other). Register it with :func:`register_phong`.
 
 Same model and sampling as :class:`mcsample.Phong`:
 f_r = rho_d / pi + rho_s (n + 2) / (2 pi) max(0, cos alpha)^n (alpha from the
@@ -119,3 +119,25 @@ def make_class(mi):
             return f"McsamplePhong[kd={self.kd}, ks={self.ks}, exponent={self.n}]"
 
     return McsamplePhong
+
+
+_REGISTERED: set[str] = set()
+
+
+def register_phong() -> str:
+    """Registers mcsample's Phong BSDF for the current Mitsuba variant (set
+    one first, e.g. with :func:`load`) and returns its type name,
+    ``"mcsample_phong"``. Its keys are ``diffuse_reflectance`` and
+    ``specular_reflectance`` (a float, an RGB triple or a constant
+    texture) and ``exponent``; it is written in Dr.Jit, independently of
+    the Rust :class:`mcsample.Phong`, with the same formula and sampling."""
+    import mitsuba as mi
+
+    variant = mi.variant()
+    if variant is None:
+        raise RuntimeError("set a Mitsuba variant first (mcsample.mitsuba.load())")
+    if variant not in _REGISTERED:
+        cls = make_class(mi)
+        mi.register_bsdf(TYPE_NAME, lambda props: cls(props))
+        _REGISTERED.add(variant)
+    return TYPE_NAME

@@ -1,0 +1,130 @@
+"""mcsample's result objects, one family: attributes by name, a short repr
+(arrays shown by shape and dtype, never dumped), and, where a result took
+the place of a tuple, unpacking in the tuple's order (``x, pdf =
+pc.sample(u)``: :class:`TupleResult`). This module imports nothing from
+the rest of mcsample.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any, Iterator
+
+import numpy as np
+
+__all__ = ["EmitterSample", "RenderResult", "Result", "TupleResult", "describe"]
+
+
+def describe(value: Any) -> str:
+    """A short text for a value in a repr: arrays by shape and dtype, floats
+    to 4 significant digits, long lists by length."""
+    if isinstance(value, np.ndarray):
+        if value.ndim == 0:
+            return describe(value.item())
+        return f"array({value.shape}, {value.dtype})"
+    if isinstance(value, (float, np.floating)):
+        return f"{float(value):.4g}"
+    if isinstance(value, (list, tuple)) and len(value) > 4:
+        return f"[{len(value)} items]"
+    return repr(value)
+
+
+class Result:
+    """Base of the result dataclasses: a short repr of their fields.
+    ``_hidden`` lists the fields the repr leaves out (long messages, back
+    references)."""
+
+    _hidden: tuple[str, ...] = ()
+
+    def __repr__(self) -> str:
+        fields = [f.name for f in dataclasses.fields(self)]  # type: ignore[arg-type]
+        shown = [f"{name}={describe(getattr(self, name))}" for name in fields
+                 if name not in self._hidden and not name.startswith("_")]
+        return f"{type(self).__name__}({', '.join(shown)})"
+
+
+class TupleResult(Result):
+    """A result that took the place of a tuple: it unpacks, indexes and has
+    the length of that tuple, whose fields ``_unpack`` lists in order."""
+
+    _unpack: tuple[str, ...] = ()
+
+    def _tuple(self) -> tuple[Any, ...]:
+        return tuple(getattr(self, name) for name in self._unpack)
+
+    def __iter__(self) -> Iterator[Any]:
+        return iter(self._tuple())
+
+    def __getitem__(self, index: int) -> Any:
+        return self._tuple()[index]
+
+    def __len__(self) -> int:
+        return len(self._unpack)
+
+
+@dataclasses.dataclass(repr=False)
+class RenderResult(Result):
+    """A rendered image.
+
+    Attributes
+    ----------
+    image : ndarray (H, W, 3) float32
+        Mean radiance per pixel (linear RGB, row 0 at the top).
+    variance : ndarray (H, W, 3) float32, or None
+        Variance of each pixel's mean (sample variance / spp; inf for
+        spp = 1). None for Mitsuba references, whose moments come in XYZ.
+    luminance_variance : ndarray (H, W) float32
+        Variance of each pixel's mean luminance (Rec. 709 Y), the quantity
+        compared with Mitsuba (whose moment integrator reports it).
+    spp : int
+        Samples per pixel.
+    seconds : float
+        Wall-clock time of the render.
+
+    In a notebook, a RenderResult shows as its tone-mapped image.
+    """
+
+    image: np.ndarray
+    variance: np.ndarray | None
+    luminance_variance: np.ndarray
+    spp: int
+    seconds: float
+
+    @property
+    def luminance(self) -> np.ndarray:
+        """Rec. 709 luminance of :attr:`image`, (H, W) float64."""
+        return np.asarray(self.image, dtype=np.float64) @ np.array([0.2126, 0.7152, 0.0722])
+
+    def _repr_png_(self) -> bytes:
+        from ._core.io import encode_png
+
+        return encode_png(np.ascontiguousarray(self.image, dtype=np.float32))
+
+
+@dataclasses.dataclass(frozen=True, repr=False)
+class EmitterSample(Result):
+    """Directions toward the lights, from :meth:`mcsample.Scene.sample_emitter`.
+
+    Attributes
+    ----------
+    direction : ndarray (N, 3)
+        Unit vectors toward the light (0 where a sample carries no light).
+    pdf : ndarray (N,)
+        Density per steradian, the light's choice included.
+    radiance : ndarray (N, 3)
+        Radiance arriving along the direction (no visibility test).
+    distance : ndarray (N,)
+        Distance to the light point (inf for the environment).
+    """
+
+    direction: np.ndarray
+    pdf: np.ndarray
+    radiance: np.ndarray
+    distance: np.ndarray
+
+    @property
+    def weight(self) -> np.ndarray:
+        """radiance / pdf, 0 where pdf is 0."""
+        pdf = np.asarray(self.pdf)[..., None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(pdf > 0, self.radiance / np.where(pdf > 0, pdf, 1.0), 0.0)

@@ -1,0 +1,180 @@
+"""Scenes described by the Mitsuba 3 scene dictionary.
+
+``Scene.from_mitsuba(d)`` reads the subset of Mitsuba's dictionary format
+that mcsample renders; ``scene.to_mitsuba()`` gives back a dictionary that
+``mi.load_dict`` renders to the same image (with mcsample's Phong registered
+as the ``"mcsample_phong"`` plugin, see :func:`mcsample.mitsuba.register_phong`).
+
+The subset (anything else raises ValueError naming the key):
+
+- shapes: ``sphere`` (center, radius, to_world, flip_normals), ``rectangle``,
+  ``disk``, ``cube``, ``ply`` and ``obj`` (filename, face_normals,
+  flip_normals, to_world), and ``mesh`` — mcsample's own type for numpy
+  arrays: ``vertices`` (N, 3), ``faces`` (M, 3) and optional ``normals``
+  (N, 3). Each may hold a ``bsdf`` and an ``area`` emitter (``radiance``).
+- bsdfs: ``diffuse`` (reflectance), ``mcsample_phong`` (diffuse_reflectance,
+  specular_reflectance, exponent), ``twosided`` around either, and
+  ``{"type": "ref", "id": ...}`` to a top-level bsdf. A shape without one
+  gets Mitsuba's default, diffuse 0.5.
+- emitters: ``envmap`` (filename, scale, to_world; or an :class:`EnvMap`
+  given directly as the value, in any mapping) and ``constant`` (radiance).
+- sensors: ``perspective`` (fov, fov_axis, near_clip, far_clip, to_world)
+  and ``thinlens`` (also aperture_radius, focus_distance), with an
+  ``hdrfilm`` (width, height, box ``rfilter``) and an ``independent``
+  sampler (sample_count: the default spp).
+- ``integrator``: ``path`` or ``direct`` (max_depth, rr_depth, hide_emitters): the
+  defaults of :func:`mcsample.render`.
+
+Colours are a float, an RGB triple or ``{"type": "rgb", "value": ...}``.
+``to_world`` is a Mitsuba transform, a 4×4 array-like, or (handy in JSON)
+``{"look_at": {"origin": ..., "target": ..., "up": ...}}``.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+import numpy as np
+
+from .._core.render import CompiledScene, SceneBuilder
+from ..results import EmitterSample
+from .parse import Camera, ShapeRecord, look_at, parse_scene
+
+__all__ = ["EmitterSample", "Scene", "look_at"]
+
+
+@dataclass
+class Scene:
+    """A scene mcsample can render and Mitsuba 3 can render too.
+
+    Build one with :meth:`from_mitsuba`; render it with
+    :func:`mcsample.render`, and in Mitsuba with
+    :func:`mcsample.mitsuba.render_reference`.
+    """
+
+    shapes: list[ShapeRecord]
+    environment: tuple[str, Any] | None
+    camera: Camera
+    integrator: dict[str, Any] = field(default_factory=dict)
+    source: dict[str, Any] = field(default_factory=dict, repr=False)
+    _compiled: CompiledScene | None = field(default=None, repr=False)
+
+    def __repr__(self) -> str:
+        kinds: dict[str, int] = {}
+        for shape in self.shapes:
+            kinds[shape.kind] = kinds.get(shape.kind, 0) + 1
+        shapes = ", ".join(f"{k} x{n}" for k, n in kinds.items())
+        lights = sum(s.emission is not None for s in self.shapes)
+        env = "no environment"
+        if self.environment is not None:
+            kind, value = self.environment
+            env = repr(value) if kind != "constant" else f"constant {value}"
+        c = self.camera
+        return (f"Scene({shapes}; {lights} area lights; {env}; camera {c.width}x{c.height}, "
+                f"fov {c.fov:g} ({c.fov_axis}))")
+
+    @classmethod
+    def from_mitsuba(cls, d: Mapping[str, Any]) -> "Scene":
+        """Reads a Mitsuba 3 scene dict (the subset in this module's doc).
+
+        Raises ValueError naming the first key outside that subset or with a
+        bad value, OSError for a mesh or image file that cannot be read.
+        """
+        p = parse_scene(d)
+        return cls(p.shapes, p.environment, p.camera, p.integrator, source=dict(d))
+
+    @property
+    def compiled(self) -> CompiledScene:
+        """The Rust scene (BVH and light selection), built on first use."""
+        if self._compiled is None:
+            b = SceneBuilder()
+            for s in self.shapes:
+                bsdf, two = s.material.phong(), s.material.two_sided
+                if s.kind == "sphere":
+                    b.add_sphere(s.center, s.radius, s.flip_normals, bsdf, two, s.emission)
+                elif s.kind == "disk":
+                    b.add_disk(s.to_world.tolist(), bsdf, two, s.emission)
+                else:
+                    b.add_mesh(np.ascontiguousarray(s.vertices),
+                               np.ascontiguousarray(s.faces),
+                               None if s.normals is None else np.ascontiguousarray(s.normals),
+                               s.face_normals, bsdf, two, s.emission)
+            if self.environment is not None:
+                kind, value = self.environment
+                if kind == "envmap":
+                    b.set_envmap(value)
+                else:
+                    b.set_constant(value)
+            c = self.camera
+            b.set_camera(c.to_world.tolist(), c.fov, c.fov_axis, c.width, c.height,
+                         c.near_clip, c.far_clip, c.aperture_radius, c.focus_distance)
+            self._compiled = b.build()
+        return self._compiled
+
+    def sample_emitter(self, x: Any, u: Any) -> "EmitterSample":
+        """Emitter sampling as the renderer's next-event estimation does it.
+
+        Parameters
+        ----------
+        x : array_like, shape (N, 3) or (3,)
+            Points the light is sampled from (world space).
+        u : array_like, shape (N, 3) or (3,), in [0, 1]
+            Uniform numbers: the light's choice (by power), then two for the
+            point on it (uniform by area; a sphere seen from outside: uniform
+            in the cone it subtends) or the environment direction.
+
+        Returns
+        -------
+        EmitterSample
+            ``.direction`` (N, 3) unit vectors toward the light, ``.pdf``
+            (N,) per steradian (the light's choice included), ``.radiance``
+            (N, 3) arriving along it (no visibility test), ``.distance``
+            (N,) to the light point (inf for the environment), ``.weight``
+            = radiance / pdf; all 0 where a sample carries no light (a point
+            on the back of a one-sided light).
+        """
+        out = np.asarray(self.compiled.sample_emitter(x, u))
+        return EmitterSample(out[..., :3], out[..., 3], out[..., 4:7], out[..., 7])
+
+    def emitter_pdf(self, x: Any, d: Any) -> Any:
+        """The density per steradian with which :meth:`sample_emitter` from
+        points ``x`` (N, 3) or (3,) draws the unit directions ``d`` (N, 3) or
+        (3,): float64 (N,) or a scalar. An area light counts where ``d``
+        first meets its front side (other shapes do not block it: this is
+        the sampler's density, not visibility)."""
+        return self.compiled.emitter_pdf(x, d)
+
+    def integrator_settings(self, integrator: str | None = None, max_depth: int | None = None,
+                            rr_depth: int | None = None,
+                            hide_emitters: bool | None = None) -> dict[str, Any]:
+        """The integrator's settings for a render: each argument that is
+        None takes the scene dict's value, else the default (``path``,
+        ``max_depth`` -1, ``rr_depth`` 5, ``hide_emitters`` False)."""
+        d = self.integrator
+        return {
+            "integrator": integrator if integrator is not None else d.get("integrator", "path"),
+            "max_depth": max_depth if max_depth is not None else d.get("max_depth", -1),
+            "rr_depth": rr_depth if rr_depth is not None else d.get("rr_depth", 5),
+            "hide_emitters": bool(hide_emitters if hide_emitters is not None
+                                  else d.get("hide_emitters", False)),
+        }
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(height, width)`` of the film in pixels, as numpy's shapes."""
+        return self.camera.height, self.camera.width
+
+    def to_mitsuba(self, spp: int | None = None,
+                   latlong_width: int | None = None) -> dict[str, Any]:
+        """A dict for ``mi.load_dict`` that renders this scene in Mitsuba 3
+        (a Mitsuba variant must be set; see
+        :func:`mcsample.mitsuba.scene_dict`)."""
+        from ..mitsuba.export import scene_dict
+
+        return scene_dict(self, spp=spp, latlong_width=latlong_width)
+
+    def copy(self) -> "Scene":
+        """A deep copy (change it and render again)."""
+        return copy.deepcopy(self)
