@@ -42,3 +42,20 @@ def test_demo_writes_its_images(tmp_path):
     for name in ("strategies.png", "render_mis.exr", "render_bsdf.png", "samplers.png"):
         assert (tmp_path / "out" / name).exists(), out
     assert "relMSE" in out
+
+
+def test_demo_refuses_what_it_cannot_do(tmp_path):
+    """Every option value the command line accepts works; the others are
+    refused before anything runs (spp 1 leaves no variance for the z-test
+    against Mitsuba)."""
+    for args in (["demo", "--spp", "1"], ["demo", "-n", "10"], ["demo", "--seed", "-1"],
+                 ["render", "x.json", "--max-depth", "-2"], ["bench", "--only", "nope"]):
+        out = subprocess.run([sys.executable, "-m", "mcsample", *args], cwd=tmp_path,
+                             capture_output=True, text=True, timeout=60)
+        assert out.returncode == 2 and "error:" in out.stderr, (args, out.stderr)
+
+
+def test_the_command_line_lists_every_bench_suite():
+    from mcsample import __main__, bench
+
+    assert tuple(bench.SUITES) == __main__.SUITE_NAMES

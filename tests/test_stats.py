@@ -149,17 +149,26 @@ def test_image_metrics(rng):
 
 
 def test_image_ztest_accepts_agreement_and_rejects_bias(rng):
-    truth = rng.random((64, 64, 3))
+    truth = rng.random((64, 64))
     var = np.full(truth.shape, 0.01)
     a = truth + rng.normal(0, 0.1, truth.shape)
     b = truth + rng.normal(0, 0.1, truth.shape)
     ok = stats.image_ztest(a, var, b, var)
     assert ok.passed, ok.message
-    assert abs(ok.mean) < 0.05 and 0.9 < ok.variance < 1.1
-    biased = stats.image_ztest(a + 0.03, var, b, var)
-    assert not biased.passed and "3 SE" in biased.message
+    assert abs(ok.mean_z) < 4 and ok.block_z.shape == (8, 8)
+    assert "ZTestResult(passed=True" in repr(ok) and "array((8, 8)" in repr(ok)
+    # A bias everywhere: the image mean's SE is 0.1 sqrt(2) / 64 = 0.0022.
+    biased = stats.image_ztest(a + 0.02, var, b, var)
+    assert not biased.passed and "whole-image means differ" in biased.message
+    # A bias in one block only: 0.1 sqrt(2) / 8 = 0.018 SE per block.
+    local = a.copy()
+    local[8:16, 24:32] += 0.12
+    t = stats.image_ztest(local, var, b, var)
+    assert not t.passed and "block (1, 3)" in t.message
     shifted = np.roll(b, 1, axis=1)
-    assert not stats.image_ztest(a, var, shifted, var).passed
+    assert stats.image_ztest(a, var, shifted, var).passed  # noise 10x the signal's change
+    with pytest.raises(ValueError, match="infinite"):
+        stats.image_ztest(a, np.full(a.shape, np.inf), b, var)
 
 
 def test_luminance_is_rec709():

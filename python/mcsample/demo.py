@@ -49,17 +49,14 @@ def run(out_dir: str = "mcsample-demo", n: int = 1_000_000, seed: int = 0) -> li
     their pdf, and writes ``samplers.png`` (per row: samples, histogram,
     expected counts, difference) into ``out_dir``. Returns the paths
     written."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     from . import plot
 
     os.makedirs(out_dir, exist_ok=True)
     rows = len(SAMPLERS)
-    fig, axes = plt.subplots(rows, 4, figsize=(17, 3.4 * rows), squeeze=False,
-                             layout="constrained")
+    fig = Figure(figsize=(17, 3.4 * rows), layout="constrained")
+    axes = fig.subplots(rows, 4, squeeze=False)
     lines = []
     for row, s in zip(axes, SAMPLERS):
         result = stats.chi2_test(s.sample, s.pdf, s.domain, n=n, ires=s.ires, seed=seed,
@@ -72,7 +69,6 @@ def run(out_dir: str = "mcsample-demo", n: int = 1_000_000, seed: int = 0) -> li
         plot.chi2(result, axes=row[1:])
     path = os.path.join(out_dir, "samplers.png")
     fig.savefig(path, dpi=70)
-    plt.close(fig)
     report = os.path.join(out_dir, "chi2.txt")
     with open(report, "w") as f:
         f.write("\n".join(lines) + "\n")
@@ -111,11 +107,6 @@ def run_render(out_dir: str = "mcsample-demo", spp: int = 32, seed: int = 0,
     a 16× spp MIS reference, and Mitsuba's image when it is installed; writes
     the EXR and PNG images and ``strategies.png`` (images, relMSE, error
     maps). Returns the paths written and the report lines."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from . import Scene, io, plot, render
     from . import mitsuba as mcs_mitsuba
 
@@ -146,6 +137,5 @@ def run_render(out_dir: str = "mcsample-demo", spp: int = 32, seed: int = 0,
     fig = plot.compare(shown, ref)
     path = os.path.join(out_dir, "strategies.png")
     fig.savefig(path, dpi=90)
-    plt.close(fig)
     paths.append(path)
     return paths, lines

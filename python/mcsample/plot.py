@@ -4,9 +4,12 @@ convergence, tone-mapped HDR images and error maps.
 
 matplotlib is imported when a function here is first called, so the rest of
 mcsample does not need it (``pip install "mcsample[plot]"``). Every function
-draws into ``ax`` / ``axes`` when given (else into a new figure made with
-pyplot, which a notebook shows by itself) and returns the Axes or Figure it
-drew; none calls ``plt.show()``.
+draws into ``ax`` / ``axes`` when given, and returns the Axes or Figure it
+drew; none calls ``plt.show()``. Without ``ax``, a function that returns an
+Axes draws into a new pyplot figure (which a notebook shows by itself); one
+that returns a Figure makes it outside pyplot's state, so that a notebook
+cell ending with it shows it once, as its value (in a script, save it with
+``fig.savefig``).
 """
 
 from __future__ import annotations
@@ -42,6 +45,14 @@ def _pyplot() -> Any:
     except ImportError as e:  # pragma: no cover - matplotlib is a test dependency
         raise ImportError("mcsample.plot needs matplotlib: pip install 'mcsample[plot]'") from e
     return plt
+
+
+def _figure(**kwargs: Any) -> Figure:
+    """A new Figure not registered with pyplot (see the module doc)."""
+    _pyplot()
+    from matplotlib.figure import Figure
+
+    return Figure(**kwargs)
 
 
 def _axes(ax: Axes | None, **subplot_kw: Any) -> Axes:
@@ -155,11 +166,10 @@ def compare(images: Mapping[str, Any], reference: Any, exposure: float = 0.0,
     against ``reference``) above their error maps (bottom row, see
     :func:`error_map`; ``kind="z"`` needs RenderResults with variances).
     ``images`` maps a name to an image (H, W, 3) or a RenderResult."""
-    plt = _pyplot()
     ref = np.asarray(getattr(reference, "image", reference))
     if fig is None:
         h, w = ref.shape[:2]
-        fig = plt.figure(figsize=(4.0 * len(images), 8.0 * h / w + 1.5), layout="constrained")
+        fig = _figure(figsize=(4.0 * len(images), 8.0 * h / w + 1.5), layout="constrained")
     axes = fig.subplots(2, len(images), squeeze=False)
     for col, (name, img) in enumerate(images.items()):
         err = relmse(getattr(img, "image", img), ref)
@@ -253,9 +263,8 @@ def chi2(result: Chi2Result, axes: Sequence[Axes] | None = None) -> Figure:
     domain's parameter box. ``result`` comes from
     :func:`mcsample.stats.chi2_test` or :func:`~mcsample.stats.two_sample_test`;
     ``axes`` may be three Axes to draw into."""
-    plt = _pyplot()
     if axes is None:
-        _, axes = plt.subplots(1, 3, figsize=(13, 3.6), layout="constrained")
+        axes = _figure(figsize=(13, 3.6), layout="constrained").subplots(1, 3)
     fig: Any = axes[0].figure
     obs, exp = np.asarray(result.histogram), np.asarray(result.expected)
     diff = obs - exp
@@ -299,9 +308,8 @@ def distribution(dist: Any, axes: Sequence[Axes] | None = None) -> Figure:
     pdf and cdf on its interval. Discrete2D / PiecewiseConstant2D: the pmf /
     pdf as an image and its marginal over rows. ``axes``: two Axes to draw
     into."""
-    plt = _pyplot()
     if axes is None:
-        _, axes = plt.subplots(1, 2, figsize=(10, 3.6), layout="constrained")
+        axes = _figure(figsize=(10, 3.6), layout="constrained").subplots(1, 2)
     fig: Any = axes[0].figure
     name = type(dist).__name__
     if hasattr(dist, "domain") and np.ndim(dist.domain) == 1:  # PiecewiseConstant1D
@@ -433,14 +441,13 @@ def envmap(env: Any, n_samples: int = 2000, seed: int = 0, exposure: float = 0.0
 
     from ._core import uniform
 
-    plt = _pyplot()
     if density not in ("map", "solid_angle"):
         raise ValueError(f"density = {density!r}: expected 'map' or 'solid_angle'")
     layout = _EnvLayout(env)
     if axes is None:
         aspect = layout.width / layout.height
-        _, axes = plt.subplots(1, 3, figsize=(7.8 * max(aspect, 1.0) + 1.5, 3.3),
-                                 layout="constrained")
+        axes = _figure(figsize=(7.8 * max(aspect, 1.0) + 1.5, 3.3),
+                       layout="constrained").subplots(1, 3)
     fig: Any = axes[0].figure
     rgb = tonemap(layout.image, exposure)
     shown = np.concatenate([rgb, np.isfinite(layout.image[..., :1]).astype(np.float64)], -1)

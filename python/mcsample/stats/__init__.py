@@ -24,8 +24,7 @@ per unit area on the plane, per unit length on an interval).
 from .chi2 import Chi2Result, chi2_test, two_sample_test
 from .domains import (ConeDomain, DiskDomain, Domain, DomainLike, EnvMapDomain, HemisphereDomain,
                       IntervalDomain, PlanarDomain, SphericalDomain, make_domain)
-from .images import (ImageZTestResult, RenderZTestResult, image_ztest, luminance, mse,
-                     relmse, render_ztest)
+from .images import ZTestResult, image_ztest, luminance, mse, relmse, render_ztest
 
 __all__ = [
     "Chi2Result",
@@ -35,10 +34,8 @@ __all__ = [
     "DomainLike",
     "EnvMapDomain",
     "HemisphereDomain",
-    "ImageZTestResult",
     "IntervalDomain",
     "PlanarDomain",
-    "RenderZTestResult",
     "SphericalDomain",
     "chi2_test",
     "image_ztest",
@@ -48,4 +45,5 @@ __all__ = [
     "relmse",
     "render_ztest",
     "two_sample_test",
+    "ZTestResult",
 ]

@@ -9,6 +9,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .._core import uniform
+from ..results import Result
 from .domains import Domain, DomainLike, make_domain
 
 
@@ -250,8 +251,8 @@ def _sidak(alpha: float, test_count: int) -> float:
 # Results
 
 
-@dataclass
-class Chi2Result:
+@dataclass(repr=False)
+class Chi2Result(Result):
     """Outcome of :func:`chi2_test` or :func:`two_sample_test`.
 
     ``histogram`` and ``expected`` are (rows, columns) arrays over the
@@ -270,6 +271,8 @@ class Chi2Result:
     domain: Domain
     messages: list[str] = field(default_factory=list)
 
+    _hidden = ("histogram", "expected", "domain", "messages")
+
     @property
     def message(self) -> str:
         """Everything the test noted, one line each."""
@@ -277,11 +280,6 @@ class Chi2Result:
 
     def __bool__(self) -> bool:
         return self.passed
-
-    def __repr__(self) -> str:
-        verdict = "passed" if self.passed else "FAILED"
-        return (f"Chi2Result({verdict}: p_value={self.p_value:.4g}, significance="
-                f"{self.significance:.3g}, statistic={self.statistic:.6g}, dof={self.dof})")
 
 
 def _verdict(stat: float, dof: int, p_value: float, significance: float, failures: list[str],
