@@ -106,6 +106,41 @@ pub enum Error {
         /// The largest number accepted.
         max: usize,
     },
+    /// An argument that is missing, or that does not fit the others or the
+    /// way it is used: a scene without a sensor, a second environment
+    /// emitter, a read-only or non-contiguous `out` array.
+    #[error("{message}")]
+    Argument {
+        /// Name of the argument.
+        arg: &'static str,
+        /// The whole message, naming the argument and what to do.
+        message: String,
+    },
+    /// Two batches whose row counts differ, neither being a single row (one
+    /// row is used for every row of the other).
+    #[error(
+        "{arg_a} has {rows_a} row{s_a} and {arg_b} has {rows_b}: give both as many rows, \
+         or one of them as a single row (used for every row of the other)",
+        s_a = plural(.rows_a)
+    )]
+    Rows {
+        /// Name of the first argument.
+        arg_a: &'static str,
+        /// Its number of rows.
+        rows_a: usize,
+        /// Name of the second argument.
+        arg_b: &'static str,
+        /// Its number of rows.
+        rows_b: usize,
+    },
+    /// The worker threads could not be started.
+    #[error("cannot start {threads} worker threads: {message}")]
+    ThreadPool {
+        /// The number of threads asked for.
+        threads: usize,
+        /// The system's reason.
+        message: String,
+    },
     /// A file that cannot be read or written, or whose content is invalid.
     #[error("{path}: {message}")]
     Io {
@@ -114,6 +149,11 @@ pub enum Error {
         /// What went wrong.
         message: String,
     },
+}
+
+/// The plural ending of a count of `n`.
+fn plural(n: &usize) -> &'static str {
+    if *n == 1 { "" } else { "s" }
 }
 
 /// Result type of the core.
@@ -152,6 +192,13 @@ mod tests {
             requirement: "must lie in [0, 1]".into(),
         };
         assert_eq!(e.to_string(), "u[3, 1] = NaN: must lie in [0, 1]");
+        let e = Error::Rows {
+            arg_a: "wi",
+            rows_a: 2,
+            arg_b: "wo",
+            rows_b: 3,
+        };
+        assert!(e.to_string().starts_with("wi has 2 rows and wo has 3: "));
     }
 
     #[test]

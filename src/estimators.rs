@@ -10,18 +10,18 @@
 //! # Irradiance `E = ∫ L(ω) max(0, n·ω) dω`
 //! - uniform: `ω` uniform on the hemisphere of `n`, `f = L cos θ · 2π`;
 //! - cosine: `ω` cosine-weighted, `f = L π`;
-//! - envmap: `ω` from the map, `f = (L/p_env) cos⁺ θ`;
-//! - mis: one cosine and one envmap sample, each weighted by the heuristic
+//! - emitter: `ω` from the map, `f = (L/p_env) cos⁺ θ`;
+//! - mis: one cosine and one emitter sample, each weighted by the heuristic
 //!   against the other's density (Veach's multi-sample model).
 //!
 //! # Reflected radiance `L_r(ωi) = ∫ L(ω) f_r(ωi, ω) cos⁺ θ dω`
-//! With the Phong BRDF in the frame of `n`: bsdf (its own sampling), envmap,
-//! and mis of the two.
+//! With the Phong BRDF in the frame of `n`: bsdf (its own sampling), emitter
+//! (the map's), and mis of the two.
 
 use crate::envmap::EnvMap;
 use crate::error::{Error, Result};
 use crate::frame::Frame;
-use crate::mis;
+use crate::mis::Heuristic;
 use crate::parallel;
 use crate::phong::Phong;
 use crate::rng::Rng;
@@ -29,7 +29,9 @@ use crate::warp::{self, V3};
 use std::f64::consts::PI;
 use std::sync::Mutex;
 
-/// A sampling strategy.
+/// A sampling strategy. The renderer's [`crate::render::Strategy`] has the
+/// same names for the same ideas (`Bsdf`, `Emitter`, `Mis`) and lacks the
+/// two hemisphere strategies, which only make sense for irradiance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Strategy {
     /// Uniform directions on the hemisphere (irradiance only).
@@ -38,51 +40,22 @@ pub enum Strategy {
     Cosine,
     /// The BRDF's own sampling (reflected radiance only).
     Bsdf,
-    /// The environment map's importance sampling.
-    Envmap,
-    /// MIS of the two applicable strategies (cosine or BSDF, and envmap).
+    /// The emitter's importance sampling (here the environment map's).
+    Emitter,
+    /// MIS of the two applicable strategies (cosine or BSDF, and emitter).
     Mis,
 }
 
 impl Strategy {
-    /// The strategy called `name` (`"uniform"`, `"cosine"`, `"bsdf"`,
-    /// `"envmap"`, `"mis"`).
-    pub fn from_name(name: &str) -> Option<Self> {
-        Some(match name {
-            "uniform" => Strategy::Uniform,
-            "cosine" => Strategy::Cosine,
-            "bsdf" => Strategy::Bsdf,
-            "envmap" => Strategy::Envmap,
-            "mis" => Strategy::Mis,
-            _ => return None,
-        })
-    }
-}
-
-/// How MIS weights two samples.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Heuristic {
-    /// `p_a / (p_a + p_b)`.
-    Balance,
-    /// `p_a² / (p_a² + p_b²)`.
-    Power,
-}
-
-impl Heuristic {
-    /// The heuristic called `name` (`"balance"`, `"power"`).
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "balance" => Some(Heuristic::Balance),
-            "power" => Some(Heuristic::Power),
-            _ => None,
-        }
-    }
-
-    #[inline(always)]
-    fn weight(self, pdf_a: f64, pdf_b: f64) -> f64 {
+    /// The name used in the Python API: `"uniform"`, `"cosine"`, `"bsdf"`,
+    /// `"emitter"`, `"mis"`.
+    pub fn name(self) -> &'static str {
         match self {
-            Heuristic::Balance => mis::balance_heuristic(pdf_a, pdf_b),
-            Heuristic::Power => mis::power_heuristic(pdf_a, pdf_b, 2.0),
+            Strategy::Uniform => "uniform",
+            Strategy::Cosine => "cosine",
+            Strategy::Bsdf => "bsdf",
+            Strategy::Emitter => "emitter",
+            Strategy::Mis => "mis",
         }
     }
 }
@@ -217,8 +190,8 @@ fn check(n: usize, normal: V3<f64>) -> Result<V3<f64>> {
 fn unsupported(strategy: Strategy, allowed: &str) -> Error {
     Error::Choice {
         arg: "strategy",
-        value: format!("{strategy:?}").to_lowercase(),
-        requirement: format!("must be one of {allowed}"),
+        value: strategy.name().into(),
+        requirement: format!("must be {allowed}"),
     }
 }
 
@@ -267,7 +240,7 @@ pub fn irradiance(env: &EnvMap, normal: V3<f64>, plan: Plan) -> Result<Estimate>
             let f = if local[2] > 0.0 { PI } else { 0.0 };
             scaled(env.eval(frame.to_world(local)), f)
         }),
-        Strategy::Envmap => estimate(n, seed, 2, |rng| {
+        Strategy::Emitter => estimate(n, seed, 2, |rng| {
             let s = env.sample(next2(rng));
             scaled(s.weight, dot(s.direction, normal).max(0.0))
         }),
@@ -287,7 +260,10 @@ pub fn irradiance(env: &EnvMap, normal: V3<f64>, plan: Plan) -> Result<Estimate>
                 scaled(s.weight, w * dot(s.direction, normal).max(0.0)),
             )
         }),
-        Strategy::Bsdf => Err(unsupported(strategy, "uniform, cosine, envmap, mis")),
+        Strategy::Bsdf => Err(unsupported(
+            strategy,
+            r#""uniform", "cosine", "emitter" or "mis""#,
+        )),
     }
 }
 
@@ -339,7 +315,7 @@ pub fn reflected_radiance(
             let (d, s) = bsdf_sample(rng);
             times(s.weight, env.eval(d))
         }),
-        Strategy::Envmap => estimate(n, seed, 2, |rng| {
+        Strategy::Emitter => estimate(n, seed, 2, |rng| {
             let s = env.sample(next2(rng));
             times(s.weight, reflect(s.direction))
         }),
@@ -351,7 +327,9 @@ pub fn reflected_radiance(
             let w = heuristic.weight(s.pdf, view.pdf(frame.to_local(s.direction)));
             add(from_bsdf, scaled(times(s.weight, reflect(s.direction)), w))
         }),
-        Strategy::Uniform | Strategy::Cosine => Err(unsupported(strategy, "bsdf, envmap, mis")),
+        Strategy::Uniform | Strategy::Cosine => {
+            Err(unsupported(strategy, r#""bsdf", "emitter" or "mis""#))
+        }
     }
 }
 
@@ -394,7 +372,7 @@ mod tests {
     fn strategies_agree_and_mis_is_deterministic() {
         let env = sky();
         let normal = [0.3, 0.9, 0.1];
-        let reference = irradiance(&env, normal, plan(400_000, Strategy::Envmap, 1)).unwrap();
+        let reference = irradiance(&env, normal, plan(400_000, Strategy::Emitter, 1)).unwrap();
         for strategy in [Strategy::Uniform, Strategy::Cosine, Strategy::Mis] {
             let e = irradiance(&env, normal, plan(400_000, strategy, 2)).unwrap();
             assert!(z(&e, &reference).abs() < 5.0, "{e:?} vs {reference:?}");
@@ -413,7 +391,7 @@ mod tests {
         let (normal, wi) = ([0.0, 1.0, 0.0], [0.5, 0.8, 0.0]);
         let reference =
             reflected_radiance(&env, &phong, normal, wi, plan(400_000, Strategy::Mis, 1)).unwrap();
-        for strategy in [Strategy::Bsdf, Strategy::Envmap] {
+        for strategy in [Strategy::Bsdf, Strategy::Emitter] {
             let e =
                 reflected_radiance(&env, &phong, normal, wi, plan(400_000, strategy, 2)).unwrap();
             assert!(z(&e, &reference).abs() < 5.0, "{e:?} vs {reference:?}");

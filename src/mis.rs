@@ -15,6 +15,31 @@
 
 use crate::math::Real;
 
+/// How MIS weights a sample of one strategy against the other: the one
+/// choice of heuristic shared by the renderer and the estimators.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Heuristic {
+    /// `p_a / (p_a + p_b)` ([`balance_heuristic`]).
+    Balance,
+    /// `p_a² / (p_a² + p_b²)` ([`power_heuristic`] with β = 2), the default
+    /// (as Mitsuba's and pbrt's path tracers).
+    #[default]
+    Power,
+}
+
+impl Heuristic {
+    /// The weight `w_a` of a sample drawn by strategy `a` (density `pdf_a`)
+    /// against strategy `b` (density `pdf_b` at the same point), with the
+    /// degenerate cases of [`power_heuristic`].
+    #[inline(always)]
+    pub fn weight<F: Real>(self, pdf_a: F, pdf_b: F) -> F {
+        match self {
+            Heuristic::Balance => balance_heuristic(pdf_a, pdf_b),
+            Heuristic::Power => power_heuristic(pdf_a, pdf_b, F::c(2.0)),
+        }
+    }
+}
+
 /// Balance heuristic `p_a / (p_a + p_b)`; see [`power_heuristic`] for the
 /// degenerate cases.
 #[inline(always)]
@@ -72,5 +97,13 @@ mod tests {
         // The two weights of a pair sum to 1.
         let (a, b) = (0.37f64, 1.9f64);
         assert!((power_heuristic(a, b, 2.0) + power_heuristic(b, a, 2.0) - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn heuristic_weights_are_the_functions() {
+        let (a, b) = (0.37f32, 1.9f32);
+        assert_eq!(Heuristic::Balance.weight(a, b), balance_heuristic(a, b));
+        assert_eq!(Heuristic::Power.weight(a, b), power_heuristic(a, b, 2.0));
+        assert_eq!(Heuristic::default(), Heuristic::Power);
     }
 }

@@ -148,10 +148,9 @@ fn pool(threads: usize) -> Result<Arc<ThreadPool>> {
         .num_threads(threads)
         .thread_name(|i| format!("mcsample-{i}"))
         .build()
-        .map_err(|e| Error::Integer {
-            arg: "threads",
-            value: threads.to_string(),
-            requirement: format!("cannot start the thread pool: {e}"),
+        .map_err(|e| Error::ThreadPool {
+            threads,
+            message: e.to_string(),
         })?;
     let pool = Arc::new(pool);
     *guard = Some(Pool {

@@ -22,6 +22,12 @@ def _img(nan=None, value=None):
     return image
 
 
+def _read_only(shape):
+    a = np.zeros(shape)
+    a.flags.writeable = False
+    return a
+
+
 CASES = [
     # (call, exception, message fragments)
     # Discrete tables: NaN, inf, negative, all-zero, empty, wrong shapes.
@@ -41,10 +47,10 @@ CASES = [
     (lambda: mcs.Discrete2D([1, 2, 3]), ValueError, ["(rows, cols)", "(3,)"]),
     (lambda: mcs.Discrete2D(np.zeros((0, 3))), ValueError, ["empty"]),
     (lambda: mcs.PiecewiseConstant1D([1, NAN]), ValueError, ["values[1] = NaN"]),
-    (lambda: mcs.PiecewiseConstant1D([1, 2], 1.0, 1.0), ValueError, ["a < b"]),
-    (lambda: mcs.PiecewiseConstant1D([1, 2], 0.0, INF), ValueError, ["a < b"]),
+    (lambda: mcs.PiecewiseConstant1D([1, 2], a=1.0, b=1.0), ValueError, ["a < b"]),
+    (lambda: mcs.PiecewiseConstant1D([1, 2], a=0.0, b=INF), ValueError, ["a < b"]),
     (lambda: mcs.PiecewiseConstant2D([[1, INF]]), ValueError, ["values[0, 1] = inf"]),
-    (lambda: mcs.PiecewiseConstant2D([[1]], ((0, 1), (1, 0))), ValueError, ["domain"]),
+    (lambda: mcs.PiecewiseConstant2D([[1]], domain=((0, 1), (1, 0))), ValueError, ["domain"]),
     # Sampling input: u outside [0, 1] or NaN, wrong shapes, bad indices.
     (lambda: mcs.Discrete1D([1, 2]).sample([0.5, 1.5]), ValueError, ["u[1] = 1.5", "[0, 1]"]),
     (lambda: mcs.Discrete1D([1, 2]).sample([[0.5, 0.5]]), ValueError, ["u must have shape (N,)"]),
@@ -55,6 +61,10 @@ CASES = [
     (lambda: mcs.Discrete1D([1, 2]).pmf(-1), ValueError, ["i = -1"]),
     (lambda: mcs.Discrete1D([1, 2]).pmf([0.5]), TypeError, ["i must be integers"]),
     (lambda: mcs.Discrete2D([[1, 2]]).pmf([[0, 5]]), ValueError, ["idx[0, 1] = 5", "[0, 2)"]),
+    (lambda: mcs.Discrete1D([1, 2]).pmf(2**70), ValueError,
+     [f"i = {2**70}", "must be an index in [0, 2)"]),
+    (lambda: mcs.Discrete1D([1, 2]).pmf(np.uint64(2**63)), ValueError, [f"i = {2**63}"]),
+    (lambda: mcs.Discrete1D([1, 2]).pmf([0, -2**70]), ValueError, [f"i = {-2**70}"]),
     (lambda: mcs.PiecewiseConstant1D([1, 2]).sample([2.0]), ValueError, ["u[0] = 2"]),
     (lambda: mcs.PiecewiseConstant1D([1, 2]).invert([0.5, 1.5]), ValueError,
      ["x[1] = 1.5", "[0, 1]"]),
@@ -124,6 +134,61 @@ CASES = [
     (lambda: mcs.EnvMap(_img()).uv_to_dir([0.5, 1.5]), ValueError, ["uv[1] = 1.5"]),
     (lambda: mcs.EnvMap(_img()).convert("cube", 0), ValueError, ["resolution = 0"]),
     (lambda: mcs.EnvMap(_img()).convert("cube", 2.5), TypeError, ["resolution"]),
+    (lambda: mcs.EnvMap(_img()).convert("latlong", (-1, 8)), ValueError, ["resolution = -1"]),
+    (lambda: mcs.EnvMap(_img()).convert("latlong", (4, 2**70)), ValueError,
+     [f"resolution = {2**70}"]),
+    # Options after the essential positional arguments are keyword-only.
+    (lambda: mcs.EnvMap(_img(), "latlong"), TypeError, ["positional"]),
+    (lambda: mcs.PiecewiseConstant1D([1, 2], 0.0, 2.0), TypeError, ["positional"]),
+    (lambda: mcs.Phong(0.2, 0.3, 1.0, "max"), TypeError, ["positional"]),
+    (lambda: mcs.estimators.irradiance(mcs.EnvMap(_img()), [0, 1, 0], 10, "mis"), TypeError,
+     ["positional"]),
+    # Named options: one message for all, listing the choices.
+    (lambda: warp.square_to_cosine_hemisphere(U2, method="spiral"), ValueError,
+     ['method = "spiral"', 'must be "concentric" or "polar"']),
+    (lambda: mcs.estimators.irradiance(mcs.EnvMap(_img()), [0, 1, 0], 10, strategy="bsdf"),
+     ValueError, ['strategy = "bsdf"', '"uniform", "cosine", "emitter" or "mis"']),
+    (lambda: mcs.estimators.irradiance(mcs.EnvMap(_img()), [0, 1, 0], 10, heuristic="max"),
+     ValueError, ['heuristic = "max"', '"power" or "balance"']),
+    # Seeds: an int in [0, 2**64), None or a numpy Generator.
+    (lambda: mcs.Rng(seed=2**64), ValueError, [f"seed = {2**64}"]),
+    (lambda: mcs.Rng(seed=-1), ValueError, ["seed = -1"]),
+    (lambda: mcs.Rng(seed="a"), TypeError, ["seed must be an int, None or a numpy"]),
+    (lambda: mcs.Rng(stream=2**63), ValueError, [f"stream = {2**63}"]),
+    (lambda: mcs.uniform(4, seed=1.5), TypeError, ["seed must be an int"]),
+    (lambda: mcs.uniform(4, dim=2**70), ValueError, [f"dim = {2**70}"]),
+    (lambda: mcs.estimators.irradiance(mcs.EnvMap(_img()), [0, 1, 0], 10, seed=2**64),
+     ValueError, [f"seed = {2**64}"]),
+    # Integers of any size: ValueError, never OverflowError.
+    (lambda: mcs.set_num_threads(2**70), ValueError, [f"n = {2**70}"]),
+    (lambda: mcs.estimators.irradiance(mcs.EnvMap(_img()), [0, 1, 0], 2**70), ValueError,
+     [f"n = {2**70}"]),
+    (lambda: mcs.Rng().random(2**70), ValueError, [f"shape = {2**70}"]),
+    # out= arrays: each says what is wrong with them.
+    (lambda: warp.square_to_uniform_disk(np.full((8, 2), 0.5), out=np.zeros((8, 2), np.float32)),
+     TypeError, ["out must have dtype float64, got float32"]),
+    (lambda: warp.square_to_uniform_disk(np.full((8, 2), 0.5), out=[[0.0, 0.0]] * 8), TypeError,
+     ["out must be a numpy array, got list"]),
+    (lambda: warp.square_to_uniform_disk(np.full((8, 2), 0.5), out=np.zeros((8, 3))), ValueError,
+     ["out must have shape (8, 2)", "got (8, 3)"]),
+    (lambda: warp.square_to_uniform_disk(np.full((8, 2), 0.5), out=np.zeros((8, 4))[:, ::2]),
+     ValueError, ["out must be C-ordered (C-contiguous"]),
+    (lambda: warp.square_to_uniform_disk(np.full((8, 2), 0.5), out=_read_only((8, 2))),
+     ValueError, ["out is read-only"]),
+    (lambda: (lambda u: warp.square_to_uniform_disk(u, out=u))(np.full((8, 2), 0.5)), ValueError,
+     ["out must not share memory"]),
+    (lambda: mcs.EnvMap(_img()).sample(np.full((4, 2), 0.5), out=(
+        np.zeros((4, 3)), np.zeros(4, np.float32), np.zeros((4, 3)))), TypeError,
+     ["out[1] must have dtype float64, got float32"]),
+    (lambda: mcs.EnvMap(_img()).pdf(np.ones((4, 3)), out=np.zeros((4, 3))), ValueError,
+     ["out must have shape (4,)", "got (4, 3)"]),
+    # Batches that do not broadcast: the refusal says how to fix the call.
+    (lambda: mcs.Phong(0.2, 0.3, 1.0).sample(np.tile([0, 0, 1.0], (2, 1)), np.full((5, 3), 0.5)),
+     ValueError, ["wi has 2 rows and u has 5", "single row"]),
+    (lambda: mcs.mis.balance_heuristic(np.ones(3), np.ones(4)), ValueError,
+     ["pdf_a has 3 rows and pdf_b has 4"]),
+    (lambda: mcs.Frame([[0, 0, 1], [0, 1, 0]]).to_world(np.ones((3, 3))), ValueError,
+     ["v must have shape (2, 3) or (3,), one row per normal"]),
     # Rejection sampling: a pdf callable returning negative values, values
     # above the bound, NaN; bad bound, domain or n.
     (lambda: mcs.rejection_sample(lambda x: x - 0.5, 1.0, (0, 1), 10), ValueError,
@@ -146,3 +211,44 @@ def test_bad_input_raises(call, exc, fragments):
         call()
     for fragment in fragments:
         assert fragment in str(info.value), str(info.value)
+
+
+def test_max_depth_of_any_size_is_a_value_error():
+    from scenes import diffuse_sphere_under_sky, sensor
+
+    d = dict(diffuse_sphere_under_sky(mcs.EnvMap(_img())), sensor=sensor(width=4, height=3))
+    scene = mcs.Scene.from_mitsuba(d)
+    for depth in [2**70, -2**70, 2**32, -2]:
+        with pytest.raises(ValueError, match=f"max_depth = {depth}: must be -1"):
+            mcs.render(scene, 1, max_depth=depth, progress=False)
+    assert mcs.render(scene, 1, max_depth=2**32 - 1, progress=False).image.shape == (3, 4, 3)
+
+
+def test_a_single_row_broadcasts():
+    """A single row (1, k) is used for every row of the other input of a
+    pair, as a (k,) point is (numpy's broadcasting)."""
+    phong = mcs.Phong(0.2, 0.3, 10.0)
+    u = mcs.uniform(5, 3, seed=1)
+    wi = np.array([0.0, 0.6, 0.8])
+    one = phong.sample(wi, u)
+    row = phong.sample(wi[None, :], u)
+    assert np.array_equal(one.wo, row.wo) and np.array_equal(one.pdf, row.pdf)
+    assert np.array_equal(phong.eval(wi[None, :], one.wo), phong.eval(wi, one.wo))
+    assert mcs.mis.power_heuristic([1.0], np.ones(4)).shape == (4,)
+    normal, v = [0.3, 0.4, 0.5], [1.0, 2.0, 3.0]
+    frames = mcs.Frame(np.tile(normal, (4, 1)))
+    assert np.array_equal(frames.to_world([v]), np.tile(mcs.Frame(normal).to_world(v), (4, 1)))
+
+
+def test_seeds_mean_the_same_everywhere():
+    """The default seed is 0; None draws fresh entropy; a Generator draws a
+    seed from itself, so a seeded Generator reproduces."""
+    assert mcs.Rng().seed == 0 and np.array_equal(mcs.uniform(3), mcs.uniform(3, seed=0))
+    assert mcs.Rng(None).seed != mcs.Rng(None).seed
+    a = mcs.uniform(3, seed=np.random.default_rng(5))
+    assert np.array_equal(a, mcs.uniform(3, seed=np.random.default_rng(5)))
+    env = mcs.EnvMap(_img())
+    e = mcs.estimators.irradiance(env, [0, 1, 0], 100, strategy="envmap")
+    assert e.strategy == "emitter"
+    same = mcs.estimators.irradiance(env, [0, 1, 0], 100, strategy="emitter", seed=0)
+    assert np.array_equal(e.value, same.value)

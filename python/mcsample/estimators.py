@@ -1,9 +1,13 @@
 """Monte Carlo estimators of the light an environment map delivers to a
 point, and their quadrature references.
 
-- :func:`irradiance` (strategies "uniform", "cosine", "envmap", "mis") and
-  :func:`reflected_radiance` from a Phong surface ("bsdf", "envmap", "mis")
+- :func:`irradiance` (strategies "uniform", "cosine", "emitter", "mis") and
+  :func:`reflected_radiance` from a Phong surface ("bsdf", "emitter", "mis")
   run in Rust on all cores; same seed, same bits on any thread count.
+  "emitter" samples the environment map ("envmap" is accepted as the same);
+  MIS weights by the power heuristic unless ``heuristic="balance"`` (the
+  default of :func:`mcsample.render` too). Everything after ``n`` is
+  keyword-only: ``irradiance(env, normal, n, strategy="emitter", seed=1)``.
 - :func:`envmap_integral` integrates any function of direction against an
   environment map by quadrature over its sampling table's cells, where the
   map's radiance is one polynomial; :func:`irradiance_reference` and

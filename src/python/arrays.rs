@@ -1,30 +1,27 @@
-//! Array conventions of every binding, written once:
+//! Array conventions of every binding, written once: conversion, checks and
+//! allocation (the loops that fill the arrays are in [`super::batch`]).
 //!
 //! - any array-like is accepted (lists, ints, float16, non-contiguous views);
 //! - float32 input is computed and returned in float32, anything else in
 //!   float64 ([`with_precision!`]);
 //! - batches are sample-major `(N, K)`; a single `(K,)` point (or a scalar
-//!   for `K = 1`) gives an unbatched result;
+//!   for `K = 1`) gives an unbatched result, and in a pair of inputs a
+//!   single point or a single row serves every row of the other;
 //! - shape and value errors name the argument and the first offending index;
-//! - outputs are fresh numpy arrays, filled with the GIL released.
+//! - outputs are fresh numpy arrays, or the caller's `out` ([`output`]).
 
-use super::parallel::run_batch;
+use super::args::type_name;
 use crate::error::{Error, shape_str};
 use crate::math::Real;
-use crate::simd::{STREAM_MIN_BYTES, map_rows};
-use numpy::PyReadwriteArrayDyn;
 use numpy::{AllowTypeChange, Element, PyArray, PyArrayDescrMethods, PyArrayDyn, PyArrayLikeDyn};
-use numpy::{PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{PyArrayMethods, PyReadwriteArrayDyn, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
 /// A float type the bindings compute in: `f32` or `f64`, readable from
 /// Python and storable in numpy arrays.
-pub trait PyFloat:
-    Element + Real + crate::envmap::TableFloat + for<'a, 'py> FromPyObject<'a, 'py>
-{
-}
+pub trait PyFloat: Element + Real + for<'a, 'py> FromPyObject<'a, 'py> {}
 impl PyFloat for f32 {}
 impl PyFloat for f64 {}
 
@@ -50,32 +47,6 @@ macro_rules! with_precision {
     };
 }
 pub(crate) use with_precision;
-
-/// An integer argument in `[min, max]`; values outside (however large)
-/// raise ValueError (never OverflowError), non-integers TypeError.
-pub fn index_arg(ob: &Bound<'_, PyAny>, arg: &'static str, min: u64, max: u64) -> PyResult<u64> {
-    let py = ob.py();
-    let int = py
-        .import(pyo3::intern!(py, "operator"))?
-        .call_method1(pyo3::intern!(py, "index"), (ob,))
-        .map_err(|_| {
-            PyTypeError::new_err(format!(
-                "{arg} must be an integer, got {}",
-                ob.get_type()
-                    .name()
-                    .map_or_else(|_| "?".into(), |n| n.to_string())
-            ))
-        })?;
-    if int.lt(min)? || int.gt(max)? {
-        return Err(Error::Integer {
-            arg,
-            value: int.to_string(),
-            requirement: format!("must be an integer from {min} to {max}"),
-        }
-        .into());
-    }
-    int.extract()
-}
 
 /// What every input value must satisfy.
 #[derive(Clone, Copy, Debug)]
@@ -128,14 +99,14 @@ impl Check {
     }
 }
 
-/// `(N, batched)` of a batch of `K`-vectors of `shape`: `(N, K)` or `(K,)`,
-/// or for `K = 1`, `(N,)` or `()`; else the error naming `arg`.
-fn batch_shape<const K: usize>(arg: &'static str, shape: &[usize]) -> PyResult<(usize, bool)> {
+/// The batch shape of a batch of `K`-vectors of `shape`: `(N,)` for
+/// `(N, K)`, empty for a single `(K,)` point, or for `K = 1`, `(N,)` or
+/// `()`; else the error naming `arg`.
+fn batch_shape<const K: usize>(arg: &'static str, shape: &[usize]) -> PyResult<Vec<usize>> {
     match (K, shape) {
-        (1, []) => Ok((1, false)),
-        (1, [n]) => Ok((*n, true)),
-        (_, [k]) if *k == K => Ok((1, false)),
-        (_, [n, k]) if *k == K => Ok((*n, true)),
+        (1, [] | [_]) => Ok(shape.to_vec()),
+        (_, [k]) if *k == K => Ok(vec![]),
+        (_, [n, k]) if *k == K => Ok(vec![*n]),
         _ => {
             let expected = if K == 1 {
                 "(N,) or ()".to_string()
@@ -152,6 +123,58 @@ fn batch_shape<const K: usize>(arg: &'static str, shape: &[usize]) -> PyResult<(
     }
 }
 
+/// The shape of a result with `m` values per point of a batch of shape
+/// `batch` (`m = 1`: a scalar each).
+pub fn result_shape(batch: &[usize], m: usize) -> Vec<usize> {
+    let mut shape = batch.to_vec();
+    if m != 1 {
+        shape.push(m);
+    }
+    shape
+}
+
+/// Where the `i`-th point of a batch of shape `batch` sits, with its
+/// component `k` when the points are vectors: `[i0, i1, k]`, `[i]`, or
+/// empty for the one value of an unbatched scalar.
+pub fn position(batch: &[usize], i: usize, k: Option<usize>) -> String {
+    let mut index = vec![0; batch.len()];
+    let mut rest = i;
+    for (slot, &len) in index.iter_mut().zip(batch).rev() {
+        *slot = rest % len.max(1);
+        rest /= len.max(1);
+    }
+    let parts: Vec<String> = index.iter().chain(&k).map(|v| v.to_string()).collect();
+    if parts.is_empty() {
+        String::new()
+    } else {
+        format!("[{}]", parts.join(", "))
+    }
+}
+
+/// The batch shape of the result of a pair of inputs of batch shapes `a`
+/// and `b` (argument names `arg_a`, `arg_b`): a single point, or a batch of
+/// one row, is used for every row of the other input; otherwise both must
+/// have as many rows.
+pub fn broadcast(
+    (arg_a, a): (&'static str, &[usize]),
+    (arg_b, b): (&'static str, &[usize]),
+) -> PyResult<Vec<usize>> {
+    let (n_a, n_b) = (a.iter().product::<usize>(), b.iter().product::<usize>());
+    match (n_a == 1, n_b == 1) {
+        (false, true) => Ok(a.to_vec()),
+        (true, false) => Ok(b.to_vec()),
+        (true, true) => Ok((if a.len() >= b.len() { a } else { b }).to_vec()),
+        (false, false) if a == b => Ok(a.to_vec()),
+        (false, false) => Err(Error::Rows {
+            arg_a,
+            rows_a: n_a,
+            arg_b,
+            rows_b: n_b,
+        }
+        .into()),
+    }
+}
+
 /// A batch of `K`-vectors read from an array-like: `(N, K)` or `(K,)`, or
 /// for `K = 1`, `(N,)` or a scalar.
 pub struct Points<'py, F: Element, const K: usize> {
@@ -160,8 +183,9 @@ pub struct Points<'py, F: Element, const K: usize> {
     owned: Option<Vec<F>>,
     /// Number of points.
     pub n: usize,
-    /// False for a single point given without the batch axis.
-    pub batched: bool,
+    /// The batch shape, `(N,)`; empty for a single point given without the
+    /// batch axis.
+    pub batch: Vec<usize>,
     /// Argument name, for messages.
     pub arg: &'static str,
 }
@@ -172,8 +196,7 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
         let array: PyArrayLikeDyn<'py, F, AllowTypeChange> = ob
             .extract()
             .map_err(|e| PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}")))?;
-        let shape = array.shape().to_vec();
-        let (n, batched) = batch_shape::<K>(arg, &shape)?;
+        let batch = batch_shape::<K>(arg, array.shape())?;
         // Only C order can be read in place (a Fortran-ordered array is
         // contiguous too, in the wrong order): copy anything else once.
         let owned = if array.is_c_contiguous() {
@@ -184,8 +207,8 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
         Ok(Points {
             array,
             owned,
-            n,
-            batched,
+            n: batch.iter().product(),
+            batch,
             arg,
         })
     }
@@ -201,27 +224,16 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
 
     /// Shape of a result with `m` values per point (`m = 1`: a scalar each).
     pub fn out_shape(&self, m: usize) -> Vec<usize> {
-        match (self.batched, m) {
-            (true, 1) => vec![self.n],
-            (true, _) => vec![self.n, m],
-            (false, 1) => vec![],
-            (false, _) => vec![m],
-        }
+        result_shape(&self.batch, m)
     }
 
     /// The error for the first value that fails `check`.
     pub fn invalid(&self, check: Check) -> PyErr {
         for (i, row) in self.rows().iter().enumerate() {
             if let Some(j) = (0..K).find(|&k| !check.holds(k, row[k])) {
-                let index = match (self.batched, K) {
-                    (true, 1) => format!("[{i}]"),
-                    (true, _) => format!("[{i}, {j}]"),
-                    (false, 1) => String::new(),
-                    (false, _) => format!("[{j}]"),
-                };
                 return Error::Element {
                     arg: self.arg,
-                    index,
+                    index: position(&self.batch, i, (K > 1).then_some(j)),
                     value: row[j].f64(),
                     requirement: check.requirement(j),
                 }
@@ -253,119 +265,56 @@ pub fn finish<'py, F: Element>(array: Bound<'py, PyArrayDyn<F>>) -> PyResult<Bou
     }
 }
 
-/// Maps every point through `kernel` (`K` values in, `M` out, of any
-/// element type), checking each input value in the same pass; the GIL is
-/// released and the batch runs on all cores.
-pub fn map<'py, F, T, const K: usize, const M: usize>(
-    py: Python<'py>,
-    x: &Points<'py, F, K>,
-    check: Check,
-    kernel: impl Fn([F; K]) -> [T; M] + Sync + Send,
-) -> PyResult<Bound<'py, PyAny>>
-where
-    F: PyFloat,
-    T: Element + Copy + Default + Send,
-{
-    map_into(py, x, check, None, kernel)
-}
-
-/// [`map`] for kernels that cannot vectorise (table lookups, library
-/// calls): a plain loop per chunk, without the SIMD dispatch and the
-/// transposes of [`map_rows`], which would only add work to them.
-pub fn map_each<'py, F, T, const K: usize, const M: usize>(
-    py: Python<'py>,
-    x: &Points<'py, F, K>,
-    check: Check,
-    kernel: impl Fn([F; K]) -> [T; M] + Sync + Send,
-) -> PyResult<Bound<'py, PyAny>>
-where
-    F: PyFloat,
-    T: Element + Copy + Default + Send,
-{
-    let out = zeros::<T>(py, &x.out_shape(M));
-    {
-        let mut guard = out.readwrite();
-        let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
-        let in_rows = x.rows();
-        let valid = run_batch(py, x.n, out_rows, |range, chunk: &mut [[T; M]]| {
-            let mut ok = true;
-            for (o, p) in chunk.iter_mut().zip(&in_rows[range]) {
-                ok &= check.holds_all(p);
-                *o = kernel(*p);
-            }
-            ok
-        })?;
-        if !valid {
-            return Err(x.invalid(check));
-        }
-    }
-    finish(out)
-}
-
-/// [`map`] for kernels that take a whole chunk of points at once and
-/// write one value per point (for work shared across points, such as
-/// prefetching table cells): every input value is checked first, and the
-/// kernel runs only on chunks that pass.
-pub fn map_chunks<'py, F, T, const K: usize>(
-    py: Python<'py>,
-    x: &Points<'py, F, K>,
-    check: Check,
-    kernel: impl Fn(&[[F; K]], &mut [T]) + Sync + Send,
-) -> PyResult<Bound<'py, PyAny>>
-where
-    F: PyFloat,
-    T: Element + Copy + Default + Send,
-{
-    let out = zeros::<T>(py, &x.out_shape(1));
-    {
-        let mut guard = out.readwrite();
-        let in_rows = x.rows();
-        let valid = run_batch(py, x.n, guard.as_slice_mut()?, |range, chunk: &mut [T]| {
-            let inputs = &in_rows[range];
-            let ok = inputs.iter().fold(true, |ok, p| ok & check.holds_all(p));
-            if ok {
-                kernel(inputs, chunk);
-            }
-            ok
-        })?;
-        if !valid {
-            return Err(x.invalid(check));
-        }
-    }
-    finish(out)
-}
-
-/// The array results go to: `out` when given (checked to be a writeable,
-/// C-ordered array of `shape` and of dtype `T`, as numpy's ufuncs check
-/// theirs), else a fresh one.
+/// The array results go to: `out` (argument `arg`) when given, checked as
+/// numpy's ufuncs check theirs (a numpy array of dtype `T` and of `shape`,
+/// C-ordered and writeable; each failure says which), else a fresh one.
 pub fn output<'py, T: Element>(
     py: Python<'py>,
     shape: &[usize],
     out: Option<&Bound<'py, PyAny>>,
+    arg: &'static str,
 ) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     let Some(out) = out.filter(|o| !o.is_none()) else {
         return Ok(zeros::<T>(py, shape));
     };
-    let array = out.cast::<PyArrayDyn<T>>().map_err(|_| {
+    let array = out.cast::<PyUntypedArray>().map_err(|_| {
         PyTypeError::new_err(format!(
-            "out must be a numpy array of dtype {}, got {}",
-            numpy::dtype::<T>(py),
-            out.get_type()
-                .name()
-                .map_or_else(|_| "?".into(), |n| n.to_string())
+            "{arg} must be a numpy array, got {}",
+            type_name(out)
         ))
     })?;
-    let writeable: bool = array.getattr("flags")?.getattr("writeable")?.extract()?;
-    let fits = array.shape() == shape && array.is_c_contiguous() && writeable;
-    if !fits {
+    let (want, got) = (numpy::dtype::<T>(py), array.dtype());
+    if !got.is_equiv_to(&want) {
+        return Err(PyTypeError::new_err(format!(
+            "{arg} must have dtype {want}, got {got}"
+        )));
+    }
+    if array.shape() != shape {
         return Err(Error::Shape {
-            arg: "out",
+            arg,
             expected: format!("{} (a writeable C-ordered array)", shape_str(shape)),
             got: shape_str(array.shape()),
         }
         .into());
     }
-    Ok(array.clone())
+    let problem = if !array.is_c_contiguous() {
+        Some(format!(
+            "{arg} must be C-ordered (C-contiguous, as np.empty makes it), not a view with other \
+             strides"
+        ))
+    } else if !array
+        .getattr(pyo3::intern!(py, "flags"))?
+        .getattr(pyo3::intern!(py, "writeable"))?
+        .extract::<bool>()?
+    {
+        Some(format!("{arg} is read-only (its flags.writeable is False)"))
+    } else {
+        None
+    };
+    if let Some(message) = problem {
+        return Err(Error::Argument { arg, message }.into());
+    }
+    Ok(array.cast::<PyArrayDyn<T>>()?.clone())
 }
 
 /// Write access to an output array, which fails (rather than panics) when
@@ -374,195 +323,12 @@ pub fn writable<'py, T: Element>(
     out: &Bound<'py, PyArrayDyn<T>>,
 ) -> PyResult<PyReadwriteArrayDyn<'py, T>> {
     out.try_readwrite().map_err(|_| {
-        pyo3::exceptions::PyValueError::new_err(
-            "out must not share memory with an input array or another output",
-        )
+        Error::Argument {
+            arg: "out",
+            message: "out must not share memory with an input array or another output".into(),
+        }
+        .into()
     })
-}
-
-/// As [`map`], writing into `out` when it is given (see [`output`]).
-pub fn map_into<'py, F, T, const K: usize, const M: usize>(
-    py: Python<'py>,
-    x: &Points<'py, F, K>,
-    check: Check,
-    out: Option<&Bound<'py, PyAny>>,
-    kernel: impl Fn([F; K]) -> [T; M] + Sync + Send,
-) -> PyResult<Bound<'py, PyAny>>
-where
-    F: PyFloat,
-    T: Element + Copy + Default + Send,
-{
-    let out = output::<T>(py, &x.out_shape(M), out)?;
-    {
-        let mut guard = writable(&out)?;
-        let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
-        let in_rows = x.rows();
-        // One batch per check, each with a loop that has no dispatch left.
-        // (One batch holding the three loops behind a `match` ran the
-        // kernels a third slower: LLVM compiled that closure worse.)
-        let valid = match check {
-            Check::Unit => map_batch(py, out_rows, in_rows, &kernel, |u| {
-                u.iter()
-                    .fold(true, |ok, &v| ok & (v >= F::zero()) & (v <= F::one()))
-            }),
-            Check::Finite => map_batch(py, out_rows, in_rows, &kernel, |u| {
-                u.iter().fold(true, |ok, &v| ok & v.is_finite())
-            }),
-            Check::Within(_) | Check::Density => {
-                map_batch(py, out_rows, in_rows, &kernel, |u| check.holds_all(u))
-            }
-        }?;
-        if !valid {
-            return Err(x.invalid(check));
-        }
-    }
-    finish(out)
-}
-
-/// `out[i] = kernel(inputs[i])` on all cores with the GIL released (see
-/// [`map_rows`]; streamed for outputs of [`STREAM_MIN_BYTES`] or more);
-/// whether `valid` held for every input.
-fn map_batch<F, T, const K: usize, const M: usize>(
-    py: Python<'_>,
-    out: &mut [[T; M]],
-    inputs: &[[F; K]],
-    kernel: &(impl Fn([F; K]) -> [T; M] + Sync),
-    valid: impl Fn(&[F; K]) -> bool + Sync,
-) -> PyResult<bool>
-where
-    F: Copy + Default + Sync,
-    T: Copy + Default + Send,
-{
-    let stream = size_of_val(out) >= STREAM_MIN_BYTES;
-    run_batch(py, inputs.len(), out, |range, chunk: &mut [[T; M]]| {
-        map_rows(chunk, &inputs[range], kernel, &valid, stream)
-    })
-}
-
-/// Maps pairs `(a[i], b[i])` through `kernel`; either input may be a single
-/// point, used for every row (the result is unbatched only when both are).
-/// Each input value is checked in the same pass; the GIL is released.
-pub fn map_pair<'py, F, T, const KA: usize, const KB: usize, const M: usize>(
-    py: Python<'py>,
-    a: (&Points<'py, F, KA>, Check),
-    b: (&Points<'py, F, KB>, Check),
-    kernel: impl Fn([F; KA], [F; KB]) -> [T; M] + Sync + Send,
-) -> PyResult<Bound<'py, PyAny>>
-where
-    F: PyFloat,
-    T: Element + Copy + Default + Send,
-{
-    let ((a, check_a), (b, check_b)) = (a, b);
-    let n = pair_len(a, b)?;
-    let shape = match (a.batched || b.batched, M) {
-        (true, 1) => vec![n],
-        (true, _) => vec![n, M],
-        (false, 1) => vec![],
-        (false, _) => vec![M],
-    };
-    let out = zeros::<T>(py, &shape);
-    {
-        let mut guard = out.readwrite();
-        let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
-        let (rows_a, rows_b) = (a.rows(), b.rows());
-        let (step_a, step_b) = (usize::from(a.batched), usize::from(b.batched));
-        let (valid_a, valid_b) = run_batch_pair(py, n, out_rows, |range, chunk: &mut [[T; M]]| {
-            let (mut ok_a, mut ok_b) = (true, true);
-            for (o, i) in chunk.iter_mut().zip(range) {
-                let (x, y) = (rows_a[i * step_a], rows_b[i * step_b]);
-                ok_a &= check_a.holds_all(&x);
-                ok_b &= check_b.holds_all(&y);
-                *o = kernel(x, y);
-            }
-            (ok_a, ok_b)
-        })?;
-        if !valid_a {
-            return Err(a.invalid(check_a));
-        }
-        if !valid_b {
-            return Err(b.invalid(check_b));
-        }
-    }
-    finish(out)
-}
-
-/// The row count of a pair of inputs that broadcast against each other.
-pub fn pair_len<F: Element, const KA: usize, const KB: usize>(
-    a: &Points<'_, F, KA>,
-    b: &Points<'_, F, KB>,
-) -> PyResult<usize> {
-    match (a.batched, b.batched) {
-        (true, true) if a.n != b.n => Err(Error::Shape {
-            arg: b.arg,
-            expected: format!("{} rows, as {} has (or a single point)", a.n, a.arg),
-            got: format!("{} rows", b.n),
-        }
-        .into()),
-        (_, true) => Ok(b.n),
-        _ => Ok(a.n),
-    }
-}
-
-/// [`run_batch`] for kernels that check two inputs: returns whether each
-/// was valid throughout.
-pub fn run_batch_pair<O, K>(
-    py: Python<'_>,
-    n: usize,
-    outputs: O,
-    kernel: K,
-) -> PyResult<(bool, bool)>
-where
-    O: crate::parallel::Outputs,
-    K: Fn(std::ops::Range<usize>, O) -> (bool, bool) + Sync + Send,
-{
-    use std::sync::atomic::{AtomicBool, Ordering};
-    let (bad_a, bad_b) = (AtomicBool::new(false), AtomicBool::new(false));
-    run_batch(py, n, outputs, |range, out| {
-        let (ok_a, ok_b) = kernel(range, out);
-        if !ok_a {
-            bad_a.store(true, Ordering::Relaxed);
-        }
-        if !ok_b {
-            bad_b.store(true, Ordering::Relaxed);
-        }
-        ok_a && ok_b
-    })?;
-    Ok((!bad_a.into_inner(), !bad_b.into_inner()))
-}
-
-/// As [`map`] for kernels with two results (`M` and `L` values per point),
-/// returned as two arrays.
-pub fn map2<'py, F, T, S, const K: usize, const M: usize, const L: usize>(
-    py: Python<'py>,
-    x: &Points<'py, F, K>,
-    check: Check,
-    kernel: impl Fn([F; K]) -> ([T; M], [S; L]) + Sync + Send,
-) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)>
-where
-    F: PyFloat,
-    T: Element + Copy + Default + Send,
-    S: Element + Copy + Default + Send,
-{
-    let first = zeros::<T>(py, &x.out_shape(M));
-    let second = zeros::<S>(py, &x.out_shape(L));
-    {
-        let (mut g1, mut g2) = (first.readwrite(), second.readwrite());
-        let rows1 = g1.as_slice_mut()?.as_chunks_mut::<M>().0;
-        let rows2 = g2.as_slice_mut()?.as_chunks_mut::<L>().0;
-        let in_rows = x.rows();
-        let valid = run_batch(py, x.n, (rows1, rows2), |range, (c1, c2)| {
-            let mut ok = true;
-            for ((o1, o2), u) in c1.iter_mut().zip(c2.iter_mut()).zip(&in_rows[range]) {
-                ok &= check.holds_all(u);
-                (*o1, *o2) = kernel(*u);
-            }
-            ok
-        })?;
-        if !valid {
-            return Err(x.invalid(check));
-        }
-    }
-    Ok((finish(first)?, finish(second)?))
 }
 
 /// Integer indices read from an array-like: `(N, K)` or `(K,)` (for
@@ -571,81 +337,85 @@ where
 pub struct Indices<const K: usize> {
     /// The indices, one `[usize; K]` per point.
     pub rows: Vec<[usize; K]>,
-    /// False for a single point given without the batch axis.
-    pub batched: bool,
+    /// The batch shape; empty for a single point.
+    pub batch: Vec<usize>,
 }
 
 impl<const K: usize> Indices<K> {
     /// Reads and checks `ob` (argument `arg`); floats raise TypeError, an
-    /// index out of range ValueError naming its position.
+    /// index out of range (however large) ValueError naming its position.
     pub fn extract(ob: &Bound<'_, PyAny>, arg: &'static str, bounds: [usize; K]) -> PyResult<Self> {
         let py = ob.py();
         let array = py
             .import(pyo3::intern!(py, "numpy"))?
             .call_method1(pyo3::intern!(py, "asarray"), (ob,))?;
-        let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
-        if kind != "i" && kind != "u" {
-            return Err(PyTypeError::new_err(format!(
-                "{arg} must be integers, got an array of dtype {}",
-                array.getattr("dtype")?
-            )));
-        }
-        let array: PyArrayLikeDyn<'_, i64, AllowTypeChange> = array.extract()?;
-        let shape = array.shape().to_vec();
-        let (_, batched) = batch_shape::<K>(arg, &shape)?;
-        let flat: Vec<i64> = array.as_array().iter().copied().collect();
+        let dtype = array.getattr("dtype")?;
+        let kind: String = dtype.getattr("kind")?.extract()?;
+        let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+        let batch = batch_shape::<K>(arg, &shape)?;
+        // Read every index exactly, whatever its integer type (an int too
+        // large for int64 comes as an object array).
+        let flat: Vec<i128> = match kind.as_str() {
+            "i" => {
+                let a: PyArrayLikeDyn<'_, i64, AllowTypeChange> = array.extract()?;
+                a.as_array().iter().map(|&v| i128::from(v)).collect()
+            }
+            "u" => {
+                let a: PyArrayLikeDyn<'_, u64, AllowTypeChange> = array.extract()?;
+                a.as_array().iter().map(|&v| i128::from(v)).collect()
+            }
+            "O" => {
+                let mut values = Vec::new();
+                for v in array.call_method0("ravel")?.try_iter()? {
+                    match v?.call_method0("__index__") {
+                        // Beyond i128: out of range all the same.
+                        Ok(int) => values.push(int.extract::<i128>().unwrap_or(i128::MAX)),
+                        Err(_) => return Err(not_integers(arg, &dtype)),
+                    }
+                }
+                values
+            }
+            _ => return Err(not_integers(arg, &dtype)),
+        };
         let mut rows = Vec::with_capacity(flat.len() / K);
         for (i, chunk) in flat.as_chunks::<K>().0.iter().enumerate() {
             let mut row = [0usize; K];
             for (k, (&v, &bound)) in chunk.iter().zip(&bounds).enumerate() {
-                if v < 0 || v as u64 >= bound as u64 {
-                    let index = match (batched, K) {
-                        (true, 1) => format!("[{i}]"),
-                        (true, _) => format!("[{i}, {k}]"),
-                        (false, 1) => String::new(),
-                        (false, _) => format!("[{k}]"),
-                    };
-                    return Err(Error::Index {
-                        arg,
-                        index,
-                        value: v,
-                        len: bound,
+                match usize::try_from(v) {
+                    Ok(index) if index < bound => row[k] = index,
+                    _ => {
+                        let index = position(&batch, i, (K > 1).then_some(k));
+                        return Err(match i64::try_from(v) {
+                            Ok(value) => Error::Index {
+                                arg,
+                                index,
+                                value,
+                                len: bound,
+                            },
+                            Err(_) => Error::Integer {
+                                arg,
+                                value: array
+                                    .call_method0("ravel")?
+                                    .get_item(i * K + k)?
+                                    .to_string(),
+                                requirement: format!("must be an index in [0, {bound})"),
+                            },
+                        }
+                        .into());
                     }
-                    .into());
                 }
-                row[k] = v as usize;
             }
             rows.push(row);
         }
-        Ok(Indices { rows, batched })
+        Ok(Indices { rows, batch })
     }
+}
 
-    /// Maps every index row to one float64 value; shape `(N,)`, or a
-    /// scalar for an unbatched row.
-    pub fn map_f64<'py>(
-        &self,
-        py: Python<'py>,
-        f: impl Fn([usize; K]) -> f64 + Sync + Send,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let shape: Vec<usize> = if self.batched {
-            vec![self.rows.len()]
-        } else {
-            vec![]
-        };
-        let out = zeros::<f64>(py, &shape);
-        {
-            let mut guard = out.readwrite();
-            let values = guard.as_slice_mut()?;
-            let rows = &self.rows;
-            run_batch(py, rows.len(), values, |range, chunk: &mut [f64]| {
-                for (o, &r) in chunk.iter_mut().zip(&rows[range]) {
-                    *o = f(r);
-                }
-                true
-            })?;
-        }
-        finish(out)
-    }
+/// The TypeError for indices `arg` given as an array of `dtype`.
+fn not_integers(arg: &str, dtype: &Bound<'_, PyAny>) -> PyErr {
+    PyTypeError::new_err(format!(
+        "{arg} must be integers, got an array of dtype {dtype}"
+    ))
 }
 
 /// A table of weights read as float64 (converted only if it is not already

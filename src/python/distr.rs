@@ -3,7 +3,8 @@
 //! are built with the GIL released; every `u` is checked to lie in [0, 1]
 //! in the sampling pass.
 
-use super::arrays::{Check, Indices, Points, Table, map, map_chunks, map2, with_precision};
+use super::arrays::{Check, Indices, Points, Table, with_precision};
+use super::batch::{map, map_chunks, map_indices, map2};
 use super::parallel::detached;
 use crate::distr;
 use crate::math::Real;
@@ -72,7 +73,8 @@ fn pmf_of<'py>(
     match i {
         None => Ok(per_index(py, table.size(), |k| table.probability(k)).into_any()),
         Some(i) => {
-            Indices::<1>::extract(i, "i", [table.size()])?.map_f64(py, |[k]| table.probability(k))
+            let i = Indices::<1>::extract(i, "i", [table.size()])?;
+            map_indices(py, &i, |[k]| table.probability(k))
         }
     }
 }
@@ -321,8 +323,10 @@ impl PyDiscrete2D {
                 let flat = per_index(py, rows * cols, |k| self.0.pmf(k / cols, k % cols));
                 Ok(flat.call_method1("reshape", (rows, cols))?)
             }
-            Some(idx) => Indices::<2>::extract(idx, "idx", [rows, cols])?
-                .map_f64(py, |[r, c]| self.0.pmf(r, c)),
+            Some(idx) => {
+                let idx = Indices::<2>::extract(idx, "idx", [rows, cols])?;
+                map_indices(py, &idx, |[r, c]| self.0.pmf(r, c))
+            }
         }
     }
 
@@ -353,7 +357,7 @@ impl PyDiscrete2D {
 /// ----------
 /// values : array_like, shape (n,)
 ///     Finite, >= 0, not all zero.
-/// a, b : float
+/// a, b : float, keyword only
 ///     The interval, finite with a < b.
 #[pyclass(module = "mcsample._core", name = "PiecewiseConstant1D", frozen)]
 pub struct PyPiecewiseConstant1D(distr::PiecewiseConstant1D);
@@ -361,7 +365,7 @@ pub struct PyPiecewiseConstant1D(distr::PiecewiseConstant1D);
 #[pymethods]
 impl PyPiecewiseConstant1D {
     #[new]
-    #[pyo3(signature = (values, a = 0.0, b = 1.0))]
+    #[pyo3(signature = (values, *, a = 0.0, b = 1.0))]
     fn new(py: Python<'_>, values: &Bound<'_, PyAny>, a: f64, b: f64) -> PyResult<Self> {
         let t = Table::extract(values, "values", 1)?;
         let v = t.values();
@@ -473,14 +477,15 @@ impl PyPiecewiseConstant1D {
 /// ----------
 /// values : array_like, shape (rows, cols)
 ///     Finite, >= 0, not all zero.
-/// domain : ((x0, x1), (y0, y1)), finite with x0 < x1 and y0 < y1
+/// domain : ((x0, x1), (y0, y1)), keyword only
+///     Finite, with x0 < x1 and y0 < y1.
 #[pyclass(module = "mcsample._core", name = "PiecewiseConstant2D", frozen)]
 pub struct PyPiecewiseConstant2D(distr::PiecewiseConstant2D);
 
 #[pymethods]
 impl PyPiecewiseConstant2D {
     #[new]
-    #[pyo3(signature = (values, domain = ((0.0, 1.0), (0.0, 1.0))))]
+    #[pyo3(signature = (values, *, domain = ((0.0, 1.0), (0.0, 1.0))))]
     fn new(
         py: Python<'_>,
         values: &Bound<'_, PyAny>,

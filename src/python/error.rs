@@ -1,6 +1,7 @@
-//! Error mapping: core [`Error`]s become `ValueError` / `OSError` with the
-//! core's message unchanged; a Rust panic becomes `RuntimeError` (never
-//! PyO3's `PanicException`, which `except Exception` does not catch).
+//! Error mapping: core [`Error`]s become `ValueError` / `OSError` (and
+//! `RuntimeError` when the worker threads cannot start) with the core's
+//! message unchanged; a Rust panic becomes `RuntimeError` (never PyO3's
+//! `PanicException`, which `except Exception` does not catch).
 
 use crate::error::Error;
 use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
@@ -11,6 +12,7 @@ impl From<Error> for PyErr {
     fn from(e: Error) -> PyErr {
         match e {
             Error::Io { .. } => PyOSError::new_err(e.to_string()),
+            Error::ThreadPool { .. } => PyRuntimeError::new_err(e.to_string()),
             Error::InvalidWeight { .. }
             | Error::AllZero { .. }
             | Error::Shape { .. }
@@ -20,6 +22,8 @@ impl From<Error> for PyErr {
             | Error::Integer { .. }
             | Error::TooLarge { .. }
             | Error::Index { .. }
+            | Error::Argument { .. }
+            | Error::Rows { .. }
             | Error::NotEnergyConserving { .. } => PyValueError::new_err(e.to_string()),
         }
     }

@@ -1,12 +1,12 @@
 //! `mcsample.estimators`: irradiance and reflected radiance under an
 //! environment map (see [`crate::estimators`]).
 
-use super::arrays::index_arg;
+use super::args::{choice, heuristic_arg, index_arg, seed};
 use super::envmap::PyEnvMap;
 use super::parallel::detached;
 use super::phong::PyPhong;
 use crate::error::Error;
-use crate::estimators::{self, Estimate, Heuristic, Plan, Strategy};
+use crate::estimators::{self, Estimate, Plan, Strategy};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 #[pyclass(module = "mcsample._core.estimators", name = "Estimate", frozen)]
 pub struct PyEstimate {
     estimate: Estimate,
-    strategy: String,
+    strategy: Strategy,
 }
 
 #[pymethods]
@@ -38,35 +38,22 @@ impl PyEstimate {
         self.estimate.n
     }
 
-    /// The strategy that produced it.
+    /// The strategy that produced it ("envmap" is reported as "emitter").
     #[getter]
-    fn strategy(&self) -> &str {
-        &self.strategy
+    fn strategy(&self) -> &'static str {
+        self.strategy.name()
     }
 
     fn __repr__(&self) -> String {
         let e = &self.estimate;
         format!(
             "Estimate(value={:?}, stderr={:?}, n={}, strategy={:?})",
-            e.value, e.stderr, e.n, self.strategy
+            e.value,
+            e.stderr,
+            e.n,
+            self.strategy.name()
         )
     }
-}
-
-fn choice<T>(
-    arg: &'static str,
-    name: &str,
-    parse: impl Fn(&str) -> Option<T>,
-    allowed: &str,
-) -> PyResult<T> {
-    parse(name).ok_or_else(|| {
-        Error::Choice {
-            arg,
-            value: name.into(),
-            requirement: format!("must be one of {allowed}"),
-        }
-        .into()
-    })
 }
 
 fn vector(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<[f64; 3]> {
@@ -83,6 +70,23 @@ fn vector(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<[f64; 3]> {
     })
 }
 
+/// The strategies of [`irradiance`] (and their names).
+const IRRADIANCE: &[(&str, Strategy)] = &[
+    ("uniform", Strategy::Uniform),
+    ("cosine", Strategy::Cosine),
+    ("emitter", Strategy::Emitter),
+    ("envmap", Strategy::Emitter),
+    ("mis", Strategy::Mis),
+];
+
+/// The strategies of [`reflected_radiance`].
+const REFLECTED: &[(&str, Strategy)] = &[
+    ("bsdf", Strategy::Bsdf),
+    ("emitter", Strategy::Emitter),
+    ("envmap", Strategy::Emitter),
+    ("mis", Strategy::Mis),
+];
+
 /// The irradiance E = integral of L(w) max(0, n.w) dw at a surface of
 /// normal ``normal`` under ``env``, by Monte Carlo.
 ///
@@ -91,36 +95,45 @@ fn vector(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<[f64; 3]> {
 /// env : EnvMap
 /// normal : (3,) array_like, world space (normalised here)
 /// n : int >= 1
-///     Evaluations (an "mis" evaluation uses one cosine and one envmap
+///     Evaluations (an "mis" evaluation uses one cosine and one emitter
 ///     sample).
-/// strategy : "uniform", "cosine", "envmap" or "mis" (default)
-/// seed : int
-///     Seed of the PCG32 stream; the result does not depend on the thread
-///     count.
-/// heuristic : "balance" (default) or "power"
+/// strategy : "uniform", "cosine", "emitter" or "mis" (default)
+///     "emitter" samples the map ("envmap" is the same).
+/// seed : int, None or numpy.random.Generator
+///     Seed of the PCG32 stream (default 0); the result does not depend on
+///     the thread count. None draws a fresh seed from the operating system,
+///     a Generator draws one from itself.
+/// heuristic : "power" (default) or "balance"
+///
+/// Everything after ``n`` is keyword-only.
 ///
 /// Returns
 /// -------
 /// Estimate
-///     ``.value`` (3,) RGB, ``.stderr`` (3,), ``.n``.
+///     ``.value`` (3,) RGB, ``.stderr`` (3,), ``.n``, ``.strategy``.
 #[pyfunction]
-#[pyo3(signature = (env, normal, n, strategy = "mis", seed = None, heuristic = "balance"))]
+#[pyo3(signature = (env, normal, n, *, strategy = "mis", seed = 0, heuristic = "power"))]
 pub fn irradiance(
     py: Python<'_>,
     env: &Bound<'_, PyEnvMap>,
     normal: &Bound<'_, PyAny>,
     n: &Bound<'_, PyAny>,
     strategy: &str,
-    seed: Option<&Bound<'_, PyAny>>,
+    #[pyo3(from_py_with = seed)] seed: u64,
     heuristic: &str,
 ) -> PyResult<PyEstimate> {
     let normal = vector(normal, "normal")?;
-    let plan = plan(n, seed, strategy, "uniform, cosine, envmap, mis", heuristic)?;
+    let plan = plan(
+        n,
+        seed,
+        choice("strategy", strategy, IRRADIANCE)?,
+        heuristic,
+    )?;
     let env = env.get().inner();
     let estimate = detached(py, || estimators::irradiance(env, normal, plan))?;
     Ok(PyEstimate {
         estimate,
-        strategy: strategy.into(),
+        strategy: plan.strategy,
     })
 }
 
@@ -134,15 +147,19 @@ pub fn irradiance(
 /// normal, wi : (3,) array_like, world space (normalised here); wi points
 ///     toward the viewer
 /// n : int >= 1
-/// strategy : "bsdf", "envmap" or "mis" (default)
-/// seed : int
-/// heuristic : "balance" (default) or "power"
+/// strategy : "bsdf", "emitter" or "mis" (default)
+///     "emitter" samples the map ("envmap" is the same).
+/// seed : int, None or numpy.random.Generator
+///     As for ``irradiance`` (default 0).
+/// heuristic : "power" (default) or "balance"
+///
+/// Everything after ``n`` is keyword-only.
 ///
 /// Returns
 /// -------
 /// Estimate
 #[pyfunction]
-#[pyo3(signature = (env, phong, normal, wi, n, strategy = "mis", seed = None, heuristic = "balance"))]
+#[pyo3(signature = (env, phong, normal, wi, n, *, strategy = "mis", seed = 0, heuristic = "power"))]
 #[allow(clippy::too_many_arguments)] // the Python signature
 pub fn reflected_radiance(
     py: Python<'_>,
@@ -152,44 +169,28 @@ pub fn reflected_radiance(
     wi: &Bound<'_, PyAny>,
     n: &Bound<'_, PyAny>,
     strategy: &str,
-    seed: Option<&Bound<'_, PyAny>>,
+    #[pyo3(from_py_with = seed)] seed: u64,
     heuristic: &str,
 ) -> PyResult<PyEstimate> {
     let (normal, wi) = (vector(normal, "normal")?, vector(wi, "wi")?);
-    let plan = plan(n, seed, strategy, "bsdf, envmap, mis", heuristic)?;
+    let plan = plan(n, seed, choice("strategy", strategy, REFLECTED)?, heuristic)?;
     let (env, phong) = (env.get().inner(), phong.get().inner());
     let estimate = detached(py, || {
         estimators::reflected_radiance(env, phong, normal, wi, plan)
     })?;
     Ok(PyEstimate {
         estimate,
-        strategy: strategy.into(),
+        strategy: plan.strategy,
     })
 }
 
-/// The checked arguments of an estimator; `allowed` lists its strategies.
-fn plan(
-    n: &Bound<'_, PyAny>,
-    seed: Option<&Bound<'_, PyAny>>,
-    strategy: &str,
-    allowed: &str,
-    heuristic: &str,
-) -> PyResult<Plan> {
-    let offered =
-        |name: &str| Strategy::from_name(name).filter(|_| allowed.split(", ").any(|a| a == name));
+/// The checked arguments of an estimator.
+fn plan(n: &Bound<'_, PyAny>, seed: u64, strategy: Strategy, heuristic: &str) -> PyResult<Plan> {
     Ok(Plan {
         n: index_arg(n, "n", 1, 1 << 40)? as usize,
-        strategy: choice("strategy", strategy, offered, allowed)?,
-        heuristic: choice(
-            "heuristic",
-            heuristic,
-            Heuristic::from_name,
-            "balance, power",
-        )?,
-        seed: match seed.filter(|s| !s.is_none()) {
-            Some(s) => index_arg(s, "seed", 0, u64::MAX)?,
-            None => 0,
-        },
+        strategy,
+        heuristic: heuristic_arg(heuristic)?,
+        seed,
     })
 }
 

@@ -1,7 +1,9 @@
 //! `mcsample.Frame`: orthonormal frames around one normal or a batch of
 //! normals (see [`crate::frame`]).
 
-use super::arrays::{Check, Points, PyFloat, finish, map, with_precision, zeros};
+use super::arrays::{Check, Points, PyFloat, broadcast, finish, position, result_shape};
+use super::arrays::{with_precision, zeros};
+use super::batch::map;
 use super::parallel::run_batch;
 use crate::error::{Error, shape_str};
 use crate::frame::Frame;
@@ -23,7 +25,8 @@ use pyo3::prelude::*;
 #[pyclass(module = "mcsample._core", name = "Frame", frozen)]
 pub struct PyFrame {
     frames: Vec<Frame<f64>>,
-    batched: bool,
+    /// The normals' batch shape; empty for one normal given as `(3,)`.
+    batch: Vec<usize>,
 }
 
 fn cast<F: Real>(f: &Frame<f64>) -> Frame<F> {
@@ -37,7 +40,7 @@ fn cast<F: Real>(f: &Frame<f64>) -> Frame<F> {
 
 impl PyFrame {
     /// `op(frame, v)` for every row: one frame for all rows, or frame i for
-    /// row i.
+    /// row i (one row of `v` serves every frame).
     fn apply<'py, F: PyFloat>(
         &self,
         py: Python<'py>,
@@ -46,20 +49,19 @@ impl PyFrame {
     ) -> PyResult<Bound<'py, PyAny>> {
         let v = Points::<F, 3>::extract(v, "v")?;
         let frames: Vec<Frame<F>> = self.frames.iter().map(cast).collect();
-        if !self.batched {
+        if self.batch.is_empty() {
             let f = frames[0];
             return map(py, &v, Check::Finite, move |x| op(&f, x));
         }
-        if v.batched && v.n != frames.len() {
-            return Err(Error::Shape {
+        let batch =
+            broadcast(("normal", &self.batch), ("v", &v.batch)).map_err(|_| Error::Shape {
                 arg: "v",
-                expected: format!("({}, 3) or (3,), one row per normal", frames.len()),
-                got: shape_str(&[v.n, 3]),
-            }
-            .into());
-        }
-        let n = frames.len();
-        let out = zeros::<F>(py, &[n, 3]);
+                expected: format!("{} or (3,), one row per normal", shape_str(&self.shape())),
+                got: shape_str(&v.out_shape(3)),
+            })?;
+        let n = batch.iter().product();
+        let (step_f, step_v) = (usize::from(frames.len() != 1), usize::from(v.n != 1));
+        let out = zeros::<F>(py, &result_shape(&batch, 3));
         {
             let mut guard = out.readwrite();
             let rows = guard.as_slice_mut()?.as_chunks_mut::<3>().0;
@@ -67,9 +69,9 @@ impl PyFrame {
             let valid = run_batch(py, n, rows, |range, chunk: &mut [[F; 3]]| {
                 let mut ok = true;
                 for (k, i) in range.enumerate() {
-                    let x = inputs[if v.batched { i } else { 0 }];
+                    let x = inputs[i * step_v];
                     ok &= x.iter().all(|c| c.is_finite());
-                    chunk[k] = op(&frames[i], x);
+                    chunk[k] = op(&frames[i * step_f], x);
                 }
                 ok
             })?;
@@ -80,17 +82,17 @@ impl PyFrame {
         finish(out)
     }
 
+    /// The shape of one axis for every frame: the normals' shape.
+    fn shape(&self) -> Vec<usize> {
+        result_shape(&self.batch, 3)
+    }
+
     fn axis<'py>(
         &self,
         py: Python<'py>,
         pick: fn(&Frame<f64>) -> [f64; 3],
     ) -> PyResult<Bound<'py, PyAny>> {
-        let shape: Vec<usize> = if self.batched {
-            vec![self.frames.len(), 3]
-        } else {
-            vec![3]
-        };
-        let out = zeros::<f64>(py, &shape);
+        let out = zeros::<f64>(py, &self.shape());
         {
             let mut guard = out.readwrite();
             let flat = guard.as_slice_mut()?;
@@ -113,11 +115,7 @@ impl PyFrame {
             if !(len.is_finite() && len > 0.0) {
                 return Err(Error::Element {
                     arg: "normal",
-                    index: if normals.batched {
-                        format!("[{i}]")
-                    } else {
-                        String::new()
-                    },
+                    index: position(&normals.batch, i, None),
                     value: len,
                     requirement: "the normal must be finite and non-zero (this is its length)"
                         .into(),
@@ -128,7 +126,7 @@ impl PyFrame {
         }
         Ok(PyFrame {
             frames,
-            batched: normals.batched,
+            batch: normals.batch,
         })
     }
 
@@ -183,8 +181,8 @@ impl PyFrame {
     }
 
     fn __repr__(&self) -> String {
-        match (self.batched, self.frames.first()) {
-            (false, Some(f)) => format!("Frame(n={:?})", f.n),
+        match (self.batch.is_empty(), self.frames.first()) {
+            (true, Some(f)) => format!("Frame(n={:?})", f.n),
             _ => format!("Frame({} normals)", self.frames.len()),
         }
     }

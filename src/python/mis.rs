@@ -1,7 +1,8 @@
 //! `mcsample.mis`: the multiple importance sampling heuristics of
 //! [`crate::mis`], batched.
 
-use super::arrays::{Check, Points, map_pair, with_precision};
+use super::arrays::{Check, Points, with_precision};
+use super::batch::map_pair;
 use crate::error::Error;
 use crate::math::Real;
 use crate::mis;

@@ -2,7 +2,9 @@
 //! GIL release and error mapping, one file per Python submodule. No
 //! sampling logic lives here.
 
+mod args;
 mod arrays;
+mod batch;
 mod distr;
 mod envmap;
 mod error;

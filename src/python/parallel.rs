@@ -1,8 +1,8 @@
-//! The one place where batch work leaves the GIL: [`run_batch`] releases it,
-//! runs the core batch engine under a panic guard, and maps its errors.
-//! Also the Python thread-count controls.
+//! The one place where work leaves the GIL: [`detached`] releases it and
+//! runs the work under a panic guard, [`run_batch`] runs the core batch
+//! engine so. Also the Python thread-count controls.
 
-use super::arrays::index_arg;
+use super::args::index_arg;
 use super::error::guarded;
 use crate::parallel::{self, MAX_THREADS, Outputs};
 use pyo3::prelude::*;

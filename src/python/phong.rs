@@ -1,13 +1,13 @@
 //! `mcsample.Phong`: the energy-normalised Phong BRDF of [`crate::phong`],
 //! batched over directions.
 
-use super::arrays::{
-    Check, Points, PyFloat, finish, map_pair, pair_len, run_batch_pair, with_precision, zeros,
-};
+use super::args::choice;
+use super::arrays::{Check, Points, PyFloat, finish, result_shape, with_precision, zeros};
+use super::batch::{map_pair, pair_shape, run_batch_pair};
 use crate::error::Error;
 use crate::phong::{Phong, PhongSamples, Selection};
 use numpy::PyArrayMethods;
-use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 
 /// An RGB reflectance: a number (grey) or three numbers.
@@ -71,7 +71,7 @@ impl PyPhongSample {
 /// diffuse, specular : float or (3,) RGB
 ///     rho_d and rho_s, >= 0, with rho_d + rho_s <= 1 in every channel.
 /// exponent : float >= 0
-/// selection : "max" (default) or "luminance"
+/// selection : "max" (default) or "luminance", keyword only
 ///     How the diffuse probability is chosen: max(rho_d) / (max(rho_d) +
 ///     max(rho_s)) over channels, or the same with Rec. 709 luminance
 ///     (Mitsuba 0.6's rule).
@@ -98,22 +98,18 @@ impl PyPhong {
 #[pymethods]
 impl PyPhong {
     #[new]
-    #[pyo3(signature = (diffuse, specular, exponent, selection = "max"))]
+    #[pyo3(signature = (diffuse, specular, exponent, *, selection = "max"))]
     fn new(
         diffuse: &Bound<'_, PyAny>,
         specular: &Bound<'_, PyAny>,
         exponent: f64,
         selection: &str,
     ) -> PyResult<Self> {
-        let selection = match selection {
-            "max" => Selection::Max,
-            "luminance" => Selection::Luminance,
-            _ => {
-                return Err(PyValueError::new_err(format!(
-                    "selection = {selection:?}: must be \"max\" or \"luminance\""
-                )));
-            }
-        };
+        let selection = choice(
+            "selection",
+            selection,
+            &[("max", Selection::Max), ("luminance", Selection::Luminance)],
+        )?;
         let (d, s) = (rgb(diffuse, "diffuse")?, rgb(specular, "specular")?);
         Ok(Self(Phong::new(d, s, exponent, selection)?))
     }
@@ -225,13 +221,9 @@ impl PyPhong {
     ) -> PyResult<PyPhongSample> {
         let wi = Points::<F, 3>::extract(wi, "wi")?;
         let u = Points::<F, 3>::extract(u, "u")?;
-        let n = pair_len(&wi, &u)?;
-        let batched = wi.batched || u.batched;
-        let (vec_shape, scalar_shape): (Vec<usize>, Vec<usize>) = if batched {
-            (vec![n, 3], vec![n])
-        } else {
-            (vec![3], vec![])
-        };
+        let batch = pair_shape(&wi, &u)?;
+        let n = batch.iter().product();
+        let (vec_shape, scalar_shape) = (result_shape(&batch, 3), result_shape(&batch, 1));
         let wo = zeros::<F>(py, &vec_shape);
         let pdf = zeros::<F>(py, &scalar_shape);
         let weight = zeros::<F>(py, &vec_shape);
@@ -246,7 +238,7 @@ impl PyPhong {
                 g_c.as_slice_mut()?,
             );
             let (rows_wi, rows_u) = (wi.rows(), u.rows());
-            let (step_wi, step_u) = (usize::from(wi.batched), usize::from(u.batched));
+            let (step_wi, step_u) = (usize::from(wi.n != 1), usize::from(u.n != 1));
             let phong = &self.0;
             let (ok_wi, ok_u) =
                 run_batch_pair(py, n, outputs, |range, (o_wo, o_pdf, o_w, o_c)| {

@@ -6,18 +6,20 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 use numpy::{PyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use glam::Vec3A;
 
-use super::arrays::{Check, Points, index_arg, map_pair};
+use super::args::{choice, depth_arg, heuristic_arg, index_arg, seed_arg};
+use super::arrays::{Check, Points};
+use super::batch::map_pair;
 use super::envmap::PyEnvMap;
 use super::error::guarded;
 use super::phong::PyPhong;
+use crate::error::Error;
 use crate::render::camera::{Camera, FovAxis};
 use crate::render::scene::{Environment, Geometry, Material, Shape, affine};
-use crate::render::{Heuristic, Integrator, Progress, Scene, Settings, Strategy};
+use crate::render::{Integrator, Progress, Scene, Settings, Strategy};
 
 fn rows<'py, T: numpy::Element + Copy, const K: usize>(
     a: &PyReadonlyArray2<'py, T>,
@@ -25,16 +27,33 @@ fn rows<'py, T: numpy::Element + Copy, const K: usize>(
 ) -> PyResult<Vec<[T; K]>> {
     let view = a.as_array();
     if view.ncols() != K {
-        return Err(PyValueError::new_err(format!(
-            "{arg} must have shape (N, {K}), got {:?}",
-            view.shape()
-        )));
+        return Err(Error::Shape {
+            arg,
+            expected: format!("(N, {K})"),
+            got: crate::error::shape_str(view.shape()),
+        }
+        .into());
     }
     Ok(view
         .rows()
         .into_iter()
         .map(|r| std::array::from_fn(|k| r[k]))
         .collect())
+}
+
+/// Checks that every channel of the RGB radiance `value` (argument `arg`)
+/// is finite and >= 0.
+fn radiance_arg(arg: &'static str, value: [f64; 3], requirement: &str) -> PyResult<()> {
+    match value.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+        Some(k) => Err(Error::Element {
+            arg,
+            index: format!("[{k}]"),
+            value: value[k],
+            requirement: requirement.into(),
+        }
+        .into()),
+        None => Ok(()),
+    }
 }
 
 /// Collects shapes, lights and the camera of a scene, then builds it
@@ -55,13 +74,8 @@ impl PySceneBuilder {
         two_sided: bool,
         emission: Option<[f64; 3]>,
     ) -> PyResult<()> {
-        if let Some(l) = emission
-            && let Some(k) = l.iter().position(|v| !(v.is_finite() && *v >= 0.0))
-        {
-            return Err(PyValueError::new_err(format!(
-                "emission[{k}] = {}: radiance must be finite and >= 0",
-                l[k]
-            )));
+        if let Some(l) = emission {
+            radiance_arg("emission", l, "radiance must be finite and >= 0")?;
         }
         self.shapes.push(Shape {
             geometry: geometry?,
@@ -76,9 +90,12 @@ impl PySceneBuilder {
 
     fn set_environment(&mut self, env: Environment) -> PyResult<()> {
         if self.environment.is_some() {
-            return Err(PyValueError::new_err(
-                "a scene holds at most one environment emitter (envmap or constant)",
-            ));
+            return Err(Error::Argument {
+                arg: "environment",
+                message: "a scene holds at most one environment emitter (envmap or constant)"
+                    .into(),
+            }
+            .into());
         }
         self.environment = Some(env);
         Ok(())
@@ -151,12 +168,7 @@ impl PySceneBuilder {
 
     /// Lights the scene with the same radiance from every direction.
     fn set_constant(&mut self, radiance: [f64; 3]) -> PyResult<()> {
-        if let Some(k) = radiance.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
-            return Err(PyValueError::new_err(format!(
-                "radiance[{k}] = {}: must be finite and >= 0",
-                radiance[k]
-            )));
-        }
+        radiance_arg("radiance", radiance, "must be finite and >= 0")?;
         self.set_environment(Environment::Constant(radiance))
     }
 
@@ -175,11 +187,17 @@ impl PySceneBuilder {
         aperture_radius: f64,
         focus_distance: f64,
     ) -> PyResult<()> {
-        let axis = FovAxis::from_name(fov_axis).ok_or_else(|| {
-            PyValueError::new_err(format!(
-                "fov_axis = {fov_axis:?}: must be 'x', 'y', 'diagonal', 'smaller' or 'larger'"
-            ))
-        })?;
+        let axis = choice(
+            "fov_axis",
+            fov_axis,
+            &[
+                ("x", FovAxis::X),
+                ("y", FovAxis::Y),
+                ("diagonal", FovAxis::Diagonal),
+                ("smaller", FovAxis::Smaller),
+                ("larger", FovAxis::Larger),
+            ],
+        )?;
         let width = index_arg(width, "width", 1, 1 << 15)? as usize;
         let height = index_arg(height, "height", 1, 1 << 15)? as usize;
         let camera = Camera::new(
@@ -199,9 +217,10 @@ impl PySceneBuilder {
 
     /// The scene, with its BVH and light selection built.
     fn build(&mut self, py: Python<'_>) -> PyResult<PyScene> {
-        let (camera, width, height) = self
-            .camera
-            .ok_or_else(|| PyValueError::new_err("the scene has no sensor"))?;
+        let (camera, width, height) = self.camera.ok_or_else(|| Error::Argument {
+            arg: "sensor",
+            message: "the scene has no sensor".into(),
+        })?;
         let shapes = std::mem::take(&mut self.shapes);
         let environment = self.environment.take();
         let scene =
@@ -273,20 +292,6 @@ impl PyScene {
     }
 }
 
-fn choice<T: Copy>(arg: &str, value: &str, options: &[(&str, T)]) -> PyResult<T> {
-    options
-        .iter()
-        .find(|(name, _)| *name == value)
-        .map(|(_, v)| *v)
-        .ok_or_else(|| {
-            let names: Vec<String> = options.iter().map(|(n, _)| format!("{n:?}")).collect();
-            PyValueError::new_err(format!(
-                "{arg} = {value:?}: must be one of {}",
-                names.join(", ")
-            ))
-        })
-}
-
 /// Renders ``scene``; returns ``(image, variance, luminance_variance)`` as
 /// flat float32 arrays of ``height * width * 3`` (the last ``height *
 /// width``). ``callback(samples_done)`` is
@@ -304,7 +309,7 @@ pub fn render<'py>(
     integrator: &str,
     strategy: &str,
     heuristic: &str,
-    max_depth: i64,
+    max_depth: &Bound<'py, PyAny>,
     rr_depth: &Bound<'py, PyAny>,
     hide_emitters: bool,
     callback: Option<Bound<'py, PyAny>>,
@@ -314,17 +319,8 @@ pub fn render<'py>(
     Bound<'py, PyArray1<f32>>,
 )> {
     let spp = index_arg(spp, "spp", 1, u64::from(u32::MAX))? as u32;
-    let seed = index_arg(seed, "seed", 0, u64::MAX)?;
+    let seed = seed_arg(seed, "seed")?;
     let rr_depth = index_arg(rr_depth, "rr_depth", 0, u64::from(u32::MAX))? as u32;
-    let max_depth = match max_depth {
-        -1 => None,
-        d if (0..=i64::from(u32::MAX)).contains(&d) => Some(d as u32),
-        d => {
-            return Err(PyValueError::new_err(format!(
-                "max_depth = {d}: must be -1 (unbounded) or >= 0"
-            )));
-        }
-    };
     let settings = Settings {
         integrator: choice(
             "integrator",
@@ -340,12 +336,8 @@ pub fn render<'py>(
                 ("mis", Strategy::Mis),
             ],
         )?,
-        heuristic: choice(
-            "heuristic",
-            heuristic,
-            &[("balance", Heuristic::Balance), ("power", Heuristic::Power)],
-        )?,
-        max_depth,
+        heuristic: heuristic_arg(heuristic)?,
+        max_depth: depth_arg(max_depth, "max_depth")?,
         rr_depth,
         hide_emitters,
     };

@@ -1,6 +1,7 @@
 //! `mcsample.Rng` and `mcsample.uniform`.
 
-use super::arrays::{finish, index_arg, zeros};
+use super::args::{index_arg, seed};
+use super::arrays::{finish, zeros};
 use super::parallel::detached;
 use crate::math::Real;
 use crate::rng::{MAX_STREAM, Rng};
@@ -76,15 +77,25 @@ fn random_array<'py, F: Element + Real>(
     finish(out)
 }
 
+/// The `stream` argument: 0 to [`MAX_STREAM`], or None for 0.
+fn stream_arg(ob: &Bound<'_, PyAny>) -> PyResult<u64> {
+    if ob.is_none() {
+        return Ok(0);
+    }
+    index_arg(ob, "stream", 0, MAX_STREAM)
+}
+
 /// PCG32 random number generator (O'Neill's ``pcg32_random_r``, seeded as
 /// ``pcg32_srandom_r(seed, stream)``), the generator of Mitsuba 3 / Dr.Jit.
 ///
 /// Parameters
 /// ----------
-/// seed : int
-///     Initial state, 0 to 2**64 - 1.
+/// seed : int, None or numpy.random.Generator
+///     Initial state, 0 to 2**64 - 1 (default 0); None draws a fresh seed
+///     from the operating system, a Generator draws one from itself.
 /// stream : int
-///     Stream id, 0 to 2**63 - 1; different streams are independent sequences.
+///     Stream id, 0 to 2**63 - 1 (default 0; None is 0 too); different
+///     streams are independent sequences.
 ///
 /// Floats are made from one 32-bit output each, exactly as Dr.Jit's
 /// ``PCG32.next_float64`` / ``next_float32`` make them, so the same seed and
@@ -100,10 +111,11 @@ pub struct PyRng {
 #[pymethods]
 impl PyRng {
     #[new]
-    #[pyo3(signature = (seed = None, stream = None))]
-    fn new(seed: Option<&Bound<'_, PyAny>>, stream: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
-        let seed = seed.map_or(Ok(0), |s| index_arg(s, "seed", 0, u64::MAX))?;
-        let stream = stream.map_or(Ok(0), |s| index_arg(s, "stream", 0, MAX_STREAM))?;
+    #[pyo3(signature = (seed = 0, stream = 0))]
+    fn new(
+        #[pyo3(from_py_with = seed)] seed: u64,
+        #[pyo3(from_py_with = stream_arg)] stream: u64,
+    ) -> PyResult<Self> {
         Ok(PyRng {
             rng: Rng::new(seed, stream),
             seed,
@@ -200,6 +212,14 @@ impl PyRng {
     }
 }
 
+/// The `dim` argument of [`uniform`]: 0 to 2²⁰, or None for 2.
+fn dim_arg(ob: &Bound<'_, PyAny>) -> PyResult<usize> {
+    if ob.is_none() {
+        return Ok(2);
+    }
+    Ok(index_arg(ob, "dim", 0, 1 << 20)? as usize)
+}
+
 /// ``n × dim`` uniform floats in [0, 1): the first ``n·dim`` numbers of
 /// ``Rng(seed)``, computed on all cores (bit-identical for any thread count).
 ///
@@ -209,24 +229,23 @@ impl PyRng {
 ///     Number of samples.
 /// dim : int
 ///     Numbers per sample (default 2).
-/// seed : int
+/// seed : int, None or numpy.random.Generator
+///     As for ``Rng`` (default 0).
 /// dtype : float64 (default) or float32
 ///
 /// Returns
 /// -------
 /// ndarray, shape (n, dim)
 #[pyfunction]
-#[pyo3(signature = (n, dim = None, seed = None, dtype = None))]
+#[pyo3(signature = (n, dim = 2, seed = 0, dtype = None))]
 pub fn uniform<'py>(
     py: Python<'py>,
     n: &Bound<'py, PyAny>,
-    dim: Option<&Bound<'py, PyAny>>,
-    seed: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = dim_arg)] dim: usize,
+    #[pyo3(from_py_with = seed)] seed: u64,
     dtype: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let n = index_arg(n, "n", 0, MAX_COUNT)? as usize;
-    let dim = dim.map_or(Ok(2), |d| index_arg(d, "dim", 0, 1 << 20))? as usize;
-    let seed = seed.map_or(Ok(0), |s| index_arg(s, "seed", 0, u64::MAX))?;
     let shape = [n, dim];
     parse_shape(Some(&PyTuple::new(py, shape)?.into_any()))?;
     let mut rng = Rng::new(seed, 0);

@@ -3,7 +3,9 @@
 //! float32, checks `u ∈ [0, 1]` (or finiteness of points) in the kernel's
 //! own pass, and runs on all cores with the GIL released.
 
-use super::arrays::{Check, Points, PyFloat, map_into, with_precision};
+use super::args::choice;
+use super::arrays::{Check, Points, PyFloat, with_precision};
+use super::batch::map_into;
 use crate::error::Error;
 use crate::math::Real;
 use crate::warp;
@@ -68,13 +70,7 @@ fn cos_cutoff_arg<F: Real>(cos_cutoff: f64) -> PyResult<F> {
 /// `method` of the cosine-hemisphere warps: true for "polar", false for
 /// "concentric".
 fn polar_arg(method: &str) -> PyResult<bool> {
-    match method {
-        "concentric" => Ok(false),
-        "polar" => Ok(true),
-        _ => Err(pyo3::exceptions::PyValueError::new_err(format!(
-            "method = {method:?}: must be \"concentric\" or \"polar\""
-        ))),
-    }
+    choice("method", method, &[("concentric", false), ("polar", true)])
 }
 
 batch_fn! {

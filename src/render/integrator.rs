@@ -22,7 +22,6 @@ use super::accel::Hit;
 use super::scene::{LightSample, Scene};
 use super::shape::Ray;
 use crate::frame::Frame;
-use crate::mis;
 use crate::rng::Rng;
 
 /// Which light transport to compute.
@@ -45,14 +44,7 @@ pub enum Strategy {
     Mis,
 }
 
-/// The MIS heuristic.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Heuristic {
-    /// `p_a / (p_a + p_b)`.
-    Balance,
-    /// `p_a² / (p_a² + p_b²)`.
-    Power,
-}
+pub use crate::mis::Heuristic;
 
 /// What to render and how.
 #[derive(Clone, Copy, Debug)]
@@ -76,10 +68,7 @@ pub struct Settings {
 
 impl Settings {
     fn weight(&self, pdf_a: f32, pdf_b: f32) -> f32 {
-        match self.heuristic {
-            Heuristic::Balance => mis::balance_heuristic(pdf_a, pdf_b),
-            Heuristic::Power => mis::power_heuristic(pdf_a, pdf_b, 2.0),
-        }
+        self.heuristic.weight(pdf_a, pdf_b)
     }
 
     fn max_depth(&self) -> u32 {

@@ -20,7 +20,8 @@ _Shape = Union[None, int, Sequence[int]]
 class Rng:
     """PCG32 (O'Neill's pcg32_random_r), seeded as pcg32_srandom_r(seed, stream)."""
 
-    def __new__(cls, seed: int | None = None, stream: int | None = None) -> Rng: ...
+    def __new__(cls, seed: int | np.random.Generator | None = 0,
+                stream: int | None = 0) -> Rng: ...
     def random(self, shape: _Shape = None, dtype: DTypeLike | None = None) -> Any:
         """Uniform floats in [0, 1) of ``shape`` (a numpy scalar for None)."""
     def next_uint32(self, shape: _Shape = None) -> Any:
@@ -35,7 +36,7 @@ class Rng:
     def __copy__(self) -> Rng: ...
     def __deepcopy__(self, memo: Any) -> Rng: ...
 
-def uniform(n: int, dim: int | None = None, seed: int | None = None,
+def uniform(n: int, dim: int | None = 2, seed: int | np.random.Generator | None = 0,
             dtype: DTypeLike | None = None) -> NDArray[np.floating[Any]]:
     """(n, dim) uniform floats in [0, 1): the first n*dim numbers of Rng(seed)."""
 
@@ -93,7 +94,7 @@ class Discrete2D:
 class PiecewiseConstant1D:
     """Piecewise-constant density on [a, b] (per unit length)."""
 
-    def __new__(cls, values: ArrayLike, a: float = 0.0, b: float = 1.0) -> PiecewiseConstant1D: ...
+    def __new__(cls, values: ArrayLike, *, a: float = 0.0, b: float = 1.0) -> PiecewiseConstant1D: ...
     def sample(self, u: ArrayLike) -> tuple[Any, Any]:
         """(x, pdf)."""
     def pdf(self, x: ArrayLike) -> Any: ...
@@ -109,7 +110,7 @@ class PiecewiseConstant1D:
 class PiecewiseConstant2D:
     """Piecewise-constant density on a rectangle (per unit area)."""
 
-    def __new__(cls, values: ArrayLike,
+    def __new__(cls, values: ArrayLike, *,
                 domain: tuple[tuple[float, float], tuple[float, float]] = ...,
                 ) -> PiecewiseConstant2D: ...
     def sample(self, u: ArrayLike) -> tuple[Any, Any]:
@@ -156,7 +157,7 @@ class Phong:
     """Energy-normalised modified Phong BRDF (local frame, normal +z)."""
 
     def __new__(cls, diffuse: float | Sequence[float], specular: float | Sequence[float],
-                exponent: float, selection: str = "max") -> Phong: ...
+                exponent: float, *, selection: str = "max") -> Phong: ...
     def eval(self, wi: ArrayLike, wo: ArrayLike) -> Any:
         """f_r(wi, wo) per RGB channel, (N, 3)."""
     def pdf(self, wi: ArrayLike, wo: ArrayLike) -> Any:
@@ -188,11 +189,11 @@ class EnvMap:
     sampling of directions ("latlong" as Mitsuba 3's envmap, "angular",
     "cube")."""
 
-    def __new__(cls, image: ArrayLike | None = None, mapping: str = "latlong",
+    def __new__(cls, image: ArrayLike | None = None, *, mapping: str = "latlong",
                 to_world: Any = None, scale: float = 1.0, sampling: str = "piecewise",
                 compensate: bool = False) -> EnvMap: ...
     @staticmethod
-    def load(path: str | os.PathLike[str], mapping: str = "latlong", to_world: Any = None,
+    def load(path: str | os.PathLike[str], *, mapping: str = "latlong", to_world: Any = None,
              scale: float = 1.0, sampling: str = "piecewise",
              compensate: bool = False) -> EnvMap:
         """Reads an OpenEXR or Radiance .hdr file."""

@@ -2,6 +2,7 @@
 
 from typing import Any, final
 
+import numpy as np
 from numpy.typing import ArrayLike
 
 from . import EnvMap, Phong
@@ -19,8 +20,9 @@ class Estimate:
     @property
     def strategy(self) -> str: ...
 
-def irradiance(env: EnvMap, normal: ArrayLike, n: int, strategy: str = "mis",
-               seed: int | None = None, heuristic: str = "balance") -> Estimate: ...
-def reflected_radiance(env: EnvMap, phong: Phong, normal: ArrayLike, wi: ArrayLike, n: int,
-                       strategy: str = "mis", seed: int | None = None,
-                       heuristic: str = "balance") -> Estimate: ...
+def irradiance(env: EnvMap, normal: ArrayLike, n: int, *, strategy: str = "mis",
+               seed: int | np.random.Generator | None = 0,
+               heuristic: str = "power") -> Estimate: ...
+def reflected_radiance(env: EnvMap, phong: Phong, normal: ArrayLike, wi: ArrayLike, n: int, *,
+                       strategy: str = "mis", seed: int | np.random.Generator | None = 0,
+                       heuristic: str = "power") -> Estimate: ...

@@ -36,7 +36,8 @@ class CompiledScene:
     def emitter_pdf(self, x: ArrayLike, d: ArrayLike) -> Any: ...
 
 def render(
-    scene: CompiledScene, spp: int, seed: int, integrator: str, strategy: str, heuristic: str,
+    scene: CompiledScene, spp: int, seed: int | np.random.Generator | None, integrator: str,
+    strategy: str, heuristic: str,
     max_depth: int, rr_depth: int, hide_emitters: bool = False,
     callback: Callable[[int], object] | None = None,
 ) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32]]: ...

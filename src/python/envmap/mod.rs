@@ -1,158 +1,24 @@
 //! `mcsample.EnvMap`: environment maps (see [`crate::envmap`]), batched
 //! over directions and uniform samples.
 
-use super::arrays::{
-    Check, Points, PyFloat, finish, map, map_each, output, with_precision, writable,
-};
+mod input;
+
+use super::args::index_arg;
+use super::arrays::{Check, Points, PyFloat, finish, output, with_precision, writable};
+use super::batch::{map, map_each};
 use super::parallel::{detached, run_batch};
-use crate::envmap::{EnvMap, EnvSamples, Mapping, Matrix3, Options, Sampling};
-use crate::error::{Error, shape_str};
-use crate::io;
-use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
+use crate::envmap::{EnvMap, EnvSamples, Mapping, Options, TableFloat};
+use crate::error::Error;
+use input::{image_arg, mapping_arg, read_image, settings};
+use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-fn mapping_arg(name: &str) -> PyResult<Mapping> {
-    Mapping::from_name(name).ok_or_else(|| {
-        Error::Choice {
-            arg: "mapping",
-            value: name.into(),
-            requirement: "must be \"latlong\", \"angular\" or \"cube\"".into(),
-        }
-        .into()
-    })
-}
-
-fn sampling_arg(name: &str) -> PyResult<Sampling> {
-    Sampling::from_name(name).ok_or_else(|| {
-        Error::Choice {
-            arg: "sampling",
-            value: name.into(),
-            requirement: "must be \"piecewise\" or \"mitsuba\"".into(),
-        }
-        .into()
-    })
-}
-
-/// `to_world` as a 3×3 rotation: None (identity), a 3×3 or 4×4 array-like
-/// (translation ignored) or an object with a ``matrix`` (a Mitsuba
-/// transform).
-fn to_world_arg(ob: Option<&Bound<'_, PyAny>>) -> PyResult<Matrix3> {
-    let Some(ob) = ob.filter(|o| !o.is_none()) else {
-        return Ok(Options::default().to_world);
-    };
-    let py = ob.py();
-    let source = match ob.getattr(pyo3::intern!(py, "matrix")) {
-        Ok(m) if !ob.hasattr("shape")? => m,
-        _ => ob.clone(),
-    };
-    let array = py
-        .import(pyo3::intern!(py, "numpy"))?
-        .call_method1(pyo3::intern!(py, "asarray"), (source,))
-        .and_then(|a| a.call_method1("astype", ("float64",)))
-        .map_err(|e| {
-            PyTypeError::new_err(format!(
-                "to_world must be a 3x3 or 4x4 matrix or a Mitsuba transform: {e}"
-            ))
-        })?;
-    let array: PyArrayLikeDyn<'_, f64, AllowTypeChange> = array.extract()?;
-    let shape = array.shape().to_vec();
-    let flat: Vec<f64> = array.as_array().iter().copied().collect();
-    // A Mitsuba JIT transform's matrix has a trailing axis of width 1.
-    let n = match (flat.len(), shape.as_slice()) {
-        (9, [3, 3] | [3, 3, 1]) => 3,
-        (16, [4, 4] | [4, 4, 1]) => 4,
-        _ => {
-            return Err(Error::Shape {
-                arg: "to_world",
-                expected: "(3, 3) or (4, 4)".into(),
-                got: shape_str(&shape),
-            }
-            .into());
-        }
-    };
-    if let Some(i) = flat.iter().position(|v| !v.is_finite()) {
-        return Err(Error::Element {
-            arg: "to_world",
-            index: format!("[{}, {}]", i / n, i % n),
-            value: flat[i],
-            requirement: "must be finite".into(),
-        }
-        .into());
-    }
-    Ok(std::array::from_fn(|r| {
-        std::array::from_fn(|c| flat[r * n + c])
-    }))
-}
-
-/// The texels of `image` for `mapping` as `(width, height, array)`: shape
-/// `(H, W, 3)`, or `(6, R, R, 3)` for cube maps (faces stacked).
-fn image_arg<'py>(
-    image: &Bound<'py, PyAny>,
-    mapping: Mapping,
-) -> PyResult<(usize, usize, PyArrayLikeDyn<'py, f32, AllowTypeChange>)> {
-    let array: PyArrayLikeDyn<'py, f32, AllowTypeChange> = image
-        .extract()
-        .map_err(|e| PyTypeError::new_err(format!("image must be an array of numbers: {e}")))?;
-    let shape = array.shape().to_vec();
-    let (width, height) = match (mapping, shape.as_slice()) {
-        (Mapping::Cube, [6, r, r2, 3]) if r == r2 => (*r, 6 * r),
-        (Mapping::LatLong | Mapping::Angular, [h, w, 3]) => (*w, *h),
-        _ => {
-            return Err(Error::Shape {
-                arg: "image",
-                expected: match mapping {
-                    Mapping::Cube => "(6, R, R, 3)".into(),
-                    _ => "(H, W, 3)".into(),
-                },
-                got: shape_str(&shape),
-            }
-            .into());
-        }
-    };
-    Ok((width, height, array))
-}
-
-/// A file's image for `mapping`: RGB(A) (alpha dropped); cube maps as a
-/// vertical strip of six faces (6R × R) or a horizontal one (R × 6R), in
-/// the order +x, -x, +y, -y, +z, -z.
-fn read_image(path: &Path, mapping: Mapping) -> crate::Result<(usize, usize, Vec<f32>)> {
-    let is_hdr = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("hdr") || e.eq_ignore_ascii_case("rgbe"));
-    let raster = if is_hdr {
-        io::read_hdr(path)?
-    } else {
-        io::read_exr(path)?
-    };
-    let rgb: Vec<f32> = raster
-        .data
-        .chunks(raster.channels)
-        .flat_map(|px| [px[0], px[1], px[2]])
-        .collect();
-    let (w, h) = (raster.width, raster.height);
-    if mapping != Mapping::Cube || h == 6 * w {
-        return Ok((w, h, rgb));
-    }
-    if w != 6 * h {
-        return Err(Error::Io {
-            path: path.to_path_buf(),
-            message: format!(
-                "a cube map file must be a strip of six square faces, 6R x R or R x 6R; got {w} x {h}"
-            ),
-        });
-    }
-    // Horizontal strip: face f is columns [f·R, (f + 1)·R).
-    let mut stacked = Vec::with_capacity(rgb.len());
-    for face in 0..6 {
-        for y in 0..h {
-            let start = (y * w + face * h) * 3;
-            stacked.extend_from_slice(&rgb[start..start + 3 * h]);
-        }
-    }
-    Ok((h, 6 * h, stacked))
-}
+/// A float type the envmap bindings compute in: a [`PyFloat`] whose
+/// sampling-table densities the map keeps ([`TableFloat`]).
+trait EnvFloat: PyFloat + TableFloat {}
+impl<F: PyFloat + TableFloat> EnvFloat for F {}
 
 /// Samples of ``EnvMap.sample``.
 #[pyclass(module = "mcsample._core", name = "EnvSample", frozen)]
@@ -206,33 +72,10 @@ impl PyEnvSample {
 ///     MIS compensation: the mean luminance is subtracted before the
 ///     sampling density is built (Karlik et al. 2019), as Mitsuba's
 ///     ``mis_compensation``. Only for use in MIS.
+///
+/// Everything after ``image`` is keyword-only.
 #[pyclass(module = "mcsample._core", name = "EnvMap", frozen)]
 pub struct PyEnvMap(EnvMap);
-
-struct Settings {
-    mapping: Mapping,
-    options: Options,
-}
-
-fn settings(
-    mapping: &str,
-    to_world: Option<&Bound<'_, PyAny>>,
-    scale: f64,
-    sampling: &str,
-    compensate: bool,
-) -> PyResult<Settings> {
-    let mapping = mapping_arg(mapping)?;
-    Ok(Settings {
-        mapping,
-        options: Options {
-            mapping,
-            to_world: to_world_arg(to_world)?,
-            scale,
-            sampling: sampling_arg(sampling)?,
-            compensate,
-        },
-    })
-}
 
 /// The three arrays of `EnvMap.sample`'s `out` (direction, pdf, weight), or
 /// none.
@@ -252,7 +95,7 @@ fn sample_outputs<'py>(
 /// Whether every coordinate of the direction `x` is finite (the check of
 /// the batch methods, inlined into their loops).
 #[inline(always)]
-fn finite<F: PyFloat>(x: &[F; 3]) -> bool {
+fn finite<F: EnvFloat>(x: &[F; 3]) -> bool {
     Check::Finite.holds_all(x)
 }
 
@@ -261,7 +104,7 @@ impl PyEnvMap {
         Ok(Self(detached(py, || EnvMap::new(w, h, data, options))?))
     }
 
-    fn directions<'py, F: PyFloat, const M: usize>(
+    fn directions<'py, F: EnvFloat, const M: usize>(
         &self,
         py: Python<'py>,
         d: &Bound<'py, PyAny>,
@@ -278,7 +121,7 @@ impl PyEnvMap {
     /// method of [`EnvMap`] (`eval_into`, `pdf_into`) that checks with
     /// [`finite`] that every direction is finite, in the same pass; into
     /// `out` when given (see [`output`]).
-    fn batch_as<'py, F: PyFloat, const M: usize>(
+    fn batch_as<'py, F: EnvFloat, const M: usize>(
         &self,
         py: Python<'py>,
         d: &Bound<'py, PyAny>,
@@ -286,7 +129,7 @@ impl PyEnvMap {
         kernel: impl Fn(&EnvMap, &[[F; 3]], &mut [[F; M]]) -> bool + Sync + Send,
     ) -> PyResult<Bound<'py, PyAny>> {
         let d = Points::<F, 3>::extract(d, "d")?;
-        let out = output::<F>(py, &d.out_shape(M), out)?;
+        let out = output::<F>(py, &d.out_shape(M), out, "out")?;
         {
             let mut guard = writable(&out)?;
             let rows = d.rows();
@@ -304,7 +147,7 @@ impl PyEnvMap {
 
     /// Samples for `u`, into the arrays of `out` (direction, pdf, weight)
     /// when given (see [`output`]).
-    fn sample_as<'py, F: PyFloat>(
+    fn sample_as<'py, F: EnvFloat>(
         &self,
         py: Python<'py>,
         u: &Bound<'py, PyAny>,
@@ -313,9 +156,9 @@ impl PyEnvMap {
         let u = Points::<F, 2>::extract(u, "u")?;
         let (vec_shape, scalar_shape) = (u.out_shape(3), u.out_shape(1));
         let [o_d, o_p, o_w] = sample_outputs(out)?;
-        let direction = output::<F>(py, &vec_shape, o_d.as_ref())?;
-        let pdf = output::<F>(py, &scalar_shape, o_p.as_ref())?;
-        let weight = output::<F>(py, &vec_shape, o_w.as_ref())?;
+        let direction = output::<F>(py, &vec_shape, o_d.as_ref(), "out[0]")?;
+        let pdf = output::<F>(py, &scalar_shape, o_p.as_ref(), "out[1]")?;
+        let weight = output::<F>(py, &vec_shape, o_w.as_ref(), "out[2]")?;
         {
             let (mut g_d, mut g_p, mut g_w) =
                 (writable(&direction)?, writable(&pdf)?, writable(&weight)?);
@@ -352,7 +195,7 @@ impl PyEnvMap {
         })
     }
 
-    fn uv_to_dir_as<'py, F: PyFloat>(
+    fn uv_to_dir_as<'py, F: EnvFloat>(
         &self,
         py: Python<'py>,
         uv: &Bound<'py, PyAny>,
@@ -369,7 +212,7 @@ impl PyEnvMap {
 #[pymethods]
 impl PyEnvMap {
     #[new]
-    #[pyo3(signature = (image = None, mapping = "latlong", to_world = None, scale = 1.0, sampling = "piecewise", compensate = false))]
+    #[pyo3(signature = (image = None, *, mapping = "latlong", to_world = None, scale = 1.0, sampling = "piecewise", compensate = false))]
     fn new(
         py: Python<'_>,
         image: Option<&Bound<'_, PyAny>>,
@@ -410,11 +253,12 @@ impl PyEnvMap {
     /// Reads an environment map from an OpenEXR or Radiance .hdr file
     /// (alpha is dropped). Cube maps are a strip of six square faces,
     /// vertical (6R x R) or horizontal (R x 6R), in the order +x, -x, +y,
-    /// -y, +z, -z. The other parameters are as for ``EnvMap``.
+    /// -y, +z, -z. The other parameters are as for ``EnvMap``, and
+    /// keyword-only.
     ///
     /// Raises OSError naming the path for a file that cannot be read.
     #[staticmethod]
-    #[pyo3(signature = (path, mapping = "latlong", to_world = None, scale = 1.0, sampling = "piecewise", compensate = false))]
+    #[pyo3(signature = (path, *, mapping = "latlong", to_world = None, scale = 1.0, sampling = "piecewise", compensate = false))]
     fn load(
         py: Python<'_>,
         path: PathBuf,
@@ -562,15 +406,16 @@ impl PyEnvMap {
         resolution: &Bound<'_, PyAny>,
     ) -> PyResult<Self> {
         let mapping = mapping_arg(mapping)?;
-        let (w, h) = match resolution.extract::<(usize, usize)>() {
-            Ok((h, w)) if mapping == Mapping::LatLong => (w, h),
+        let side = |ob: &Bound<'_, PyAny>| index_arg(ob, "resolution", 1, 1 << 15);
+        let (w, h) = match resolution.extract::<(Bound<'_, PyAny>, Bound<'_, PyAny>)>() {
+            Ok((h, w)) if mapping == Mapping::LatLong => (side(&w)? as usize, side(&h)? as usize),
             Ok(_) => {
                 return Err(PyTypeError::new_err(
                     "resolution is a single int R for angular and cube maps",
                 ));
             }
             Err(_) => {
-                let r = super::arrays::index_arg(resolution, "resolution", 1, 1 << 15)? as usize;
+                let r = side(resolution)? as usize;
                 match mapping {
                     Mapping::LatLong => (r, (r / 2).max(3)),
                     Mapping::Angular => (r, r),

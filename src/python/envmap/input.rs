@@ -1,0 +1,172 @@
+//! The inputs of ``EnvMap``: its options (mapping, sampling, `to_world`),
+//! its image as an array, and image files.
+
+use crate::envmap::{Mapping, Matrix3, Options, Sampling};
+use crate::error::{Error, shape_str};
+use crate::io;
+use crate::python::args::choice;
+use numpy::{AllowTypeChange, PyArrayLikeDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use std::path::Path;
+
+/// `mapping`, by the names of [`Mapping::name`].
+pub fn mapping_arg(name: &str) -> PyResult<Mapping> {
+    let options = [Mapping::LatLong, Mapping::Angular, Mapping::Cube].map(|m| (m.name(), m));
+    choice("mapping", name, &options)
+}
+
+/// `sampling`, by the names of [`Sampling::name`].
+fn sampling_arg(name: &str) -> PyResult<Sampling> {
+    let options = [Sampling::Piecewise, Sampling::Mitsuba].map(|m| (m.name(), m));
+    choice("sampling", name, &options)
+}
+
+/// `to_world` as a 3×3 rotation: None (identity), a 3×3 or 4×4 array-like
+/// (translation ignored) or an object with a ``matrix`` (a Mitsuba
+/// transform).
+fn to_world_arg(ob: Option<&Bound<'_, PyAny>>) -> PyResult<Matrix3> {
+    let Some(ob) = ob.filter(|o| !o.is_none()) else {
+        return Ok(Options::default().to_world);
+    };
+    let py = ob.py();
+    let source = match ob.getattr(pyo3::intern!(py, "matrix")) {
+        Ok(m) if !ob.hasattr("shape")? => m,
+        _ => ob.clone(),
+    };
+    let array = py
+        .import(pyo3::intern!(py, "numpy"))?
+        .call_method1(pyo3::intern!(py, "asarray"), (source,))
+        .and_then(|a| a.call_method1("astype", ("float64",)))
+        .map_err(|e| {
+            PyTypeError::new_err(format!(
+                "to_world must be a 3x3 or 4x4 matrix or a Mitsuba transform: {e}"
+            ))
+        })?;
+    let array: PyArrayLikeDyn<'_, f64, AllowTypeChange> = array.extract()?;
+    let shape = array.shape().to_vec();
+    let flat: Vec<f64> = array.as_array().iter().copied().collect();
+    // A Mitsuba JIT transform's matrix has a trailing axis of width 1.
+    let n = match (flat.len(), shape.as_slice()) {
+        (9, [3, 3] | [3, 3, 1]) => 3,
+        (16, [4, 4] | [4, 4, 1]) => 4,
+        _ => {
+            return Err(Error::Shape {
+                arg: "to_world",
+                expected: "(3, 3) or (4, 4)".into(),
+                got: shape_str(&shape),
+            }
+            .into());
+        }
+    };
+    if let Some(i) = flat.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Element {
+            arg: "to_world",
+            index: format!("[{}, {}]", i / n, i % n),
+            value: flat[i],
+            requirement: "must be finite".into(),
+        }
+        .into());
+    }
+    Ok(std::array::from_fn(|r| {
+        std::array::from_fn(|c| flat[r * n + c])
+    }))
+}
+
+/// The texels of `image` for `mapping` as `(width, height, array)`: shape
+/// `(H, W, 3)`, or `(6, R, R, 3)` for cube maps (faces stacked).
+pub fn image_arg<'py>(
+    image: &Bound<'py, PyAny>,
+    mapping: Mapping,
+) -> PyResult<(usize, usize, PyArrayLikeDyn<'py, f32, AllowTypeChange>)> {
+    let array: PyArrayLikeDyn<'py, f32, AllowTypeChange> = image
+        .extract()
+        .map_err(|e| PyTypeError::new_err(format!("image must be an array of numbers: {e}")))?;
+    let shape = array.shape().to_vec();
+    let (width, height) = match (mapping, shape.as_slice()) {
+        (Mapping::Cube, [6, r, r2, 3]) if r == r2 => (*r, 6 * r),
+        (Mapping::LatLong | Mapping::Angular, [h, w, 3]) => (*w, *h),
+        _ => {
+            return Err(Error::Shape {
+                arg: "image",
+                expected: match mapping {
+                    Mapping::Cube => "(6, R, R, 3)".into(),
+                    _ => "(H, W, 3)".into(),
+                },
+                got: shape_str(&shape),
+            }
+            .into());
+        }
+    };
+    Ok((width, height, array))
+}
+
+/// A file's image for `mapping`: RGB(A) (alpha dropped); cube maps as a
+/// vertical strip of six faces (6R × R) or a horizontal one (R × 6R), in
+/// the order +x, -x, +y, -y, +z, -z.
+pub fn read_image(path: &Path, mapping: Mapping) -> crate::Result<(usize, usize, Vec<f32>)> {
+    let is_hdr = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("hdr") || e.eq_ignore_ascii_case("rgbe"));
+    let raster = if is_hdr {
+        io::read_hdr(path)?
+    } else {
+        io::read_exr(path)?
+    };
+    let rgb: Vec<f32> = raster
+        .data
+        .chunks(raster.channels)
+        .flat_map(|px| [px[0], px[1], px[2]])
+        .collect();
+    let (w, h) = (raster.width, raster.height);
+    if mapping != Mapping::Cube || h == 6 * w {
+        return Ok((w, h, rgb));
+    }
+    if w != 6 * h {
+        return Err(Error::Io {
+            path: path.to_path_buf(),
+            message: format!(
+                "a cube map file must be a strip of six square faces, 6R x R or R x 6R; got {w} x {h}"
+            ),
+        });
+    }
+    // Horizontal strip: face f is columns [f·R, (f + 1)·R).
+    let mut stacked = Vec::with_capacity(rgb.len());
+    for face in 0..6 {
+        for y in 0..h {
+            let start = (y * w + face * h) * 3;
+            stacked.extend_from_slice(&rgb[start..start + 3 * h]);
+        }
+    }
+    Ok((h, 6 * h, stacked))
+}
+
+/// The checked options of ``EnvMap`` and ``EnvMap.load``.
+pub struct Settings {
+    /// The mapping (also in `options`).
+    pub mapping: Mapping,
+    /// The options of [`crate::envmap::EnvMap::new`].
+    pub options: Options,
+}
+
+/// The options of ``EnvMap`` and ``EnvMap.load`` checked: each named
+/// option among its names, `to_world` a finite 3×3 or 4×4 matrix.
+pub fn settings(
+    mapping: &str,
+    to_world: Option<&Bound<'_, PyAny>>,
+    scale: f64,
+    sampling: &str,
+    compensate: bool,
+) -> PyResult<Settings> {
+    let mapping = mapping_arg(mapping)?;
+    Ok(Settings {
+        mapping,
+        options: Options {
+            mapping,
+            to_world: to_world_arg(to_world)?,
+            scale,
+            sampling: sampling_arg(sampling)?,
+            compensate,
+        },
+    })
+}
