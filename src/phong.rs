@@ -389,6 +389,7 @@ fn reflect<F: Real>(wi: V3<F>) -> V3<F> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     fn phong(n: f64) -> Phong {
         Phong::new([0.3, 0.2, 0.1], [0.5, 0.6, 0.7], n, Selection::Max).unwrap()
@@ -510,6 +511,107 @@ mod tests {
             }
             total *= std::f64::consts::TAU / nphi as f64 * 2.0 / nz as f64;
             assert!((total - 1.0).abs() < 2e-3, "n = {n}: {total}");
+        }
+    }
+
+    /// The parameters read back; `f_r` and the density at chosen directions
+    /// are `ρd/π + ρs (n + 2)/(2π) cos^n α` and `p_d cos θo/π + (1 − p_d)
+    /// (n + 1)/(2π) cos^n α`, with α from the mirror direction `(−x, −y, z)`
+    /// of `wi`.
+    #[test]
+    fn eval_and_pdf_known_values() {
+        let p = phong(10.0);
+        assert_eq!(
+            (p.diffuse(), p.specular(), p.exponent()),
+            ([0.3, 0.2, 0.1], [0.5, 0.6, 0.7], 10.0)
+        );
+        let wi = [0.6, -0.1, (1.0f64 - 0.37).sqrt()];
+        let wo = [-0.5, 0.2, (1.0f64 - 0.29).sqrt()];
+        let cos_alpha = -wi[0] * wo[0] - wi[1] * wo[1] + wi[2] * wo[2];
+        let lobe = cos_alpha.powf(10.0);
+        let f = p.eval(wi, wo);
+        for k in 0..3 {
+            let expected = p.diffuse()[k] / PI + p.specular()[k] * 12.0 / (2.0 * PI) * lobe;
+            assert!((f[k] - expected).abs() < 1e-12 * expected, "{k}: {f:?}");
+        }
+        let pd = p.diffuse_probability();
+        let pdf = pd * wo[2] / PI + (1.0 - pd) * 11.0 / (2.0 * PI) * lobe;
+        assert!((p.pdf(wi, wo) - pdf).abs() < 1e-12 * pdf);
+    }
+
+    /// At normal incidence the lobe is centred on the normal, and the
+    /// energy-normalised BRDF reflects `ρd + ρs` of the light: `2π ∫ f_r(μ)
+    /// μ dμ` over `μ = cos θ` (midpoint rule).
+    #[test]
+    fn albedo_at_normal_incidence_is_the_sum_of_the_reflectances() {
+        for n in [0.0, 3.0, 40.0] {
+            let p = phong(n);
+            let steps = 20_000;
+            let mut albedo = [0.0; 3];
+            for j in 0..steps {
+                let mu = (j as f64 + 0.5) / steps as f64;
+                let wo = [(1.0 - mu * mu).sqrt(), 0.0, mu];
+                let f = p.eval([0.0, 0.0, 1.0], wo);
+                for k in 0..3 {
+                    albedo[k] += 2.0 * PI * f[k] * mu / steps as f64;
+                }
+            }
+            for k in 0..3 {
+                let expected = p.diffuse()[k] + p.specular()[k];
+                assert!((albedo[k] - expected).abs() < 1e-6, "n = {n}: {albedo:?}");
+            }
+        }
+    }
+
+    /// Nothing is reflected from or toward the horizon itself, and the lobe
+    /// is 0 where `cos α = 0` exactly, also for `n = 0` (where `0⁰` would
+    /// be 1).
+    #[test]
+    fn the_horizon_and_the_lobes_edge_are_black() {
+        let p = phong(4.0);
+        let up = [0.0, 0.6, 0.8];
+        assert_eq!(p.eval([1.0, 0.0, 0.0], up), [0.0; 3]);
+        assert_eq!(p.eval(up, [0.0, -1.0, 0.0]), [0.0; 3]);
+        let flat = phong(0.0);
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let (wi, wo) = ([h, 0.0, h], [h, 0.0, h]); // mirror (−h, 0, h) ⟂ wo
+        let pd = flat.diffuse_probability();
+        assert!((flat.pdf(wi, wo) - pd * h / PI).abs() < 1e-15);
+        let f = flat.eval(wi, wo);
+        for (v, rho) in f.iter().zip(flat.diffuse()) {
+            assert!((v - rho / PI).abs() < 1e-15);
+        }
+    }
+
+    /// A sample's weight is `f_r cos θo / pdf` (0 below the surface), and
+    /// its part is the diffuse one exactly when `u[2] < p_d` (at `u[2] =
+    /// p_d`, the glossy one), in both forms.
+    #[test]
+    fn sample_weight_and_component() {
+        let p = phong(15.0);
+        let wi = [0.3, 0.2, (1.0f64 - 0.13).sqrt()];
+        let view = p.view(wi);
+        let pd = p.diffuse_probability();
+        for k in 0..200 {
+            let u2 = match k {
+                0 => pd,
+                1 => pd - 1e-12,
+                _ => (k as f64 * 0.618_034) % 1.0,
+            };
+            let u = [
+                (k as f64 * 0.414_214) % 1.0,
+                (k as f64 * 0.732_051) % 1.0,
+                u2,
+            ];
+            for s in [view.sample(u), view.sample_one(u)] {
+                assert_eq!(s.component, u8::from(u2 >= pd), "u = {u:?}");
+                let f = p.eval(wi, s.wo);
+                let cos = s.wo[2].max(0.0);
+                for (w, v) in s.weight.iter().zip(f) {
+                    let expected = v * cos / s.pdf;
+                    assert!((w - expected).abs() <= 1e-12 * expected.max(1e-300));
+                }
+            }
         }
     }
 }

@@ -150,7 +150,7 @@ def test_discrete2d_pmf_and_chi2(rng):
 def test_piecewise1d_chi2_inverse_and_normalisation(rng):
     values = rng.random(40) ** 2
     values[[0, 10, 11, 39]] = 0
-    p = mcs.PiecewiseConstant1D(values, -2.0, 3.0)
+    p = mcs.PiecewiseConstant1D(values, a=-2.0, b=3.0)
     assert p.integral == pytest.approx(values.sum() * 5 / 40)
     result = stats.chi2_test(lambda u: p.sample(u[:, 0])[0], p.pdf, (-2.0, 3.0), sample_dim=1,
                              res=200, seed=4, test_count=TEST_COUNT)
@@ -168,7 +168,7 @@ def test_piecewise1d_chi2_inverse_and_normalisation(rng):
 
 
 def test_piecewise1d_float32(rng):
-    p = mcs.PiecewiseConstant1D(rng.random(16) + 0.1, 0.0, 0.1)
+    p = mcs.PiecewiseConstant1D(rng.random(16) + 0.1, a=0.0, b=0.1)
     x, pdf = p.sample(EDGE_GRID.astype(np.float32))
     assert x.dtype == np.float32 and pdf.dtype == np.float32
     assert np.all((x >= 0) & (x <= np.float32(0.1)))
@@ -182,7 +182,7 @@ def test_piecewise2d_spiky_chi2_inverse_and_normalisation():
     values[5] = 0
     values[:, 7] = 0
     dom = ((-1.0, 3.0), (0.5, 2.5))
-    p = mcs.PiecewiseConstant2D(values, dom)
+    p = mcs.PiecewiseConstant2D(values, domain=dom)
     assert p.shape == (24, 48) and p.domain == dom
     result = stats.chi2_test(lambda u: p.sample(u)[0], p.pdf, dom, res=(96, 48), seed=5,
                              test_count=TEST_COUNT)

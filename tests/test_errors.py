@@ -153,7 +153,7 @@ CASES = [
     # Seeds: an int in [0, 2**64), None or a numpy Generator.
     (lambda: mcs.Rng(seed=2**64), ValueError, [f"seed = {2**64}"]),
     (lambda: mcs.Rng(seed=-1), ValueError, ["seed = -1"]),
-    (lambda: mcs.Rng(seed="a"), TypeError, ["seed must be an int, None or a numpy"]),
+    (lambda: mcs.Rng(seed="a"), TypeError, ["seed must be an integer, None or a numpy"]),
     (lambda: mcs.Rng(stream=2**63), ValueError, [f"stream = {2**63}"]),
     (lambda: mcs.uniform(4, seed=1.5), TypeError, ["seed must be an int"]),
     (lambda: mcs.uniform(4, dim=2**70), ValueError, [f"dim = {2**70}"]),

@@ -107,7 +107,7 @@ def test_distribution_draws_pmf_and_cdf():
     fig = plot.distribution(d)
     np.testing.assert_allclose([p.get_height() for p in fig.axes[0].patches], d.pmf())
     np.testing.assert_allclose(fig.axes[1].lines[0].get_ydata()[1:-1], np.cumsum(d.pmf()))
-    pc = mcs.PiecewiseConstant1D([1.0, 3.0], 0.0, 2.0)
+    pc = mcs.PiecewiseConstant1D([1.0, 3.0], a=0.0, b=2.0)
     fig = plot.distribution(pc)
     np.testing.assert_allclose(fig.axes[1].lines[0].get_ydata()[[0, -1]], [0.0, 1.0])
     fig = plot.distribution(mcs.Discrete2D([[1.0, 2.0], [3.0, 4.0]]))

@@ -29,7 +29,7 @@ def resolve_seed(seed: SeedLike, arg: str = "seed") -> int:
     try:
         value = operator.index(seed)
     except TypeError:
-        raise TypeError(f"{arg} must be an int, None or a numpy.random.Generator, "
+        raise TypeError(f"{arg} must be an integer, None or a numpy.random.Generator, "
                         f"got {type(seed).__name__}") from None
     if not 0 <= value < 2**64:
         raise ValueError(f"{arg} = {value}: must be an integer from 0 to {2**64 - 1}")
