@@ -102,7 +102,9 @@ def plant(id: str, description: str, path: str, *edits: tuple[str, str],
 
 INTEGRATOR = "src/render/integrator.rs"
 SCENE = "src/render/scene.rs"
-SHAPE = "src/render/shape.rs"
+SPHERE = "src/render/shape/sphere.rs"
+DISK = "src/render/shape/disk.rs"
+TRIANGLE = "src/render/shape/triangle.rs"
 RENDER = ("render::",)
 AREA_LIGHTS = "test_vs_mitsuba_area_lights.py"
 FURNACE = "test_render.py::test_white_furnace"
@@ -177,25 +179,25 @@ RENDER_BUGS = [
           pytest=("test_render.py::test_camera_matches_mitsubas", f"{AREA_LIGHTS} -k room")),
     plant("sphere-cone-density-4pi",
           "uniform_cone_density is 1/(4 pi (1 - cos max)) instead of 1/(2 pi (1 - cos max))",
-          SHAPE,
+          SPHERE,
           ("(1.0 / (2.0 * std::f64::consts::PI * one_minus_cos_max)) as f32",
            "(1.0 / (4.0 * std::f64::consts::PI * one_minus_cos_max)) as f32"),
           cargo=RENDER, pytest=("test_emitters.py -k sphere",)),
     plant("sphere-cone-sample-not-uniform",
           "Sphere::sample_cone draws 1 - cos theta from u0^2, not u0: not uniform in the cone",
-          SHAPE,
+          SPHERE,
           ("let omc = f64::from(u[0]) * one_minus_cos_max;",
            "let omc = f64::from(u[0]) * f64::from(u[0]) * one_minus_cos_max;"),
           cargo=RENDER, pytest=("test_emitters.py -k sphere",)),
     plant("disk-area-non-uniform-scale",
           "Disk::new takes the area pi |Mx|^2, wrong under non-uniform scale",
-          SHAPE,
+          DISK,
           ("area: std::f32::consts::PI * cross.length(),",
            "area: std::f32::consts::PI * m.x_axis.length() * m.x_axis.length(),"),
           cargo=RENDER, pytest=("test_emitters.py -k disk",)),
     plant("triangle-sample-not-uniform",
           "Triangle::sample (area lights) forgets the square root: t = 1 - u0, not sqrt(1 - u0)",
-          SHAPE,
+          TRIANGLE,
           ("let [b1, b2] = warp::square_to_uniform_triangle(u);",
            "let [b1, b2] = [u[0], (1.0 - u[0]) * u[1]];"),
           cargo=RENDER, pytest=("test_emitters.py -k 'rectangle or cube or mesh'",)),
@@ -313,7 +315,7 @@ DISTR = ("distr",)
 DISTR_BUGS = [
     plant("discrete-reuse-first-entry",
           "Search::rescale (sample_reuse) subtracts C_0, not 0, for entry 0: its u' is always 0",
-          "src/distr/discrete.rs",
+          "src/distr/search.rs",
           ("(u.f64() * self.sum - self.sum_before(i))",
            "(u.f64() * self.sum - self.running(i.saturating_sub(1)))"),
           cargo=DISTR,

@@ -140,7 +140,7 @@ def test_discrete2d_pmf_and_chi2(rng):
         cells, r = d.sample_reuse(u)
         return cells[:, ::-1] + r  # (col + r0, row + r1): x along columns
     result = stats.chi2_test(sample, _cells_pdf(d.pmf(), (7, 13)), ((0, 13), (0, 7)),
-                             res=(13, 7), seed=3, test_count=TEST_COUNT)
+                             res=(7, 13), seed=3, test_count=TEST_COUNT)
     assert result.passed, result.message
     cells = d.sample(np.concatenate([np.stack([EDGE_GRID, EDGE_GRID[::-1]], 1),
                                      mcs.uniform(100_000, 2, seed=8)]))
@@ -184,7 +184,7 @@ def test_piecewise2d_spiky_chi2_inverse_and_normalisation():
     dom = ((-1.0, 3.0), (0.5, 2.5))
     p = mcs.PiecewiseConstant2D(values, domain=dom)
     assert p.shape == (24, 48) and p.domain == dom
-    result = stats.chi2_test(lambda u: p.sample(u)[0], p.pdf, dom, res=(96, 48), seed=5,
+    result = stats.chi2_test(lambda u: p.sample(u)[0], p.pdf, dom, res=(48, 96), seed=5,
                              test_count=TEST_COUNT)
     assert result.passed, result.message
     u = np.stack(np.meshgrid(EDGE_GRID[::20], EDGE_GRID[::20]), -1).reshape(-1, 2)

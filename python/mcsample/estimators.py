@@ -41,7 +41,7 @@ def envmap_integral(env: Any, f: Callable[[np.ndarray], Any], k: int = 4,
     Exact for the map's own pdf, and accurate for integrands built on its
     radiance, whose texel-scale features the cells follow."""
     domain = EnvMapDomain(env)
-    nx, ny = domain.cells[0] * k, domain.cells[1] * k
+    ny, nx = domain.cells[0] * k, domain.cells[1] * k
     (x0, x1), (y0, y1) = domain.bounds
     xs = x0 + (np.arange(nx) + 0.5) / nx * (x1 - x0)
     rows_per_batch = max(1, batch // nx)

@@ -1,6 +1,6 @@
 //! [`Discrete2D`]: a discrete distribution over the cells of a table.
 
-use super::discrete::{Place, Search, fill_table, guide_len};
+use super::search::{Place, Search, fill_table, guide_len};
 use super::{Discrete1D, GROUP, check_weights};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};

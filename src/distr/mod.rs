@@ -17,6 +17,7 @@ mod alias;
 mod discrete;
 mod discrete2d;
 mod piecewise;
+mod search;
 
 pub use alias::AliasTable;
 pub use discrete::Discrete1D;

@@ -1,7 +1,7 @@
 //! Piecewise-constant densities on an interval and on a rectangle, sampled
 //! by inverting their piecewise-linear CDFs.
 
-use super::discrete::Search;
+use super::search::Search;
 use super::{Discrete1D, Discrete2D, GROUP};
 use crate::error::{Error, Result};
 use crate::math::Real;

@@ -14,9 +14,10 @@ from .domains import Domain, DomainLike, make_domain
 
 
 def _grid_shape(domain: Domain, res: int | tuple[int, int]) -> tuple[int, int]:
-    """(columns, rows) of the histogram."""
+    """(columns, rows) of the histogram from ``res``: rows, or (rows,
+    columns) as numpy's shapes."""
     if isinstance(res, tuple):
-        nx, ny = res
+        ny, nx = res
     elif domain.aspect is None:
         nx, ny = res, 1
     else:
@@ -344,9 +345,10 @@ def chi2_test(
         Number of samples.
     sample_dim : int
         Uniform numbers per sample.
-    res : int or (columns, rows)
-        Rows of the histogram (columns follow the domain's aspect); odd
-        values keep cell edges off symmetry planes.
+    res : int or (rows, columns)
+        Rows of the histogram (columns follow the domain's aspect), or
+        both, as numpy's shapes; odd values keep cell edges off symmetry
+        planes.
     ires : int >= 2
         Integration points per cell and axis; raise it for sharp densities.
     seed : int
@@ -445,7 +447,7 @@ def two_sample_test(
         Points, (n,) on an interval or (n, point_dim); sizes may differ.
     domain : str, tuple or Domain
         As for :func:`chi2_test`.
-    res : int or (columns, rows)
+    res : int or (rows, columns)
         Histogram resolution; cells with few samples are pooled.
     alpha, test_count : as for :func:`chi2_test`.
 

@@ -205,9 +205,10 @@ class EnvMapDomain(Domain):
     (atan2(y, x) / 2 pi, acos(z) / pi); cube, (u, face + v). Densities per
     steradian.
 
-    ``cells`` is a histogram resolution whose cells each lie in one cell of
-    the table (lat-long: half-texel columns, rows between texel rows;
-    angular: 2W sectors x W rings; cube: half-texel cells), so that the
+    ``cells`` is a histogram resolution (rows, columns) whose cells each lie
+    in one cell of the table (lat-long: half-texel columns, rows between
+    texel rows; angular: 2W sectors x W rings; cube: half-texel cells), so
+    that the
     expected counts of a ``sampling="piecewise"`` map are integrated exactly:
     ``chi2_test(..., EnvMapDomain(env), res=EnvMapDomain(env).cells)``.
     """
@@ -222,14 +223,14 @@ class EnvMapDomain(Domain):
         if self.mapping == "cube":
             r = shape[1]
             self.bounds = ((0.0, 1.0), (0.0, 6.0))
-            self.cells: tuple[int, int] = (2 * r, 12 * r)
+            self.cells: tuple[int, int] = (12 * r, 2 * r)
         elif self.mapping == "angular":
             self.bounds = ((0.0, 1.0), (0.0, 1.0))
-            self.cells = (max(2 * shape[1], 4), max(shape[1], 2))
+            self.cells = (max(shape[1], 2), max(2 * shape[1], 4))
         else:
             h, w = shape[:2]
             self.bounds = ((0.0, 1.0), (0.0, 1.0))
-            self.cells = (2 * w, h - 1)
+            self.cells = (h - 1, 2 * w)
         (x0, x1), (y0, y1) = self.bounds
         self.aspect = (x1 - x0) / (y1 - y0)
 

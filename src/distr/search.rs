@@ -1,0 +1,322 @@
+//! The search behind the CDF-inversion tables ([`super::Discrete1D`] and
+//! the rows of [`super::Discrete2D`]): running sums, a guide table (the
+//! cutpoint method of Chen and Asau) that narrows the search to an expected
+//! O(1) entries, and the search itself.
+
+use super::is_weight;
+use crate::math::Real;
+use crate::simd;
+
+/// Tables shorter than this are searched without a guide table: a binary
+/// search over a cache line or two is as fast. (Above it, even a table of a
+/// few hundred entries, such as an environment map's marginal, gains: its
+/// binary search is a chain of dependent loads.)
+const GUIDE_MIN_LEN: usize = 64;
+
+/// The running sums of `weights` from 0 into `cdf`, in order, and the
+/// weights into `copy` (all three of one length): their total, and whether
+/// every weight is finite and `>= 0`.
+pub(crate) fn sum_into(weights: &[f64], cdf: &mut [f64], copy: &mut [f64]) -> (f64, bool) {
+    let (mut acc, mut valid) = (0.0, true);
+    for ((c, w_copy), &w) in cdf.iter_mut().zip(copy.iter_mut()).zip(weights) {
+        acc += w;
+        *c = acc;
+        *w_copy = w;
+        valid &= is_weight(w);
+    }
+    (acc, valid)
+}
+
+/// The first and last entries of positive weight (`None` if there is none).
+pub(crate) fn positive_range(weights: &[f64]) -> Option<(usize, usize)> {
+    let positive = |w: &f64| *w > 0.0;
+    Some((
+        weights.iter().position(positive)?,
+        weights.iter().rposition(positive)?,
+    ))
+}
+
+/// The length of the guide table of a table of `n` entries: one cell per 4
+/// entries (a short search, a small table), plus the end; 0 (no guide) for
+/// tables shorter than [`GUIDE_MIN_LEN`].
+pub(crate) fn guide_len(n: usize) -> usize {
+    if n < GUIDE_MIN_LEN { 0 } else { n / 4 + 1 }
+}
+
+/// Fills the guide table of the running sums `cdf` (total `sum`, entries of
+/// positive weight from `first` to `last`): `guide[k]` is the first `i`
+/// with `C_i ≥ k·Σw/G`, for `G + 1 = guide.len()` cells.
+///
+/// Branch-free: entry `i` writes its index into cell `⌊C_i·G/Σw⌋`, last
+/// entries first, so each hit cell keeps its smallest index; a cell no
+/// entry hits takes the answer of the next cell up (a suffix minimum).
+/// Round-off here only costs a fallback search (see [`Search::bracket`]).
+pub(crate) fn fill_guide(cdf: &[f64], sum: f64, (first, last): (usize, usize), guide: &mut [u32]) {
+    let Some(cells) = guide.len().checked_sub(1) else {
+        return;
+    };
+    let scale = cells as f64 / sum;
+    guide.fill(u32::MAX);
+    for (i, &c) in cdf.iter().enumerate().rev() {
+        guide[((c * scale) as usize).min(cells)] = i as u32;
+    }
+    let (first, mut next) = (first as u32, last as u32);
+    for g in guide.iter_mut().rev() {
+        next = next.min(*g);
+        *g = next.max(first);
+    }
+}
+
+/// The tables of one distribution written into slices of a larger store
+/// (the rows of a [`super::Discrete2D`]): `weights` (checked: finite and
+/// `>= 0`) copied into `copy`, their running sums into `cdf` (summed in
+/// order) and the guide table into `guide` ([`guide_len`] entries). Returns
+/// the sum and the first and last entries of positive weight, as
+/// [`Search::new`] takes them, or `None` for a table that sums to 0.
+pub(crate) fn fill_table(
+    weights: &[f64],
+    (copy, cdf, guide): (&mut [f64], &mut [f64], &mut [u32]),
+) -> Option<(f64, usize, usize)> {
+    let (sum, _) = sum_into(weights, cdf, copy);
+    let range = positive_range(weights)?;
+    if !(sum > 0.0 && sum.is_finite()) {
+        return None;
+    }
+    fill_guide(cdf, sum, range, guide);
+    Some((sum, range.0, range.1))
+}
+
+/// The running sums from a guide cell's first entry that [`Search::index`]
+/// compares with the value all at once (one vector compare, no branch),
+/// instead of a binary search whose branches the CPU cannot predict.
+const SCAN: usize = 8;
+
+/// The number of entries of `window` below `value`, for running sums and a
+/// value that are finite and `>= 0` (`-0.0` counts as `+0.0`). Such floats
+/// order as their bits do, so `c < value` is the sign of the difference of
+/// the bits: integer lanes that add up in a few vector instructions (where
+/// a sum of compare results compiles to one extraction per lane on
+/// AVX-512).
+#[inline(always)]
+fn count_below(window: &[f64; SCAN], value: f64) -> usize {
+    let value = value.abs().to_bits();
+    window
+        .iter()
+        .map(|&c| c.to_bits().wrapping_sub(value) >> 63)
+        .sum::<u64>() as usize
+}
+
+/// A table's weights, running sums and guide cells, as plain slices of a
+/// store that may hold several tables (the rows of a
+/// [`super::Discrete2D`], row after row), and a draw in steps that a batch
+/// can interleave: [`Search::locate`] the guide cell (prefetched),
+/// [`Search::prefetch_window`], then [`Search::index`] or
+/// [`Search::index_reuse`]. Indices are the table's own (from 0); the
+/// table starts at `start` in `weights` and `cdf`, and its guide at
+/// `guide_start` in `guide`, so that cutting one table out of the store
+/// is arithmetic on its place (no sub-slices to cut and check per draw).
+#[derive(Clone, Copy)]
+pub(crate) struct Search<'a> {
+    weights: &'a [f64],
+    cdf: &'a [f64],
+    guide: &'a [u32],
+    start: usize,
+    guide_start: usize,
+    len: usize,
+    guide_len: usize,
+    sum: f64,
+    first: usize,
+    last: usize,
+}
+
+/// Where a table lies in a store of tables (see [`Search::within`]): its
+/// first entry in the weights and running sums, its first guide cell, and
+/// its number of entries.
+#[derive(Clone, Copy)]
+pub(crate) struct Place {
+    pub(crate) start: usize,
+    pub(crate) guide_start: usize,
+    pub(crate) len: usize,
+}
+
+impl<'a> Search<'a> {
+    /// The search of tables written by [`fill_table`] (`weights`, `cdf` and
+    /// `guide` as it wrote them; `(sum, first, last)` as it returned them).
+    #[inline(always)]
+    pub(crate) fn new(
+        (weights, cdf, guide): (&'a [f64], &'a [f64], &'a [u32]),
+        span: (f64, usize, usize),
+    ) -> Self {
+        let place = Place {
+            start: 0,
+            guide_start: 0,
+            len: weights.len(),
+        };
+        Self::within((weights, cdf, guide), place, span)
+    }
+
+    /// The search of the table at `place` in a store of tables that
+    /// [`fill_table`] wrote one after another (each guide [`guide_len`]
+    /// cells long).
+    #[inline(always)]
+    pub(crate) fn within(
+        (weights, cdf, guide): (&'a [f64], &'a [f64], &'a [u32]),
+        place: Place,
+        (sum, first, last): (f64, usize, usize),
+    ) -> Self {
+        Search {
+            weights,
+            cdf,
+            guide,
+            start: place.start,
+            guide_start: place.guide_start,
+            len: place.len,
+            guide_len: guide_len(place.len),
+            sum,
+            first,
+            last,
+        }
+    }
+
+    /// The sum of the weights.
+    #[inline(always)]
+    pub(crate) fn sum(&self) -> f64 {
+        self.sum
+    }
+
+    /// The weight of entry `i` (0 outside the table).
+    #[inline(always)]
+    pub(crate) fn weight(&self, i: usize) -> f64 {
+        if i < self.len {
+            self.weights[self.start + i]
+        } else {
+            0.0
+        }
+    }
+
+    /// The running sum `C_i` of entry `i` of the table (`i < len`).
+    #[inline(always)]
+    fn running(&self, i: usize) -> f64 {
+        self.cdf[self.start + i]
+    }
+
+    /// The first entry of guide cell `k` (`None` past the guide, or without
+    /// one).
+    #[inline(always)]
+    fn guide_entry(&self, k: usize) -> Option<usize> {
+        (k < self.guide_len).then(|| self.guide[self.guide_start + k] as usize)
+    }
+
+    /// The guide cell `⌊u·G⌋` of `u` (clamped to the last cell; 0 without a
+    /// guide table).
+    #[inline(always)]
+    pub(crate) fn guide_cell(&self, u: f64) -> usize {
+        let cells = self.guide_len.saturating_sub(1);
+        (u * cells as f64).floor_index(cells.saturating_sub(1))
+    }
+
+    /// The index and the rescaled `u` in one go (see
+    /// [`Discrete1D::sample_reuse`]).
+    #[inline(always)]
+    pub(crate) fn sample_reuse<F: Real>(&self, u: F) -> (usize, F) {
+        self.index_reuse(u, self.guide_cell(u.f64()))
+    }
+
+    /// Step 1: the guide cell of `u`, prefetched.
+    #[inline(always)]
+    pub(crate) fn locate(&self, u: f64) -> usize {
+        let k = self.guide_cell(u);
+        simd::prefetch(self.guide, self.guide_start + k);
+        k
+    }
+
+    /// Step 2: prefetches what [`Search::index`] reads for guide cell `k`:
+    /// the running sum before its first entry `lo`, the window of [`SCAN`]
+    /// sums from `lo` (at most two cache lines with it), and the weight at
+    /// `lo`.
+    #[inline(always)]
+    pub(crate) fn prefetch_window(&self, k: usize) {
+        if let Some(lo) = self.guide_entry(k) {
+            let lo = self.start + lo;
+            simd::prefetch(self.cdf, lo.saturating_sub(1));
+            simd::prefetch(self.cdf, lo + SCAN - 1);
+            simd::prefetch(self.weights, lo);
+        }
+    }
+
+    /// Step 3: the index for `u`, starting from the first entry `lo` of
+    /// guide cell `k`. Where the sum before `lo` is below `u·Σw` (or `lo`
+    /// is the first entry of positive weight), the answer is the first of
+    /// the [`SCAN`] sums from `lo` that reaches `u·Σw`, found by counting
+    /// those below it in one vector compare; they are sorted, and past the
+    /// last entry of positive weight every sum is `Σw`. Otherwise (the
+    /// guide cell missed by round-off, or an answer further on) a binary
+    /// search of the cell's bracket (see [`Search::bracket`]).
+    #[inline(always)]
+    pub(crate) fn index(&self, u: f64, k: usize) -> usize {
+        let value = u * self.sum;
+        if let Some(lo) = self.guide_entry(k) {
+            let lo_ok = lo == self.first || self.running(lo - 1) < value;
+            if lo + SCAN <= self.len {
+                let at = self.start + lo;
+                if let Some(window) = self.cdf[at..].first_chunk() {
+                    let below = count_below(window, value);
+                    if lo_ok && below < SCAN {
+                        return lo + below;
+                    }
+                }
+            }
+        }
+        let (lo, hi) = self.bracket(k, value);
+        lo + self.cdf[self.start + lo..self.start + hi].partition_point(|&c| c < value)
+    }
+
+    /// Step 3 of [`Discrete1D::sample_reuse`]: the index and the rescaled
+    /// `u`.
+    #[inline(always)]
+    pub(crate) fn index_reuse<F: Real>(&self, u: F, k: usize) -> (usize, F) {
+        let i = self.index(u.f64(), k);
+        (i, self.rescale(u, i))
+    }
+
+    /// Prefetches the weight of index `i`, which [`Search::rescale`] reads
+    /// (the running sum before it is among those just searched).
+    #[inline(always)]
+    pub(crate) fn prefetch_weight(&self, i: usize) {
+        simd::prefetch(self.weights, self.start + i);
+    }
+
+    /// The leftover of `u` past the running sum before index `i`, rescaled
+    /// to `[0, 1)` by its weight.
+    #[inline(always)]
+    pub(crate) fn rescale<F: Real>(&self, u: F, i: usize) -> F {
+        let rescaled = (u.f64() * self.sum - self.sum_before(i)) / self.weights[self.start + i];
+        F::c(rescaled.clamp(0.0, f64::ONE_MINUS_EPSILON))
+    }
+
+    /// `C_{i−1}` (0 for i = 0, Σw past the end).
+    #[inline(always)]
+    pub(crate) fn sum_before(&self, i: usize) -> f64 {
+        match i {
+            0 => 0.0,
+            _ if i <= self.len => self.running(i - 1),
+            _ => self.sum,
+        }
+    }
+
+    /// The range `[lo, hi]` (inclusive) that holds the answer for `value`:
+    /// from guide cell `k` when it provably brackets `value`, else the
+    /// whole range of positive weights.
+    #[inline(always)]
+    fn bracket(&self, k: usize, value: f64) -> (usize, usize) {
+        let full = (self.first, self.last);
+        let (Some(lo), Some(hi)) = (self.guide_entry(k), self.guide_entry(k + 1)) else {
+            return full;
+        };
+        // Round-off in u·G against the guide's thresholds can miss by one
+        // cell: check the bracket and fall back to the full range.
+        let lo_ok = lo == self.first || self.running(lo - 1) < value;
+        let hi_ok = hi == self.last || self.running(hi) >= value;
+        if lo_ok && hi_ok { (lo, hi) } else { full }
+    }
+}
