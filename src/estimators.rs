@@ -25,7 +25,8 @@ use crate::mis::Heuristic;
 use crate::parallel;
 use crate::phong::Phong;
 use crate::rng::Rng;
-use crate::warp::{self, V3};
+use crate::math::{V3, dot};
+use crate::warp;
 use std::f64::consts::PI;
 use std::sync::Mutex;
 
@@ -195,10 +196,6 @@ fn unsupported(strategy: Strategy, allowed: &str) -> Error {
     }
 }
 
-#[inline(always)]
-fn dot(a: V3<f64>, b: V3<f64>) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 
 #[inline(always)]
 fn scaled(v: V3<f64>, s: f64) -> V3<f64> {

@@ -1,8 +1,7 @@
 //! Orthonormal frames: the local shading frame (normal = +z) around a
 //! world-space normal.
 
-use crate::math::Real;
-use crate::warp::V3;
+use crate::math::{Real, V3, dot};
 
 /// An orthonormal basis `(s, t, n)`: `to_local` gives a vector's
 /// coordinates along `s`, `t`, `n`; `to_world` maps them back.
@@ -27,10 +26,6 @@ pub struct Frame<F> {
     pub n: V3<F>,
 }
 
-#[inline(always)]
-fn dot<F: Real>(a: V3<F>, b: V3<F>) -> F {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 
 impl<F: Real> Frame<F> {
     /// The frame around the unit vector `n`.

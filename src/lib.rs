@@ -47,6 +47,8 @@ pub mod math;
 pub mod mis;
 pub mod parallel;
 pub mod phong;
+#[cfg(test)]
+mod quadrature;
 pub mod render;
 pub mod rng;
 pub mod simd;

@@ -6,6 +6,17 @@
 use num_traits::{Float, FloatConst};
 use std::fmt::Debug;
 
+/// A point of the unit square or a planar domain.
+pub type P2<F> = [F; 2];
+/// A direction (unit vector) or a 3D point.
+pub type V3<F> = [F; 3];
+
+/// The dot product `a · b`.
+#[inline(always)]
+pub fn dot<F: Real>(a: V3<F>, b: V3<F>) -> F {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
 /// A floating-point type a kernel can run in: `f32` or `f64`.
 pub trait Real: Float + FloatConst + Debug + Default + Send + Sync + 'static {
     /// The largest value below 1; `u = 1.0` is clamped to it where a kernel

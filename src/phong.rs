@@ -6,9 +6,9 @@
 
 use crate::error::{Error, Result};
 use crate::frame::Frame;
-use crate::math::{Real, luminance};
+use crate::math::{Real, V3, dot, luminance};
 use crate::simd;
-use crate::warp::{self, V3};
+use crate::warp;
 
 /// How [`Phong::sample`] picks the diffuse or the glossy part.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -375,10 +375,6 @@ fn max3(v: [f64; 3]) -> f64 {
     v[0].max(v[1]).max(v[2])
 }
 
-#[inline(always)]
-fn dot<F: Real>(a: V3<F>, b: V3<F>) -> F {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
 
 /// The mirror direction of `wi` about the normal +z: `(−x, −y, z)`.
 #[inline(always)]
@@ -495,21 +491,10 @@ mod tests {
 
     #[test]
     fn pdf_integrates_to_one_over_the_sphere() {
-        // Midpoint rule in (φ, cos θ) on the sphere.
         for n in [0.0, 1.0, 30.0] {
             let p = phong(n);
             let wi = [0.5f64, 0.0, 0.75f64.sqrt()];
-            let (nphi, nz) = (400, 4000);
-            let mut total = 0.0;
-            for i in 0..nphi {
-                let phi = (i as f64 + 0.5) / nphi as f64 * std::f64::consts::TAU;
-                for j in 0..nz {
-                    let z = -1.0 + (j as f64 + 0.5) / nz as f64 * 2.0;
-                    let r = (1.0 - z * z).sqrt();
-                    total += p.pdf(wi, [r * phi.cos(), r * phi.sin(), z]);
-                }
-            }
-            total *= std::f64::consts::TAU / nphi as f64 * 2.0 / nz as f64;
+            let total = crate::quadrature::integrate_sphere(|wo| p.pdf(wi, wo), 400, 4000);
             assert!((total - 1.0).abs() < 2e-3, "n = {n}: {total}");
         }
     }

@@ -8,12 +8,8 @@
 //! `u = 1` maps inside the domain, and inverses of degenerate points (the
 //! origin, a pole) return a valid point of the square.
 
+pub use crate::math::{P2, V3};
 use crate::math::{Real, atan2, safe_sqrt, sin_cos_turn};
-
-/// A point of the unit square or a planar domain.
-pub type P2<F> = [F; 2];
-/// A direction (unit vector) or a 3D point.
-pub type V3<F> = [F; 3];
 
 #[inline(always)]
 fn two_pi<F: Real>() -> F {

@@ -32,18 +32,7 @@ fn integrate_plane(pdf: Pdf) -> f64 {
 
 /// Midpoint rule over the sphere in (φ, cos θ), which is area-preserving.
 fn integrate_sphere(pdf: Pdf) -> f64 {
-    let (n_phi, n_z) = (200, 4000);
-    let (h_phi, h_z) = (2.0 * PI / n_phi as f64, 2.0 / n_z as f64);
-    let mut sum = 0.0;
-    for i in 0..n_phi {
-        let (s, c) = ((i as f64 + 0.5) * h_phi).sin_cos();
-        for j in 0..n_z {
-            let z = -1.0 + (j as f64 + 0.5) * h_z;
-            let r = (1.0 - z * z).sqrt();
-            sum += pdf(&[r * c, r * s, z]);
-        }
-    }
-    sum * h_phi * h_z
+    crate::quadrature::integrate_sphere(|d| pdf(&d), 200, 4000)
 }
 
 const EXPONENTS: [f64; 5] = [0.0, 1.0, 10.0, 100.0, 1000.0];
