@@ -21,7 +21,7 @@
 //!   integrators) for comparing sampling strategies with Mitsuba 3.
 //! - [`frame`]: orthonormal frames around a normal.
 //! - [`io`]: EXR, Radiance HDR and PNG files.
-//! - [`simd`]: runtime dispatch of batch loops to AVX2 + FMA.
+//! - [`simd`]: runtime dispatch of batch loops to AVX-512 or AVX2 + FMA.
 //! - [`math`]: the [`math::Real`] scalar trait (`f32` / `f64`) and helpers.
 //! - [`error`]: the one error type.
 //!

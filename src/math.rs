@@ -167,8 +167,8 @@ macro_rules! sin_cos_turn {
 /// (Taylor series), `2ᵏ` built from its bits. Both polynomials are
 /// evaluated by Estrin's scheme: the loops that call `pow` (the
 /// cosine-power warp, Phong) wait on the chain of dependent operations,
-/// and Horner's is 24 steps long (Estrin's: 8; measured, the cosine-power
-/// warp 1.4–2× faster at the same accuracy). The whole numbers `e` and
+/// and Horner's is 24 steps long (Estrin's: 8), at the same accuracy. The
+/// whole numbers `e` and
 /// `k` stay floats: a biased exponent field is read as a float by placing
 /// it in the mantissa of `2⁵²` (and written back the same way), because
 /// AVX2 has no conversion between `f64` and 64-bit integers and a loop

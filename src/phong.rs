@@ -273,10 +273,10 @@ impl<F: Real> PhongView<F> {
     /// The kernel is large (two powers, two sines and cosines, a frame),
     /// and whether LLVM vectorises it for AVX2 has been seen to depend on
     /// code elsewhere in the crate (a binding that filled an `N`-row buffer
-    /// through the same kernel ran one lane at a time, 3–5× slower). After
-    /// a change, compare `python -m mcsample bench --only phong` with the
-    /// same run under `MCSAMPLE_SIMD=baseline`: the vectorised build is
-    /// about twice as fast.
+    /// through the same kernel ran one lane at a time). After a change,
+    /// compare `python -m mcsample bench --only phong` with the same run
+    /// under `MCSAMPLE_SIMD=baseline`: the vectorised build must be the
+    /// faster one.
     ///
     /// # Panics
     /// If an array of `out` is shorter than `rows`.

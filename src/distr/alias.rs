@@ -59,8 +59,8 @@ const ONE: f64 = 4_294_967_296.0;
 /// block order, settles them; its last heavy keeps its whole cell. Random
 /// weights leave a few percent of the entries over; weights sorted by size
 /// leave most of them, and the last sweep, on one thread and on freshly
-/// allocated arrays, then dominates (measured for 10^6 entries: 56–63 ms
-/// sorted, against 4.9–6.4 ms for the same weights in random order).
+/// allocated arrays, then dominates (an order of magnitude slower; see
+/// benches/README.md).
 /// Thresholds come from prefix sums over one block (or over the
 /// leftovers), never from a residual carried along the sweep, and the
 /// table is the same whatever the number of threads.
@@ -146,8 +146,7 @@ impl Orders<'_> {
     /// The steps form a chain of dependent loads,
     /// so the merge runs as [`LANES`] pieces, interleaved one step of each
     /// in turn, each started where the merge path crosses its first step's
-    /// diagonal (measured: the build of 10^6 entries takes 3.9 ms rather
-    /// than 5.6 ms with one step after another). Both
+    /// diagonal, so that the pieces' loads overlap. Both
     /// outputs of a step are written (no unpredictable branch), so a slot
     /// may be written early and is written again by its own step; but the
     /// last steps of a piece also write the first slots of the next one,
@@ -392,9 +391,7 @@ impl AliasTable {
         // The sum, by blocks, and the copy of the weights that `pmf` reads
         // (dividing by the sum only when asked keeps divisions out of the
         // build); the weights are checked on the way. The copy is streamed
-        // past the caches, so that it leaves them to the sweeps (measured
-        // for 10^6 entries: 5.9 ms against 6.3 ms on one thread, 3.1 against
-        // 3.2 ms on two).
+        // past the caches, so that it leaves them to the sweeps.
         let mut copy = Buffer::<f64>::for_overwrite(weights.len());
         let (block_totals, valid): (Vec<f64>, Vec<bool>) = copy
             .par_chunks_mut(BLOCK)
@@ -508,8 +505,8 @@ impl AliasTable {
 
     /// `out[i] = sample(us[i])` for a batch. Groups of draws first locate
     /// their cells and prefetch them, then read them, so that the cache
-    /// misses of a group overlap (on tables larger than the cache, 3–4×
-    /// the speed of one draw after another).
+    /// misses of a group overlap (on tables larger than the cache, several
+    /// times the speed of one draw after another).
     pub fn sample_into<F: Real, I: From<u32>>(&self, us: &[F], out: &mut [I]) {
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
             let mut located = [(0, 0); GROUP];

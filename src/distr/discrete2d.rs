@@ -216,8 +216,8 @@ impl Discrete2D {
     /// conditionals' guide cells), their windows, the columns (prefetching
     /// their weights), then the rescaled `u` of each column. The cache
     /// misses of a group overlap, and each step is a short loop of
-    /// independent draws (a row's search and its division in one loop ran
-    /// 9% slower on a table that fits in the caches).
+    /// independent draws (faster than a row's search and its division in
+    /// one loop; see benches/README.md).
     pub fn sample_reuse_into<F: Real>(&self, us: &[[F; 2]], out: &mut [((usize, usize), [F; 2])]) {
         simd::dispatch(
             #[inline(always)]

@@ -1,8 +1,7 @@
 //! The acceleration structure: every primitive of the scene (triangles,
 //! spheres, disks) in one compressed wide BVH (obvhs' CWBVH, built by PLOC).
 //! A scene of at most [`LEAF_MAX`] primitives is a single leaf, which costs a
-//! fraction of a wide-node traversal (measured: one sphere, 15 ns against
-//! 75 ns per ray): its triangles are tested four at a time
+//! fraction of a wide-node traversal: its triangles are tested four at a time
 //! ([`Triangles4`]), its other primitives one after the other.
 
 use std::time::Duration;

@@ -339,8 +339,8 @@ fn interleave<T: Copy, const M: usize>(columns: &[[T; BLOCK]; M], rows: &mut [[T
 /// [`crate::buffer::Buffer`] are); otherwise with plain stores. For copies
 /// that are not read again soon: such stores skip reading each line before
 /// writing it. The width is read at run time on purpose: given as the
-/// dispatch's constant, LLVM merged the copy into the block's transpose and
-/// the AVX2 warps of three components ran 15% more instructions per row.
+/// dispatch's constant, LLVM merged the copy into the block's transpose,
+/// which cost the AVX2 warps of three components instructions per row.
 #[inline(always)]
 pub(crate) fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
     #[cfg(target_arch = "x86_64")]
