@@ -3,13 +3,13 @@ luminance for a diffuse floor (or wall, or room) lit by one area light, by
 each strategy alone and by MIS.
 
 Each cell renders the scene with ``--seeds`` seeds × ``--spp`` samples per
-pixel on each side (Mitsuba's ``direct`` or ``path`` integrator with its MIS
-as the reference for every strategy, since all are unbiased) and prints the
-ratio of the mean luminances with its standard error (from the spread of
-the seeds' means on both sides) and how many standard errors it lies from
-1. Run on demand (not in CI):
+pixel on each side (BSDF sampling 4× as many; Mitsuba's ``direct`` or
+``path`` integrator with its MIS as the reference for every strategy, since
+all are unbiased) and prints the ratio of the mean luminances with its
+standard error (from each render's per-pixel variances, on both sides) and
+how many standard errors it lies from 1. Run on demand (not in CI):
 
-    python scripts/area_light_table.py [--seeds 8] [--spp 64] [--markdown]
+    python scripts/area_light_table.py [--seeds 16] [--spp 256] [--markdown]
 """
 
 from __future__ import annotations
@@ -81,11 +81,11 @@ def cases() -> dict[str, tuple[dict, str]]:
     return out
 
 
-def mean_luminances(scene: mcs.Scene, integrator: str, spp: int, seeds: int,
-                    strategy: str | None) -> np.ndarray:
-    """Image-mean luminance of each seed's render (Mitsuba's if strategy is
-    None)."""
-    means = []
+def mean_luminance(scene: mcs.Scene, integrator: str, spp: int, seeds: int,
+                   strategy: str | None) -> tuple[float, float]:
+    """The image-mean luminance over the seeds' renders (Mitsuba's if
+    strategy is None) and its variance, from the pixels' variances."""
+    means, variances = [], []
     for seed in range(seeds):
         if strategy is None:
             r = mcs.mitsuba.render_reference(scene, spp, seed=1000 + seed, integrator=integrator,
@@ -94,31 +94,33 @@ def mean_luminances(scene: mcs.Scene, integrator: str, spp: int, seeds: int,
             r = mcs.render(scene, spp, integrator=integrator, strategy=strategy, seed=seed,
                            hide_emitters=True, progress=False)
         means.append(r.luminance.mean())
-    return np.array(means)
+        variances.append(r.luminance_variance.sum() / r.luminance.size ** 2)
+    return float(np.mean(means)), float(np.sum(variances)) / seeds ** 2
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seeds", type=int, default=8)
-    parser.add_argument("--spp", type=int, default=64)
+    parser.add_argument("--seeds", type=int, default=16)
+    parser.add_argument("--spp", type=int, default=256)
     parser.add_argument("--markdown", action="store_true", help="print a markdown table")
     args = parser.parse_args()
     strategies = ("emitter", "bsdf", "mis")
     print(f"mcsample / Mitsuba {mcs.mitsuba.load().__version__} ({mcs.mitsuba.choose_variant()}),"
-          f" {args.seeds} seeds x {args.spp} spp per side; ratio ± SE (z = (ratio - 1) / SE)")
+          f" {args.seeds} seeds x {args.spp} spp per side (BSDF sampling x4); ratio ± SE "
+          "(z = (ratio - 1) / SE)")
     if args.markdown:
         print("| light | " + " | ".join(f'strategy="{s}"' for s in strategies) + " |")
         print("|---|" + "---|" * len(strategies))
     for name, (d, integrator) in cases().items():
         scene = mcs.Scene.from_mitsuba(d)
-        ref = mean_luminances(scene, integrator, args.spp, args.seeds, None)
+        ref, ref_var = mean_luminance(scene, integrator, args.spp, args.seeds, None)
         cells = []
         for strategy in strategies:
-            ours = mean_luminances(scene, integrator, args.spp, args.seeds, strategy)
-            ratio = ours.mean() / ref.mean()
-            se = ratio * np.hypot(ours.std(ddof=1) / ours.mean(), ref.std(ddof=1) / ref.mean()) \
-                / np.sqrt(args.seeds)
-            cells.append(f"{ratio:.3f} ± {se:.3f} (z = {(ratio - 1) / se:+.1f})")
+            spp = 4 * args.spp if strategy == "bsdf" else args.spp
+            ours, var = mean_luminance(scene, integrator, spp, args.seeds, strategy)
+            ratio = ours / ref
+            se = ratio * np.hypot(np.sqrt(var) / ours, np.sqrt(ref_var) / ref)
+            cells.append(f"{ratio:.4f} ± {se:.4f} (z = {(ratio - 1) / se:+.1f})")
         if args.markdown:
             print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
         else:

@@ -21,11 +21,11 @@
 use crate::envmap::EnvMap;
 use crate::error::{Error, Result};
 use crate::frame::Frame;
+use crate::math::{V3, dot};
 use crate::mis::Heuristic;
 use crate::parallel;
 use crate::phong::Phong;
 use crate::rng::Rng;
-use crate::math::{V3, dot};
 use crate::warp;
 use std::f64::consts::PI;
 use std::sync::Mutex;
@@ -195,7 +195,6 @@ fn unsupported(strategy: Strategy, allowed: &str) -> Error {
         requirement: format!("must be {allowed}"),
     }
 }
-
 
 #[inline(always)]
 fn scaled(v: V3<f64>, s: f64) -> V3<f64> {

@@ -26,7 +26,6 @@ pub struct Frame<F> {
     pub n: V3<F>,
 }
 
-
 impl<F: Real> Frame<F> {
     /// The frame around the unit vector `n`.
     #[inline(always)]

@@ -375,7 +375,6 @@ fn max3(v: [f64; 3]) -> f64 {
     v[0].max(v[1]).max(v[2])
 }
 
-
 /// The mirror direction of `wi` about the normal +z: `(−x, −y, z)`.
 #[inline(always)]
 fn reflect<F: Real>(wi: V3<F>) -> V3<F> {
