@@ -6,6 +6,7 @@
 use super::arrays::{Check, Indices, Points, Table, with_precision};
 use super::batch::{map, map_chunks, map_indices, map2};
 use super::parallel::detached;
+use super::records::record;
 use crate::distr;
 use crate::math::Real;
 use numpy::PyArray1;
@@ -79,6 +80,29 @@ fn pmf_of<'py>(
     }
 }
 
+record! {
+    /// Draws of ``PiecewiseConstant1D.sample`` / ``PiecewiseConstant2D.sample``;
+    /// unpacks as ``x, pdf``.
+    PyPiecewiseSample, "PiecewiseSample", "mcsample._core", {
+        /// The points, (N,) on the interval or (N, 2) in the rectangle.
+        x,
+        /// Their densities, per unit length or area, (N,).
+        pdf,
+    }
+}
+
+record! {
+    /// Draws of ``Discrete1D.sample_reuse`` / ``Discrete2D.sample_reuse``;
+    /// unpacks as ``index, u``.
+    PyReusedSample, "ReusedSample", "mcsample._core", {
+        /// The indices, (N,) int64, or (N, 2) (row, col).
+        index,
+        /// u rescaled within the chosen entry's share to [0, 1), a fresh
+        /// uniform number: (N,) or (N, 2), in u's precision.
+        u,
+    }
+}
+
 /// A discrete distribution over 0..n-1 proportional to ``weights``,
 /// sampled by inverting its CDF (binary search on running sums accumulated
 /// in float64, in order within blocks of 65536 entries, narrowed by a guide
@@ -122,18 +146,20 @@ impl PyDiscrete1D {
     ///
     /// Returns
     /// -------
-    /// (ndarray (N,) int64, ndarray (N,) float of u's precision)
+    /// ReusedSample: ``.index`` ndarray (N,) int64 and ``.u`` ndarray (N,)
+    /// float of u's precision; unpacks as ``index, u``.
     fn sample_reuse<'py>(
         &self,
         py: Python<'py>,
         u: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    ) -> PyResult<PyReusedSample> {
         with_precision!(u, F => {
             let u = Points::<F, 1>::extract(u, "u")?;
-            map2(py, &u, Check::Unit, |u| {
+            let (index, u) = map2(py, &u, Check::Unit, |u| {
                 let (i, r) = self.0.sample_reuse(u[0]);
                 ([i as i64], [r])
-            })
+            })?;
+            Ok(PyReusedSample { index: index.unbind(), u: u.unbind() })
         })
     }
 
@@ -286,18 +312,20 @@ impl PyDiscrete2D {
     ///
     /// Returns
     /// -------
-    /// (ndarray (N, 2) int64 (row, col), ndarray (N, 2) float of u's precision)
+    /// ReusedSample: ``.index`` ndarray (N, 2) int64 (row, col) and ``.u``
+    /// ndarray (N, 2) float of u's precision; unpacks as ``index, u``.
     fn sample_reuse<'py>(
         &self,
         py: Python<'py>,
         u: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    ) -> PyResult<PyReusedSample> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
-            map2(py, &u, Check::Unit, |u| {
+            let (index, u) = map2(py, &u, Check::Unit, |u| {
                 let ((r, c), v) = self.0.sample_reuse(u);
                 ([r as i64, c as i64], v)
-            })
+            })?;
+            Ok(PyReusedSample { index: index.unbind(), u: u.unbind() })
         })
     }
 
@@ -382,19 +410,17 @@ impl PyPiecewiseConstant1D {
     ///
     /// Returns
     /// -------
-    /// (x, pdf): ndarrays of shape (N,) in u's precision (scalars for a
-    /// scalar u); pdf per unit length.
-    fn sample<'py>(
-        &self,
-        py: Python<'py>,
-        u: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    /// PiecewiseSample: ``.x`` and ``.pdf``, ndarrays of shape (N,) in u's
+    /// precision (scalars for a scalar u), pdf per unit length; unpacks as
+    /// ``x, pdf``.
+    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<PyPiecewiseSample> {
         with_precision!(u, F => {
             let u = Points::<F, 1>::extract(u, "u")?;
-            map2(py, &u, Check::Unit, |u| {
+            let (x, pdf) = map2(py, &u, Check::Unit, |u| {
                 let (x, pdf) = self.0.sample(u[0]);
                 ([x], [pdf])
-            })
+            })?;
+            Ok(PyPiecewiseSample { x: x.unbind(), pdf: pdf.unbind() })
         })
     }
 
@@ -507,18 +533,16 @@ impl PyPiecewiseConstant2D {
     ///
     /// Returns
     /// -------
-    /// (xy (N, 2), pdf (N,)) in u's precision; pdf per unit area.
-    fn sample<'py>(
-        &self,
-        py: Python<'py>,
-        u: &Bound<'py, PyAny>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    /// PiecewiseSample: ``.x`` (N, 2) and ``.pdf`` (N,) in u's precision,
+    /// pdf per unit area; unpacks as ``x, pdf``.
+    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<PyPiecewiseSample> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
-            map2(py, &u, Check::Unit, |u| {
+            let (x, pdf) = map2(py, &u, Check::Unit, |u| {
                 let (p, pdf) = self.0.sample(u);
                 (p, [pdf])
-            })
+            })?;
+            Ok(PyPiecewiseSample { x: x.unbind(), pdf: pdf.unbind() })
         })
     }
 
@@ -590,5 +614,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyDiscrete2D>()?;
     m.add_class::<PyPiecewiseConstant1D>()?;
     m.add_class::<PyPiecewiseConstant2D>()?;
+    m.add_class::<PyPiecewiseSample>()?;
+    m.add_class::<PyReusedSample>()?;
     Ok(())
 }

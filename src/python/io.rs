@@ -109,6 +109,12 @@ pub fn write_png(
     exposure: f64,
     srgb: bool,
 ) -> PyResult<()> {
+    let (raster, exposure) = png_input(image, exposure)?;
+    detached(py, || io::write_png(&path, &raster, exposure, srgb))
+}
+
+/// The raster and exposure of a PNG to write, checked.
+fn png_input(image: &Bound<'_, PyAny>, exposure: f64) -> PyResult<(Raster, f32)> {
     if !exposure.is_finite() {
         return Err(Error::Parameter {
             arg: "exposure",
@@ -117,8 +123,7 @@ pub fn write_png(
         }
         .into());
     }
-    let raster = from_numpy(image)?;
-    detached(py, || io::write_png(&path, &raster, exposure as f32, srgb))
+    Ok((from_numpy(image)?, exposure as f32))
 }
 
 /// The PNG file :func:`write_png` writes, as bytes (for notebooks'
@@ -139,17 +144,9 @@ pub fn encode_png<'py>(
     exposure: f64,
     srgb: bool,
 ) -> PyResult<Bound<'py, PyBytes>> {
-    if !exposure.is_finite() {
-        return Err(Error::Parameter {
-            arg: "exposure",
-            value: exposure,
-            requirement: "must be finite",
-        }
-        .into());
-    }
-    let raster = from_numpy(image)?;
+    let (raster, exposure) = png_input(image, exposure)?;
     let bytes = detached(py, || {
-        io::encode_png(Path::new("image"), &raster, exposure as f32, srgb)
+        io::encode_png(Path::new("image"), &raster, exposure, srgb)
     })?;
     Ok(PyBytes::new(py, &bytes))
 }

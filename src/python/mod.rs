@@ -14,6 +14,7 @@ mod io;
 mod mis;
 mod parallel;
 mod phong;
+mod records;
 mod render;
 mod rng;
 mod warp;

@@ -10,6 +10,8 @@ use numpy::PyArrayMethods;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 
+use super::records::record;
+
 /// An RGB reflectance: a number (grey) or three numbers.
 fn rgb(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<[f64; 3]> {
     if let Ok(v) = ob.extract::<f64>() {
@@ -28,30 +30,19 @@ fn rgb(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<[f64; 3]> {
     })
 }
 
-/// Samples of ``Phong.sample``.
-#[pyclass(module = "mcsample._core", name = "PhongSample", frozen)]
-pub struct PyPhongSample {
-    /// Sampled directions, (N, 3) or (3,), local frame (normal +z).
-    #[pyo3(get)]
-    wo: Py<PyAny>,
-    /// Their densities per steradian (the mixture of both parts), (N,).
-    #[pyo3(get)]
-    pdf: Py<PyAny>,
-    /// f_r(wi, wo) cos(theta_o) / pdf per RGB channel, (N, 3); 0 below the
-    /// surface.
-    #[pyo3(get)]
-    weight: Py<PyAny>,
-    /// 0 where the diffuse part drew the sample, 1 for the glossy part,
-    /// (N,) int64.
-    #[pyo3(get)]
-    component: Py<PyAny>,
-}
-
-#[pymethods]
-impl PyPhongSample {
-    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        let shape = self.pdf.bind(py).getattr("shape")?;
-        Ok(format!("PhongSample(shape={shape})"))
+record! {
+    /// Samples of ``Phong.sample``.
+    PyPhongSample, "PhongSample", "mcsample._core", {
+        /// Sampled directions, (N, 3) or (3,), local frame (normal +z).
+        wo,
+        /// Their densities per steradian (the mixture of both parts), (N,).
+        pdf,
+        /// f_r(wi, wo) cos(theta_o) / pdf per RGB channel, (N, 3); 0 below
+        /// the surface.
+        weight,
+        /// 0 where the diffuse part drew the sample, 1 for the glossy part,
+        /// (N,) int64.
+        component,
     }
 }
 

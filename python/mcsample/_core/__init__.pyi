@@ -1,7 +1,7 @@
 """Type stub of mcsample's compiled core (``mcsample._core``)."""
 
 import os
-from typing import Any, Sequence, Union, final
+from typing import Any, Iterator, Sequence, Union, final
 
 import numpy as np
 from numpy.typing import ArrayLike, DTypeLike, NDArray
@@ -15,6 +15,11 @@ from . import warp as warp
 __version__: str
 
 _Shape = Union[None, int, Sequence[int]]
+#: Arrays in the input's precision (float32 or float64), or one such
+#: scalar for an unbatched input.
+_Floats = Union[NDArray[np.float64], NDArray[np.float32], np.float64, np.float32]
+#: int64 indices, an array or one scalar.
+_Ints = Union[NDArray[np.int64], np.int64]
 
 @final
 class Rng:
@@ -48,6 +53,30 @@ def get_num_threads() -> int:
 
 def _trigger_panic() -> None: ...
 
+class _Record:
+    def __len__(self) -> int: ...
+    def __getitem__(self, key: int, /) -> Any: ...
+    def __iter__(self) -> Iterator[Any]: ...
+    def __bool__(self) -> bool: ...
+
+@final
+class PiecewiseSample(_Record):
+    """Draws of a piecewise-constant density; unpacks as (x, pdf)."""
+
+    @property
+    def x(self) -> _Floats: ...
+    @property
+    def pdf(self) -> _Floats: ...
+
+@final
+class ReusedSample(_Record):
+    """Draws of Discrete1D / Discrete2D.sample_reuse; unpacks as (index, u)."""
+
+    @property
+    def index(self) -> _Ints: ...
+    @property
+    def u(self) -> _Floats: ...
+
 @final
 class Discrete1D:
     """Discrete distribution over 0..n-1 proportional to weights (CDF inversion)."""
@@ -55,8 +84,8 @@ class Discrete1D:
     def __new__(cls, weights: ArrayLike) -> Discrete1D: ...
     def sample(self, u: ArrayLike) -> Any:
         """Indices (N,) int64 for u (N,) in [0, 1]."""
-    def sample_reuse(self, u: ArrayLike) -> tuple[Any, Any]:
-        """(indices, u rescaled to [0, 1) within the chosen entry)."""
+    def sample_reuse(self, u: ArrayLike) -> ReusedSample:
+        """Indices and u rescaled to [0, 1) within the chosen entry."""
     def pmf(self, i: ArrayLike | None = None) -> Any:
         """w[i] / sum (all entries when i is None)."""
     @property
@@ -83,7 +112,7 @@ class Discrete2D:
     def __new__(cls, weights: ArrayLike) -> Discrete2D: ...
     def sample(self, u: ArrayLike) -> Any:
         """(N, 2) int64 (row, col): the row by u[:, 1], the column by u[:, 0]."""
-    def sample_reuse(self, u: ArrayLike) -> tuple[Any, Any]: ...
+    def sample_reuse(self, u: ArrayLike) -> ReusedSample: ...
     def pmf(self, idx: ArrayLike | None = None) -> Any: ...
     @property
     def shape(self) -> tuple[int, int]: ...
@@ -95,8 +124,8 @@ class PiecewiseConstant1D:
     """Piecewise-constant density on [a, b] (per unit length)."""
 
     def __new__(cls, values: ArrayLike, *, a: float = 0.0, b: float = 1.0) -> PiecewiseConstant1D: ...
-    def sample(self, u: ArrayLike) -> tuple[Any, Any]:
-        """(x, pdf)."""
+    def sample(self, u: ArrayLike) -> PiecewiseSample:
+        """Points x and their densities pdf; unpacks as (x, pdf)."""
     def pdf(self, x: ArrayLike) -> Any: ...
     def cdf(self, x: ArrayLike) -> Any: ...
     def invert(self, x: ArrayLike) -> Any: ...
@@ -113,8 +142,8 @@ class PiecewiseConstant2D:
     def __new__(cls, values: ArrayLike, *,
                 domain: tuple[tuple[float, float], tuple[float, float]] = ...,
                 ) -> PiecewiseConstant2D: ...
-    def sample(self, u: ArrayLike) -> tuple[Any, Any]:
-        """(xy (N, 2), pdf (N,))."""
+    def sample(self, u: ArrayLike) -> PiecewiseSample:
+        """Points x (N, 2) and pdf (N,); unpacks as (x, pdf)."""
     def pdf(self, xy: ArrayLike) -> Any: ...
     def invert(self, xy: ArrayLike) -> Any: ...
     @property
@@ -140,7 +169,7 @@ class Frame:
     def __len__(self) -> int: ...
 
 @final
-class PhongSample:
+class PhongSample(_Record):
     """Samples of Phong.sample."""
 
     @property
