@@ -248,6 +248,25 @@ fn pdfs_vanish_off_the_support() {
     assert_eq!(interval_to_power_pdf(1.5f64, 2.0), 0.0);
 }
 
+/// The support tests allow a few ulps of round-off past the edge (so that
+/// `u = 1` and rounded samples stay inside), and no more: a disk point 4 ε
+/// outside the rim, and a cone direction 4 ε below its cutoff, still have
+/// their density; 10⁻⁹ outside, none.
+#[test]
+fn support_edges_allow_a_few_ulps() {
+    let eps = f64::EPSILON;
+    assert!(square_to_uniform_disk_pdf([1.0 + 2.0 * eps, 0.0]) > 0.0);
+    assert_eq!(square_to_uniform_disk_pdf([1.0 + 1e-9, 0.0]), 0.0);
+    let c = 0.5;
+    let below = |t: f64| [(1.0 - (c - t) * (c - t)).sqrt(), 0.0, c - t];
+    assert!(square_to_uniform_cone_pdf(below(4.0 * eps), c) > 0.0);
+    assert_eq!(square_to_uniform_cone_pdf(below(1e-9), c), 0.0);
+    assert!(square_to_uniform_triangle_pdf([0.5 + 4.0 * eps, 0.5]) > 0.0);
+    assert_eq!(square_to_uniform_triangle_pdf([0.5 + 1e-9, 0.5]), 0.0);
+    // The triangle's vertex where the inverse would divide by 0.
+    assert_eq!(uniform_triangle_to_square([1.0f64, 0.0]), [1.0, 0.0]);
+}
+
 #[test]
 fn f32_agrees_with_f64() {
     for &a in &grid() {
