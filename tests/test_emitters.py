@@ -32,6 +32,10 @@ RECEIVERS = {
     "near": (0.05, 0.0, 0.1),
     "far": (2.0, -3.0, 1.5),
     "grazing": (1.2, 0.37, 0.4),
+    # Two more at random (fixed seed) within a few sizes of the light.
+    **{f"random {k}": tuple(np.random.default_rng(31 + k).uniform(-1.0, 1.0, 3) * [1.5, 1.0, 1.5]
+                             + [0.0, 0.4, 0.0] + [0.0, 0.7 * (-1) ** k, 0.0])
+       for k in range(2)},
 }
 
 N = 400_000

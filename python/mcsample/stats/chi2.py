@@ -136,10 +136,12 @@ def _jittered_pdf_integral(domain: Domain, pdf: Callable[[np.ndarray], Any],
     Carlo ([`_jittered_cells`], 16 passes), an unbiased estimate even where
     the density jumps inside a cell. Cells where the estimate's variance is
     not small next to the Poisson variance of the counts of `n` samples
-    (those a jump crosses), and cells estimated at 0 that `observed` counts
-    hold samples in (a sliver of support that no point met), are estimated
-    again, independently (so still without bias), with twice the strata per
-    axis, up to five times. Returns the estimates and their variances."""
+    (those a jump crosses), and cells whose `observed` count lies more than
+    4 standard deviations from the estimate (a sliver of high density that
+    few or no points met, so that the spread of the passes underrates the
+    error), are estimated again, independently (which keeps the estimate
+    unbiased whatever chose the cell), with twice the strata per axis, up
+    to five times. Returns the estimates and their variances."""
     nx, ny = shape
     counts = observed.reshape(-1)
     rng = np.random.default_rng(seed)
@@ -148,8 +150,10 @@ def _jittered_pdf_integral(domain: Domain, pdf: Callable[[np.ndarray], Any],
     k = int(ires)
     for _ in range(5):
         # Var of the expected count n·mean next to the count's own, n·mean.
+        expected = n * mean
         rough = np.flatnonzero((n * var > 0.02 * np.maximum(mean, 1.0 / n))
-                               | ((mean == 0) & (counts > 0)))
+                               | ((mean == 0) & (counts > 0))
+                               | ((counts - expected) ** 2 > 16 * (expected + n * n * var + 1)))
         if rough.size == 0:
             break
         k *= 2
