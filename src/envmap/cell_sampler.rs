@@ -1,11 +1,11 @@
 //! [`CellSampler`]: draws from an environment map's piecewise density in
 //! O(1), for renderers that take one light sample at a time.
 
-use super::{Distribution, EnvMap, EnvSample};
+use super::distribution::Distribution;
+use super::{EnvMap, EnvSample};
 use crate::distr::AliasTable;
 use crate::error::Result;
 use crate::math::Real;
-use crate::warp::V3;
 
 /// The density of [`EnvMap::sample`] (piecewise sampling), drawn in O(1):
 /// the table cell `(row, col)` by an [`AliasTable`] over the cells'
@@ -43,23 +43,25 @@ impl CellSampler {
         }))
     }
 
-    /// A direction of `env` (the map this sampler was built for), its
-    /// density per steradian and the radiance arriving along it (not
-    /// divided by the density, as a renderer's light sample wants it): the
-    /// cell from the 64 random bits `bits`, the point within it at
-    /// fractions `r` in `[0, 1)²` (along the table's x and y). Computed in
+    /// A direction of `env` (the map this sampler was built for) as an
+    /// [`EnvSample`]; its `radiance` is what a renderer's light sample
+    /// wants. The cell comes from the 64 random bits `bits`, the point
+    /// within it from the fractions `r` in `[0, 1)²` (along the table's x
+    /// and y); from there it is the path of [`EnvMap::sample`]. Computed in
     /// `F`: in `f32` the point stays in its cell, and the direction and
     /// density are good to a few `f32` ulps. (Given a map that is not
     /// sampled piecewise, it draws by [`EnvMap::sample`] of `r`.)
     #[inline]
-    pub fn sample<F: Real>(&self, env: &EnvMap, bits: u64, r: [F; 2]) -> (V3<F>, F, V3<F>) {
+    pub fn sample<F: Real>(&self, env: &EnvMap, bits: u64, r: [F; 2]) -> EnvSample<F> {
         let Distribution::Piecewise(table) = &env.distribution else {
-            let s: EnvSample<F> = env.sample(r.map(F::f64)).cast();
-            return (s.direction, s.pdf, s.radiance());
+            return env.sample(r.map(F::f64)).cast();
         };
+        debug_assert_eq!(
+            table.table().shape().1,
+            self.cols,
+            "a sampler of another map"
+        );
         let c = self.cells.sample_bits(bits);
-        let (p, pdf_q, corners) = env.place_in_cell(table, (c / self.cols, c % self.cols), r);
-        let [x, y, z, pdf, _] = env.frame_at(env.options.mapping, p, pdf_q);
-        ([x, y, z], pdf, env.radiance_of(&corners))
+        env.sample_at(&env.place_in_cell(table, (c / self.cols, c % self.cols), r))
     }
 }

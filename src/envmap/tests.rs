@@ -1,7 +1,10 @@
 //! Unit tests of the environment maps: sample / pdf agreement, densities
 //! that integrate to 1, support, modes and conversions.
 
+use super::batch::BATCH_BLOCK;
 use super::*;
+use crate::warp;
+use std::f64::consts::PI;
 
 /// A smooth map with a bright spot, `w × h` (cube: faces of `w`).
 fn test_image(mapping: Mapping, w: usize, h: usize) -> Vec<f32> {
@@ -106,6 +109,8 @@ fn samples_carry_their_own_pdf_and_weight() {
                 for k in (0..3).filter(|_| s.pdf > 0.0 && !seam) {
                     let diff = (s.weight[k] * s.pdf - l[k]).abs();
                     assert!(diff <= 1e-6 * l[k].max(1e-3), "{:?} {u:?}", m.options());
+                    let diff = (s.radiance[k] - l[k]).abs();
+                    assert!(diff <= 1e-6 * l[k].max(1e-3), "{:?} {u:?}", m.options());
                 }
             }
         }
@@ -114,7 +119,7 @@ fn samples_carry_their_own_pdf_and_weight() {
     }
 }
 
-/// `m.sample_into(us)` as samples.
+/// `m.sample_into(us)` as samples (radiance 0: a batch writes none).
 fn batch<F: Real>(m: &EnvMap, us: &[[F; 2]]) -> Vec<EnvSample<F>> {
     let n = us.len();
     let (mut direction, mut pdf, mut weight) = (
@@ -133,6 +138,7 @@ fn batch<F: Real>(m: &EnvMap, us: &[[F; 2]]) -> Vec<EnvSample<F>> {
             direction: direction[k],
             pdf: pdf[k],
             weight: weight[k],
+            radiance: [F::zero(); 3],
         })
         .collect()
 }
@@ -147,7 +153,11 @@ fn batch_sampling_agrees_with_single_draws() {
             .collect();
         let out = batch(&m, &us);
         for (&u, o) in us.iter().zip(&out) {
-            assert_eq!(*o, m.sample(u), "{:?}: u = {u:?}", m.options());
+            let s = EnvSample {
+                radiance: [0.0; 3],
+                ..m.sample(u)
+            };
+            assert_eq!(*o, s, "{:?}: u = {u:?}", m.options());
         }
         // In f32: the same directions and densities to f32 precision, away
         // from the poles and seams (where rounding u may pick a neighbour).
@@ -418,14 +428,16 @@ fn cell_sampler_draws_the_table_density() {
         for _ in 0..n {
             let bits = rng.next_u64();
             let r: [f64; 2] = [rng.next_float(), rng.next_float()];
-            let (direction, s_pdf, radiance) = cells.sample(&m, bits, r);
+            let s = cells.sample(&m, bits, r);
+            let (direction, s_pdf, radiance) = (s.direction, s.pdf, s.radiance);
             let pdf = m.pdf(direction);
             assert!((pdf - s_pdf).abs() <= 1e-9 * s_pdf, "{:?}", m.options());
             let l = m.eval(direction);
             for (a, l) in radiance.iter().zip(l) {
                 assert!((a - l).abs() <= 1e-9 * l.max(1e-3));
             }
-            let (d32, pdf32, _) = cells.sample(&m, bits, r.map(|x| x as f32));
+            let s32 = cells.sample(&m, bits, r.map(|x| x as f32));
+            let (d32, pdf32) = (s32.direction, s32.pdf);
             for (a, b) in d32.iter().zip(direction) {
                 assert!((f64::from(*a) - b).abs() < 1e-5);
             }

@@ -8,7 +8,7 @@ use super::accel::{Accel, Primitive};
 use super::camera::Camera;
 use super::shape::{Disk, Ray, Sphere, SurfacePoint, Triangle};
 use crate::distr::Discrete1D;
-use crate::envmap::{CellSampler, EnvMap};
+use crate::envmap::{CellSampler, EnvMap, EnvSample};
 use crate::error::{Error, Result};
 use crate::math::luminance;
 use crate::phong::Phong;
@@ -99,14 +99,19 @@ impl Environment {
     ) -> (Vec3A, f32, [f32; 3]) {
         match self {
             Environment::Map(env) => {
-                let (d, pdf, radiance) = match cells {
+                let s = match cells {
                     Some((cells, bits)) => cells.sample(env, bits, u),
                     None => {
                         let s = env.sample(u.map(f64::from)).cast::<f32>();
-                        (s.direction, s.pdf, s.radiance())
+                        // Radiance as weight · pdf in f32 rather than rounded
+                        // from f64, so that these renders keep their bits.
+                        EnvSample {
+                            radiance: s.weight.map(|w| w * s.pdf),
+                            ..s
+                        }
                     }
                 };
-                (Vec3A::from(d), pdf, radiance)
+                (Vec3A::from(s.direction), s.pdf, s.radiance)
             }
             Environment::Constant(l) => {
                 let d = warp::square_to_uniform_sphere(u);

@@ -1,0 +1,286 @@
+//! The batch pipelines of an [`EnvMap`]: `eval`, `pdf` and `sample` over
+//! many directions or numbers at once, in blocks whose steps run at SIMD
+//! width and whose table and texel reads are prefetched so that their
+//! cache misses overlap. Each computes what its one-at-a-time method does,
+//! with the same functions.
+
+use super::distribution::Distribution;
+use super::mapping::Mapping;
+use super::polar::TableFloat;
+use super::sample::{PdfQuery, Placed};
+use super::{EnvMap, EnvSample};
+use crate::distr::GROUP;
+use crate::math::Real;
+use crate::simd;
+use crate::warp::V3;
+
+#[cfg(doc)]
+use super::PolarTable;
+
+/// Directions per block of [`EnvMap::eval_into`] and [`EnvMap::pdf_into`].
+pub(super) const BATCH_BLOCK: usize = 256;
+
+/// `$run`, once per mapping with `$m` that mapping as a constant, so that
+/// each loop has its own formulas inlined (a match inside a loop would
+/// keep it from vectorising).
+macro_rules! per_mapping {
+    ($mapping:expr, |$m:ident| $run:expr) => {
+        match $mapping {
+            Mapping::LatLong => {
+                const $m: Mapping = Mapping::LatLong;
+                $run
+            }
+            Mapping::Angular => {
+                const $m: Mapping = Mapping::Angular;
+                $run
+            }
+            Mapping::Cube => {
+                const $m: Mapping = Mapping::Cube;
+                $run
+            }
+        }
+    };
+}
+
+/// The arrays a batch of [`EnvMap::sample_into`] writes: each sample's
+/// parts into their own array, as a caller's separate outputs want them.
+#[derive(Debug)]
+pub struct EnvSamples<'a, F> {
+    /// The directions.
+    pub direction: &'a mut [V3<F>],
+    /// Their densities per steradian.
+    pub pdf: &'a mut [F],
+    /// `L/pdf` per RGB channel.
+    pub weight: &'a mut [V3<F>],
+}
+
+impl<F: Copy> EnvSamples<'_, F> {
+    /// Writes sample `k`.
+    #[inline(always)]
+    fn set(&mut self, k: usize, s: EnvSample<F>) {
+        (self.direction[k], self.pdf[k], self.weight[k]) = (s.direction, s.pdf, s.weight);
+    }
+}
+
+impl EnvMap {
+    /// `out[i] = eval(d[i])` for a batch, in `F`: every direction's place on
+    /// the map by one loop (which vectorises for lat-long maps), then the
+    /// texel reads of the whole block, which overlap. Returns whether
+    /// `valid` held for every direction (it is checked in the same pass).
+    pub fn eval_into<F: Real>(
+        &self,
+        d: &[[F; 3]],
+        out: &mut [[F; 3]],
+        valid: impl Fn(&[F; 3]) -> bool,
+    ) -> bool {
+        per_mapping!(self.options.mapping, |M| {
+            let place = {
+                #[inline(always)]
+                |x: [F; 3]| self.uv_of(M, x)
+            };
+            self.eval_blocks(d, out, &place, valid)
+        })
+    }
+
+    /// [`EnvMap::eval_into`] with `place` the mapping's `from_dir`.
+    #[inline(always)]
+    fn eval_blocks<F: Real>(
+        &self,
+        d: &[[F; 3]],
+        out: &mut [[F; 3]],
+        place: &impl Fn([F; 3]) -> [F; 2],
+        valid: impl Fn(&[F; 3]) -> bool,
+    ) -> bool {
+        let mut ok = true;
+        let mut points = [[F::zero(); 2]; BATCH_BLOCK];
+        for (d, out) in d.chunks(BATCH_BLOCK).zip(out.chunks_mut(BATCH_BLOCK)) {
+            let points = &mut points[..d.len()];
+            ok &= simd::map_rows(points, d, place, &valid, false);
+            for (o, &p) in out.iter_mut().zip(points.iter()) {
+                *o = self.radiance_at(p);
+            }
+        }
+        ok
+    }
+
+    /// `out[i] = pdf(d[i])` for a batch, in `F`, in blocks of
+    /// `BATCH_BLOCK`: for polar tables, every direction's cell by the
+    /// branch-free [`PolarTable::query`] at full SIMD width and its density
+    /// prefetched, then the densities of the block before read (one block
+    /// behind, so that the reads wait on no cache miss); for the others
+    /// [`EnvMap::pdf_query`] then [`EnvMap::pdf_at`]. Returns whether
+    /// `valid` held for every direction (it is checked in the same pass).
+    pub fn pdf_into<F: TableFloat>(
+        &self,
+        d: &[[F; 3]],
+        out: &mut [F],
+        valid: impl Fn(&[F; 3]) -> bool,
+    ) -> bool {
+        let mut ok = true;
+        let blocks = out.chunks_mut(BATCH_BLOCK).zip(d.chunks(BATCH_BLOCK));
+        if let Some(table) = &self.polar {
+            // Two blocks in flight: each block's cells are located and their
+            // densities prefetched, then the densities of the block before
+            // are read (by now in the caches), so that the table reads
+            // overlap the next block's arithmetic instead of waiting on it.
+            let mut queries = [[[F::zero(); 3]; BATCH_BLOCK]; 2];
+            let mut cells = [[0usize; BATCH_BLOCK]; 2];
+            let densities = F::densities(table);
+            let query = {
+                #[inline(always)]
+                |x| table.query(x)
+            };
+            let read = {
+                #[inline(always)]
+                |o: &mut [F], q: &[[F; 3]; BATCH_BLOCK], c: &[usize; BATCH_BLOCK]| {
+                    for ((o, q), &c) in o.iter_mut().zip(q).zip(c) {
+                        *o = densities.get(c).copied().unwrap_or(F::zero()) * q[2];
+                    }
+                }
+            };
+            ok = simd::dispatch(
+                #[inline(always)]
+                |_| {
+                    let mut ok = true;
+                    let mut previous: Option<&mut [F]> = None;
+                    for (b, (o, x)) in blocks.enumerate() {
+                        let (q, c) = (&mut queries[b % 2], &mut cells[b % 2]);
+                        ok &= simd::map_rows(&mut q[..x.len()], x, &query, &valid, false);
+                        for (c, q) in c.iter_mut().zip(&q[..x.len()]) {
+                            *c = table.cell(*q);
+                            simd::prefetch(densities, *c);
+                        }
+                        if let Some(p) = previous.replace(o) {
+                            read(p, &queries[(b + 1) % 2], &cells[(b + 1) % 2]);
+                        }
+                    }
+                    if let Some(p) = previous {
+                        let last = d.len().div_ceil(BATCH_BLOCK) - 1;
+                        read(p, &queries[last % 2], &cells[last % 2]);
+                    }
+                    ok
+                },
+            );
+        } else {
+            let mut queries = [PdfQuery::default(); BATCH_BLOCK];
+            for (o, x) in blocks {
+                for (q, x) in queries.iter_mut().zip(x) {
+                    ok &= valid(x);
+                    *q = self.pdf_query(x.map(F::f64));
+                }
+                for (o, q) in o.iter_mut().zip(&queries) {
+                    *o = F::c(self.pdf_at(*q));
+                }
+            }
+        }
+        ok
+    }
+
+    /// `out[i] = sample(us[i])` for a batch, in groups: the table points by
+    /// the tables' batch samplers (whose cache misses overlap), then placed
+    /// on the map as [`EnvMap::sample`] places them and their texels
+    /// prefetched, the directions and densities of the group in one loop at
+    /// SIMD width, and last the radiance. Computed in `F` past the table
+    /// draw (whose searches run in `f64`; Mitsuba's bilinear density is
+    /// sampled in `f64` and rounded); in `f64`, the same bits as
+    /// [`EnvMap::sample`]. In `f32` a direction and its density are good to
+    /// a few ulps of `f32` (the density near a pole of a polar table to
+    /// about `10⁻⁷/sin θ`).
+    ///
+    /// # Panics
+    /// If an array of `out` is shorter than `us`.
+    pub fn sample_into<F: Real>(&self, us: &[[F; 2]], out: EnvSamples<'_, F>) {
+        self.sample_rows(us, |&u| u, out);
+    }
+
+    /// [`EnvMap::sample_into`] of `prepare(row)` for each of `rows`: the
+    /// numbers `u` of a group are made (checked, clamped) as the group is
+    /// drawn, in the same pass, so that a caller needs no pass of its own
+    /// over its input.
+    ///
+    /// # Panics
+    /// If an array of `out` is shorter than `rows`.
+    pub fn sample_rows<F: Real, R>(
+        &self,
+        rows: &[R],
+        prepare: impl FnMut(&R) -> [F; 2],
+        out: EnvSamples<'_, F>,
+    ) {
+        simd::dispatch(
+            #[inline(always)]
+            |_| self.sample_groups(rows, prepare, out),
+        )
+    }
+
+    /// The pipeline of [`EnvMap::sample_rows`], group by group: the draw
+    /// of [`EnvMap::sample_at`] in its two halves, the first for a whole
+    /// group at SIMD width.
+    #[inline(always)]
+    fn sample_groups<F: Real, R>(
+        &self,
+        rows: &[R],
+        mut prepare: impl FnMut(&R) -> [F; 2],
+        mut out: EnvSamples<'_, F>,
+    ) {
+        let zero = F::zero();
+        let mut cells = [((0, 0), [zero; 2]); GROUP];
+        let mut points = [[zero; 3]; GROUP];
+        let mut frames = [[zero; 5]; GROUP];
+        let mut corners = [([0; 4], [zero; 4]); GROUP];
+        let mut bilinear = [([0.0; 2], 0.0); GROUP];
+        let mut group = [[zero; 2]; GROUP];
+        let mapping = self.options.mapping;
+        for (g, rows) in rows.chunks(GROUP).enumerate() {
+            let n = rows.len();
+            let first = g * GROUP;
+            let us = &mut group[..n];
+            for (u, row) in us.iter_mut().zip(rows) {
+                *u = prepare(row);
+            }
+            let us = &*us;
+            // Each point's domain point and density, and its texels
+            // (prefetched).
+            let mut place = |k: usize, placed: Placed<F>| {
+                self.image.prefetch(&placed.corners);
+                let [s, t] = placed.point;
+                (points[k], corners[k]) = ([s, t, placed.pdf_q], placed.corners);
+            };
+            match &self.distribution {
+                Distribution::Piecewise(table) => {
+                    let cells = &mut cells[..n];
+                    table.table().sample_groups(us, cells);
+                    for (k, &(cell, r)) in cells.iter().enumerate() {
+                        place(k, self.place_in_cell(table, cell, r));
+                    }
+                }
+                Distribution::Bilinear(grid) => {
+                    let (u64s, b) = (&mut [[0.0; 2]; GROUP][..n], &mut bilinear[..n]);
+                    for (u, x) in u64s.iter_mut().zip(us) {
+                        *u = x.map(F::f64);
+                    }
+                    grid.sample_into(u64s, b);
+                    for (k, &(q, pdf)) in b.iter().enumerate() {
+                        place(k, self.place_at(q.map(F::c), F::c(pdf)));
+                    }
+                }
+                Distribution::Black => {
+                    for (k, &u) in (first..).zip(us) {
+                        out.set(k, self.sample_black(u.map(F::f64)).cast());
+                    }
+                    continue;
+                }
+            }
+            let (points, frames) = (&points[..n], &mut frames[..n]);
+            per_mapping!(mapping, |M| {
+                let frame = {
+                    #[inline(always)]
+                    |[s, t, pdf_q]: [F; 3]| self.frame_at(M, [s, t], pdf_q)
+                };
+                simd::map_rows(frames, points, &frame, |_| true, false)
+            });
+            for ((k, f), c) in (first..).zip(frames.iter()).zip(&corners) {
+                out.set(k, self.sample_from(f, c));
+            }
+        }
+    }
+}

@@ -1,0 +1,60 @@
+//! Resampling an [`EnvMap`] into another mapping or resolution, and where
+//! each texel of an image sits in its mapping's domain.
+
+use super::mapping::Mapping;
+use super::{EnvMap, Options, Sampling};
+use crate::error::Result;
+
+impl EnvMap {
+    /// The same light resampled into `mapping` at `width × height` texels
+    /// (cube maps: `height = 6·width`): every new texel takes the bilinear
+    /// value of this map in its direction. `to_world`, `scale` and
+    /// `compensate` are kept; the sampling mode too where the new mapping
+    /// has it (else [`Sampling::Piecewise`]).
+    ///
+    /// # Errors
+    /// As [`EnvMap::new`] for the new shape.
+    pub fn convert(&self, mapping: Mapping, width: usize, height: usize) -> Result<EnvMap> {
+        let mut data = Vec::with_capacity(width * height * 3);
+        for y in 0..height {
+            for x in 0..width {
+                let p = texel_centre(mapping, width, height, x, y);
+                let lit = mapping.jacobian(p) > 0.0 || mapping != Mapping::Angular;
+                let rgb = if lit {
+                    let d = mapping.to_dir(p);
+                    self.image
+                        .lookup(self.options.mapping, self.options.mapping.from_dir(d))
+                } else {
+                    [0.0; 3]
+                };
+                data.extend(rgb.map(|v| v as f32));
+            }
+        }
+        let sampling = if mapping == Mapping::LatLong {
+            self.options.sampling
+        } else {
+            Sampling::Piecewise
+        };
+        EnvMap::new(
+            width,
+            height,
+            &data,
+            Options {
+                mapping,
+                sampling,
+                ..self.options
+            },
+        )
+    }
+}
+
+/// Where texel `(x, y)` of a `width × height` image of `mapping` sits in
+/// the domain (lat-long rows on the poles and between; others centred).
+pub fn texel_centre(mapping: Mapping, width: usize, height: usize, x: usize, y: usize) -> [f64; 2] {
+    let s = (x as f64 + 0.5) / width as f64;
+    match mapping {
+        Mapping::LatLong => [s, y as f64 / (height.max(2) - 1) as f64],
+        Mapping::Angular => [s, (y as f64 + 0.5) / height as f64],
+        Mapping::Cube => [s, (y as f64 + 0.5) / width as f64],
+    }
+}
