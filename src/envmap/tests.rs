@@ -4,7 +4,6 @@
 use super::batch::BATCH_BLOCK;
 use super::*;
 use crate::warp;
-use std::f64::consts::PI;
 
 /// A smooth map with a bright spot, `w × h` (cube: faces of `w`).
 fn test_image(mapping: Mapping, w: usize, h: usize) -> Vec<f32> {
@@ -58,19 +57,10 @@ fn all_maps() -> Vec<EnvMap> {
     ]
 }
 
-/// ∫ f dω over the sphere by the midpoint rule in (φ, cos θ).
+/// ∫ f dω over the sphere by the midpoint rule in (φ, cos θ), with the
+/// poles on ±y (the lat-long map's).
 fn integrate(f: impl Fn(V3<f64>) -> f64) -> f64 {
-    let (nphi, nz) = (800, 800);
-    let mut total = 0.0;
-    for i in 0..nphi {
-        let phi = (i as f64 + 0.5) / nphi as f64 * 2.0 * PI;
-        for j in 0..nz {
-            let z = -1.0 + (j as f64 + 0.5) / nz as f64 * 2.0;
-            let r = (1.0 - z * z).sqrt();
-            total += f([r * phi.cos(), z, r * phi.sin()]);
-        }
-    }
-    total * 4.0 * PI / (nphi * nz) as f64
+    crate::quadrature::integrate_sphere(|[x, y, z]| f([x, z, y]), 800, 800)
 }
 
 #[test]

@@ -1,7 +1,7 @@
 """Stub of ``mcsample._core.render``: see ``mcsample.scene`` and
 ``mcsample.rendering`` for the docs."""
 
-from typing import Any, Callable, Sequence, final
+from typing import Callable, Literal, Sequence, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -23,7 +23,7 @@ class SceneBuilder:
                  emission: _RGB | None) -> None: ...
     def set_envmap(self, env: EnvMap) -> None: ...
     def set_constant(self, radiance: _RGB) -> None: ...
-    def set_camera(self, to_world: _Matrix, fov: float, fov_axis: str, width: int, height: int,
+    def set_camera(self, to_world: _Matrix, fov: float, fov_axis: Literal["x", "y", "diagonal", "smaller", "larger"], width: int, height: int,
                    near_clip: float, far_clip: float, aperture_radius: float,
                    focus_distance: float) -> None: ...
     def build(self) -> CompiledScene: ...
@@ -33,11 +33,12 @@ class CompiledScene:
     @property
     def film(self) -> tuple[int, int]: ...
     def sample_emitter(self, x: ArrayLike, u: ArrayLike) -> NDArray[np.float64]: ...
-    def emitter_pdf(self, x: ArrayLike, d: ArrayLike) -> Any: ...
+    def emitter_pdf(self, x: ArrayLike, d: ArrayLike) -> NDArray[np.float64] | float: ...
 
 def render(
-    scene: CompiledScene, spp: int, seed: int | np.random.Generator | None, integrator: str,
-    strategy: str, heuristic: str,
+    scene: CompiledScene, spp: int, seed: int | np.random.Generator | None,
+    integrator: Literal["direct", "path"], strategy: Literal["bsdf", "emitter", "mis"],
+    heuristic: Literal["balance", "power"],
     max_depth: int, rr_depth: int, hide_emitters: bool = False,
     callback: Callable[[int], object] | None = None,
 ) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32]]: ...

@@ -7,12 +7,15 @@ use super::args::index_arg;
 use super::arrays::{Check, Points, PyFloat, finish, output, with_precision, writable};
 use super::batch::{map, map_each};
 use super::parallel::{detached, run_batch};
+use super::records::record;
 use crate::envmap::{EnvMap, EnvSamples, Mapping, Options, TableFloat};
 use crate::error::Error;
+use crate::io::Raster;
 use input::{image_arg, mapping_arg, read_image, settings};
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
+use pyo3::types::PyBytes;
 use std::path::PathBuf;
 
 /// A float type the envmap bindings compute in: a [`PyFloat`] whose
@@ -20,25 +23,15 @@ use std::path::PathBuf;
 trait EnvFloat: PyFloat + TableFloat {}
 impl<F: PyFloat + TableFloat> EnvFloat for F {}
 
-/// Samples of ``EnvMap.sample``.
-#[pyclass(module = "mcsample._core", name = "EnvSample", frozen)]
-pub struct PyEnvSample {
-    /// World directions toward the environment, (N, 3) or (3,), unit.
-    #[pyo3(get)]
-    direction: Py<PyAny>,
-    /// Their densities per steradian, (N,).
-    #[pyo3(get)]
-    pdf: Py<PyAny>,
-    /// Radiance / pdf per RGB channel, (N, 3); 0 where pdf = 0.
-    #[pyo3(get)]
-    weight: Py<PyAny>,
-}
-
-#[pymethods]
-impl PyEnvSample {
-    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
-        let shape = self.pdf.bind(py).getattr("shape")?;
-        Ok(format!("EnvSample(shape={shape})"))
+record! {
+    /// Samples of ``EnvMap.sample``.
+    PyEnvSample, "EnvSample", "mcsample._core", {
+        /// World directions toward the environment, (N, 3) or (3,), unit.
+        direction,
+        /// Their densities per steradian, (N,).
+        pdf,
+        /// Radiance / pdf per RGB channel, (N, 3); 0 where pdf = 0.
+        weight,
     }
 }
 
@@ -480,6 +473,43 @@ impl PyEnvMap {
         Ok(PyArray1::from_vec(py, m.concat())
             .reshape([3, 3])?
             .into_any())
+    }
+
+    /// The map as a PNG (tone-mapped as ``io.write_png``: clamped, sRGB),
+    /// for notebooks: lat-long and angular maps as they are stored, the six
+    /// faces of a cube map side by side (+x, -x, +y, -y, +z, -z).
+    fn _repr_png_<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let img = self.0.image();
+        let (w, h) = (img.width(), img.height());
+        let scale = self.0.options().scale as f32;
+        let texels = img.texels();
+        let raster = if self.0.options().mapping == Mapping::Cube {
+            // Face f's row y, texel x sits at column f w + x of row y.
+            let mut data = vec![0.0f32; 6 * w * w * 3];
+            for (k, t) in texels.iter().enumerate() {
+                let (f, y, x) = (k / (w * w), (k / w) % w, k % w);
+                let at = 3 * (y * 6 * w + f * w + x);
+                data[at..at + 3].copy_from_slice(&t.map(|v| v * scale));
+            }
+            Raster {
+                width: 6 * w,
+                height: w,
+                channels: 3,
+                data,
+            }
+        } else {
+            let data = texels.iter().flat_map(|t| t.map(|v| v * scale)).collect();
+            Raster {
+                width: w,
+                height: h,
+                channels: 3,
+                data,
+            }
+        };
+        let png = detached(py, || {
+            crate::io::encode_png(std::path::Path::new("EnvMap"), &raster, 0.0, true)
+        })?;
+        Ok(PyBytes::new(py, &png))
     }
 
     fn __repr__(&self) -> String {
