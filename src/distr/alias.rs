@@ -1,7 +1,7 @@
 //! [`AliasTable`]: O(1) sampling of a discrete distribution (Walker's alias
 //! method, built block by block in parallel).
 
-use super::{GROUP, all_weights, check_len, find_invalid};
+use super::{GROUP, Weights, all_weights, check_len, find_invalid};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
@@ -76,9 +76,9 @@ pub struct AliasTable {
     /// fraction of `u·n` past `c`, in 32-bit fixed point, is below the
     /// threshold, else returns the alias. A full cell is its own alias.
     cells: Buffer<[u32; 2]>,
-    /// The weights as given: `pmf(i) = w_i / Σw`, computed when asked.
-    weights: Buffer<f64>,
-    sum: f64,
+    /// The weights as given and their sum: `pmf(i) = w_i / Σw`, computed
+    /// when asked (`len`, `sum`, `pmf`, ... by dereference).
+    weights: Weights,
 }
 
 /// The cell of entry `index` that keeps it with probability `keep` and
@@ -441,29 +441,8 @@ impl AliasTable {
         }
         Ok(AliasTable {
             cells,
-            weights: copy,
-            sum,
+            weights: Weights::new(copy, sum),
         })
-    }
-
-    /// Number of entries.
-    pub fn len(&self) -> usize {
-        self.weights.len()
-    }
-
-    /// Whether the table has no entries (never true for a built table).
-    pub fn is_empty(&self) -> bool {
-        self.weights.is_empty()
-    }
-
-    /// The sum of the weights.
-    pub fn sum(&self) -> f64 {
-        self.sum
-    }
-
-    /// Probability of index `i`: `w_i / Σw` (0 outside the table).
-    pub fn pmf(&self, i: usize) -> f64 {
-        self.weights.get(i).map_or(0.0, |&w| w / self.sum)
     }
 
     /// The cell of `u` and the fraction of `u·n` past it, in 32-bit fixed
@@ -518,6 +497,14 @@ impl AliasTable {
                 *o = I::from(self.answer(c, fraction));
             }
         }
+    }
+}
+
+impl std::ops::Deref for AliasTable {
+    type Target = Weights;
+
+    fn deref(&self) -> &Weights {
+        &self.weights
     }
 }
 

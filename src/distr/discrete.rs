@@ -1,7 +1,7 @@
 //! [`Discrete1D`]: a discrete distribution sampled by inverting its CDF.
 
 use super::search::{Search, fill_guide, guide_len, positive_range, sum_into};
-use super::{GROUP, check_len, find_invalid};
+use super::{GROUP, Weights, check_len, find_invalid};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
@@ -34,9 +34,10 @@ const SUM_BLOCK: usize = 1 << 16;
 /// distribution", AIIE Transactions 6(2), 1974.
 #[derive(Clone, Debug)]
 pub struct Discrete1D {
-    weights: Buffer<f64>,
+    /// The weights as given and their sum (`len`, `sum`, `pmf`, ... by
+    /// dereference).
+    weights: Weights,
     cdf: Buffer<f64>,
-    sum: f64,
     first: usize,
     last: usize,
     /// `guide[k]`: the first index whose running sum reaches `k/G · Σw`,
@@ -104,44 +105,13 @@ impl Discrete1D {
         let mut guide = Buffer::for_overwrite(guide_len(weights.len()));
         fill_guide(&cdf, acc, (first, last), &mut guide);
         let table = Discrete1D {
-            weights: copy,
+            weights: Weights::new(copy, acc),
             cdf,
-            sum: acc,
             first,
             last,
             guide,
         };
         (Some(table), valid)
-    }
-
-    /// Number of entries.
-    pub fn len(&self) -> usize {
-        self.weights.len()
-    }
-
-    /// Whether the table has no entries (never true for a built table).
-    pub fn is_empty(&self) -> bool {
-        self.weights.is_empty()
-    }
-
-    /// The sum of the weights (the normalisation constant).
-    pub fn sum(&self) -> f64 {
-        self.sum
-    }
-
-    /// The weight of entry `i` as given (0 outside the table).
-    pub fn weight(&self, i: usize) -> f64 {
-        self.weights.get(i).copied().unwrap_or(0.0)
-    }
-
-    /// The weights as given.
-    pub fn weights(&self) -> &[f64] {
-        &self.weights
-    }
-
-    /// Probability of index `i`: `w_i / Σw` (0 outside the table).
-    pub fn pmf(&self, i: usize) -> f64 {
-        self.weight(i) / self.sum
     }
 
     /// Running sum of the weights before entry `i`: `C_{i−1}` (0 for i = 0).
@@ -151,7 +121,7 @@ impl Discrete1D {
 
     /// Cumulative probability `P(index ≤ i) = C_i / Σw` (1 past the end).
     pub fn cdf(&self, i: usize) -> f64 {
-        self.cdf.get(i).map_or(1.0, |&c| c / self.sum)
+        self.cdf.get(i).map_or(1.0, |&c| c / self.sum())
     }
 
     /// The index `i` with `C_{i−1} < u·Σw ≤ C_i`, among entries of positive
@@ -194,9 +164,17 @@ impl Discrete1D {
     #[inline(always)]
     pub(crate) fn search(&self) -> Search<'_> {
         Search::new(
-            (&self.weights, &self.cdf, &self.guide),
-            (self.sum, self.first, self.last),
+            (self.weights.weights(), &self.cdf, &self.guide),
+            (self.sum(), self.first, self.last),
         )
+    }
+}
+
+impl std::ops::Deref for Discrete1D {
+    type Target = Weights;
+
+    fn deref(&self) -> &Weights {
+        &self.weights
     }
 }
 
@@ -208,7 +186,7 @@ mod tests {
     /// The reference: a linear scan for `C_{i−1} < u·Σw ≤ C_i` over the
     /// entries of positive weight.
     fn linear(table: &Discrete1D, u: f64) -> usize {
-        let value = u * table.sum;
+        let value = u * table.sum();
         (table.first..=table.last)
             .find(|&i| table.cdf[i] >= value)
             .unwrap_or(table.last)
@@ -269,7 +247,7 @@ mod tests {
         }
         // Exactly on every running sum.
         for i in 0..n {
-            let u = d.cdf[i] / d.sum;
+            let u = d.cdf[i] / d.sum();
             assert_eq!(d.sample(u), linear(&d, u), "u = C_{i}");
         }
     }
@@ -330,7 +308,7 @@ mod tests {
             .iter()
             .map(|&g| (g + 1).min(d.last as u32))
             .collect();
-        let search = Search::new((&d.weights, &d.cdf, &late), (d.sum, d.first, d.last));
+        let search = Search::new((d.weights(), &d.cdf, &late), (d.sum(), d.first, d.last));
         for k in 0..=4000 {
             let u = k as f64 / 4000.0;
             assert_eq!(

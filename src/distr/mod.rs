@@ -18,11 +18,13 @@ mod discrete;
 mod discrete2d;
 mod piecewise;
 mod search;
+mod weights;
 
 pub use alias::AliasTable;
 pub use discrete::Discrete1D;
 pub use discrete2d::Discrete2D;
 pub use piecewise::{PiecewiseConstant1D, PiecewiseConstant2D};
+pub use weights::Weights;
 
 use crate::error::{Error, Result};
 use crate::parallel;

@@ -8,7 +8,6 @@ use super::batch::{map, map_chunks, map_indices, map2};
 use super::parallel::detached;
 use super::records::record;
 use crate::distr;
-use crate::math::Real;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
@@ -21,63 +20,85 @@ fn per_index<'py>(
     PyArray1::from_iter(py, (0..n).map(f))
 }
 
-/// What the two 1D index tables share, for the method bodies they share.
-trait IndexTable: Sync {
-    fn size(&self) -> usize;
-    fn probability(&self, i: usize) -> f64;
-    /// `out[i]`: the index drawn for `us[i]`, for a batch.
-    fn draw_into<F: Real>(&self, us: &[F], out: &mut [i64]);
-}
+/// The Python methods of a 1D index table (`Discrete1D`, `AliasTable`):
+/// the constructor, ``sample``, ``pmf``, ``sum``, ``len`` and the repr,
+/// and the table's own methods given in `{ ... }`.
+macro_rules! index_table_methods {
+    ($py_type:ident, $table:ty, $name:literal, { $($extra:tt)* }) => {
+        #[pymethods]
+        impl $py_type {
+            #[new]
+            fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
+                let w = Table::extract(weights, "weights", 1)?;
+                let w = w.values();
+                Ok(Self(detached(py, || <$table>::new(w))?))
+            }
 
-impl IndexTable for distr::Discrete1D {
-    fn size(&self) -> usize {
-        self.len()
-    }
-    fn probability(&self, i: usize) -> f64 {
-        self.pmf(i)
-    }
-    fn draw_into<F: Real>(&self, us: &[F], out: &mut [i64]) {
-        self.sample_into(us, out);
-    }
-}
+            /// Indices drawn from the distribution.
+            ///
+            /// Parameters
+            /// ----------
+            /// u : float or array_like, shape (N,), values in [0, 1]
+            ///
+            /// Returns
+            /// -------
+            /// ndarray, shape (N,) int64 (a scalar for a scalar u).
+            fn sample<'py>(
+                &self,
+                py: Python<'py>,
+                u: &Bound<'py, PyAny>,
+            ) -> PyResult<Bound<'py, PyAny>> {
+                with_precision!(u, F => {
+                    let u = Points::<F, 1>::extract(u, "u")?;
+                    map_chunks(py, &u, Check::Unit, |u, out: &mut [i64]| {
+                        self.0.sample_into(u.as_flattened(), out)
+                    })
+                })
+            }
 
-impl IndexTable for distr::AliasTable {
-    fn size(&self) -> usize {
-        self.len()
-    }
-    fn probability(&self, i: usize) -> f64 {
-        self.pmf(i)
-    }
-    fn draw_into<F: Real>(&self, us: &[F], out: &mut [i64]) {
-        self.sample_into(us, out);
-    }
-}
+            /// Probabilities w[i] / sum of the indices ``i`` (all n when
+            /// omitted).
+            ///
+            /// Parameters
+            /// ----------
+            /// i : int or array_like of int, shape (N,), optional
+            ///
+            /// Returns
+            /// -------
+            /// ndarray, shape (N,) float64 (a scalar for a scalar i).
+            #[pyo3(signature = (i = None))]
+            fn pmf<'py>(
+                &self,
+                py: Python<'py>,
+                i: Option<&Bound<'py, PyAny>>,
+            ) -> PyResult<Bound<'py, PyAny>> {
+                let table = &self.0;
+                match i {
+                    None => Ok(per_index(py, table.len(), |k| table.pmf(k)).into_any()),
+                    Some(i) => {
+                        let i = Indices::<1>::extract(i, "i", [table.len()])?;
+                        map_indices(py, &i, |[k]| table.pmf(k))
+                    }
+                }
+            }
 
-/// Indices drawn from `table` for every u (int64, (N,) or a scalar).
-fn sample_indices<'py>(
-    table: &impl IndexTable,
-    py: Python<'py>,
-    u: &Bound<'py, PyAny>,
-) -> PyResult<Bound<'py, PyAny>> {
-    with_precision!(u, F => {
-        let u = Points::<F, 1>::extract(u, "u")?;
-        map_chunks(py, &u, Check::Unit, |u, out| table.draw_into(u.as_flattened(), out))
-    })
-}
+            /// The sum of the weights (the normalisation constant).
+            #[getter]
+            fn sum(&self) -> f64 {
+                self.0.sum()
+            }
 
-/// Probabilities of the indices `i` (all of them when `None`).
-fn pmf_of<'py>(
-    table: &impl IndexTable,
-    py: Python<'py>,
-    i: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyAny>> {
-    match i {
-        None => Ok(per_index(py, table.size(), |k| table.probability(k)).into_any()),
-        Some(i) => {
-            let i = Indices::<1>::extract(i, "i", [table.size()])?;
-            map_indices(py, &i, |[k]| table.probability(k))
+            fn __len__(&self) -> usize {
+                self.0.len()
+            }
+
+            fn __repr__(&self) -> String {
+                format!(concat!($name, "(n={}, sum={})"), self.0.len(), self.0.sum())
+            }
+
+            $($extra)*
         }
-    }
+    };
 }
 
 record! {
@@ -119,28 +140,7 @@ record! {
 #[pyclass(module = "mcsample._core", name = "Discrete1D", frozen)]
 pub struct PyDiscrete1D(distr::Discrete1D);
 
-#[pymethods]
-impl PyDiscrete1D {
-    #[new]
-    fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let w = Table::extract(weights, "weights", 1)?;
-        let w = w.values();
-        Ok(Self(detached(py, || distr::Discrete1D::new(w))?))
-    }
-
-    /// Indices drawn from the distribution.
-    ///
-    /// Parameters
-    /// ----------
-    /// u : float or array_like, shape (N,), values in [0, 1]
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) int64 (a scalar for a scalar u).
-    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        sample_indices(&self.0, py, u)
-    }
-
+index_table_methods!(PyDiscrete1D, distr::Discrete1D, "Discrete1D", {
     /// Indices as ``sample``, and u rescaled within the chosen entry's share
     /// to [0, 1): (u * sum - C[i-1]) / w[i], a fresh uniform number.
     ///
@@ -163,44 +163,12 @@ impl PyDiscrete1D {
         })
     }
 
-    /// Probabilities w[i] / sum of the indices ``i`` (all n when omitted).
-    ///
-    /// Parameters
-    /// ----------
-    /// i : int or array_like of int, shape (N,), optional
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) float64 (a scalar for a scalar i).
-    #[pyo3(signature = (i = None))]
-    fn pmf<'py>(
-        &self,
-        py: Python<'py>,
-        i: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        pmf_of(&self.0, py, i)
-    }
-
     /// The normalised CDF, shape (n,): P(index <= i); the last entry is 1.
     #[getter]
     fn cdf<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         per_index(py, self.0.len(), |k| self.0.cdf(k))
     }
-
-    /// The sum of the weights (the normalisation constant).
-    #[getter]
-    fn sum(&self) -> f64 {
-        self.0.sum()
-    }
-
-    fn __len__(&self) -> usize {
-        self.0.len()
-    }
-
-    fn __repr__(&self) -> String {
-        format!("Discrete1D(n={}, sum={})", self.0.len(), self.0.sum())
-    }
-}
+});
 
 /// An alias table (Walker's method, built by a parallel sweep): O(1)
 /// sampling over 0..n-1 proportional to ``weights``, with one uniform number
@@ -217,52 +185,7 @@ impl PyDiscrete1D {
 #[pyclass(module = "mcsample._core", name = "AliasTable", frozen)]
 pub struct PyAliasTable(distr::AliasTable);
 
-#[pymethods]
-impl PyAliasTable {
-    #[new]
-    fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let w = Table::extract(weights, "weights", 1)?;
-        let w = w.values();
-        Ok(Self(detached(py, || distr::AliasTable::new(w))?))
-    }
-
-    /// Indices drawn from the distribution.
-    ///
-    /// Parameters
-    /// ----------
-    /// u : float or array_like, shape (N,), values in [0, 1]
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) int64 (a scalar for a scalar u).
-    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        sample_indices(&self.0, py, u)
-    }
-
-    /// Probabilities w[i] / sum of the indices ``i`` (all n when omitted).
-    #[pyo3(signature = (i = None))]
-    fn pmf<'py>(
-        &self,
-        py: Python<'py>,
-        i: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        pmf_of(&self.0, py, i)
-    }
-
-    /// The sum of the weights.
-    #[getter]
-    fn sum(&self) -> f64 {
-        self.0.sum()
-    }
-
-    fn __len__(&self) -> usize {
-        self.0.len()
-    }
-
-    fn __repr__(&self) -> String {
-        format!("AliasTable(n={}, sum={})", self.0.len(), self.0.sum())
-    }
-}
+index_table_methods!(PyAliasTable, distr::AliasTable, "AliasTable", {});
 
 /// A discrete distribution over the cells (row, col) of a table,
 /// proportional to ``weights``: a row from the marginal (row sums) by
