@@ -131,3 +131,19 @@ def test_mis_beats_each_strategy_on_glossy_spheres_under_the_sun(mi):
     print("relMSE at 64 spp:", {k: f"{v:.4g}" for k, v in errors.items()})
     assert errors["mis"] < errors["bsdf"]
     assert errors["mis"] < errors["emitter"]
+
+
+def test_reference_renders_leave_the_callers_variant_set(mi):
+    """render_reference picks its own variant and sets the caller's back,
+    also when Mitsuba raises on the way."""
+    scene = mcs.Scene.from_mitsuba(diffuse_sphere_under_sky())
+    before = mi.variant()
+    try:
+        mi.set_variant("scalar_rgb")
+        mcs.mitsuba.render_reference(scene, 2, variant=before)
+        assert mi.variant() == "scalar_rgb"
+        with pytest.raises(ValueError):
+            mcs.mitsuba.render_reference(scene, 2, integrator="volpath", variant=before)
+        assert mi.variant() == "scalar_rgb"
+    finally:
+        mi.set_variant(before)
