@@ -94,3 +94,30 @@ fn check_weights(
     }
     find_invalid(arg, weights, index)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The size limit, checked without allocating a table of 2³² entries.
+    #[test]
+    fn tables_may_have_at_most_max_entries() {
+        assert!(check_len("weights", MAX_ENTRIES).is_ok());
+        let e = check_len("weights", MAX_ENTRIES + 1).unwrap_err();
+        assert!(matches!(e, Error::TooLarge { len, .. } if len == MAX_ENTRIES + 1));
+        assert!(check_len("weights", 0).is_ok());
+    }
+
+    /// The one-pass check agrees with the search for the culprit: it fails
+    /// exactly when some entry is negative, NaN or infinite.
+    #[test]
+    fn the_fast_weight_check_finds_every_bad_weight() {
+        assert!(all_weights(&[0.0, 1.0, f64::MAX]));
+        for bad in [-1.0, f64::NAN, f64::INFINITY, -0.5e-300] {
+            let w = [1.0, 2.0, bad, 3.0];
+            assert!(!all_weights(&w), "{bad}");
+            assert!(check_weights("w", &w, |i| format!("[{i}]")).is_err());
+        }
+        assert!(check_weights("w", &[1.0, 0.0], |i| format!("[{i}]")).is_ok());
+    }
+}
