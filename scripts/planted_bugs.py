@@ -1,8 +1,9 @@
 """Planted-bug campaign: how many realistic mistakes does the test suite catch?
 
-Each planted bug is a small, realistic mistake in the Rust core (a dropped
-cosine, a density off by a constant, a swapped argument, an off-by-one), with
-the tests that should catch it. For every bug the campaign
+Each planted bug (the catalogue is ``planted_bugs.toml``) is a small,
+realistic mistake in the Rust core (a dropped cosine, a density off by a
+constant, a swapped argument, an off-by-one), with the tests that should
+catch it. For every bug the campaign
 
 1. applies it to a scratch worktree of HEAD (``git worktree add --detach``,
    made once and reset between bugs);
@@ -55,6 +56,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import tomllib
 from collections import Counter
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -65,6 +67,7 @@ REPO = Path(__file__).resolve().parent.parent
 VENV = Path("/tmp/planted-venv")
 TARGET_DIR = Path("/tmp/planted-target")
 LOG_DIR = Path("/tmp/planted-logs")
+CATALOGUE = REPO / "scripts" / "planted_bugs.toml"
 DEFAULT_TIMEOUT_MINUTES = 20.0
 
 #: The fewest bugs each module must have (see ``--check``).
@@ -95,261 +98,16 @@ class Bug:
         return Path(Path(self.path).parts[1]).stem
 
 
-def plant(id: str, description: str, path: str, *edits: tuple[str, str],
-          cargo: tuple[str, ...] = (), pytest: tuple[str, ...] = ()) -> Bug:
-    return Bug(id, description, path, edits, cargo, pytest)
+def load_bugs(path: Path) -> list[Bug]:
+    """The catalogue: one ``[[bug]]`` table per bug, fields as in ``Bug``."""
+    with path.open("rb") as f:
+        tables = tomllib.load(f)["bug"]
+    return [Bug(t["id"], t["description"], t["path"],
+                tuple((old, new) for old, new in t["edits"]),
+                tuple(t.get("cargo", ())), tuple(t.get("pytest", ()))) for t in tables]
 
 
-INTEGRATOR = "src/render/integrator.rs"
-SCENE = "src/render/scene.rs"
-SPHERE = "src/render/shape/sphere.rs"
-DISK = "src/render/shape/disk.rs"
-TRIANGLE = "src/render/shape/triangle.rs"
-RENDER = ("render::",)
-AREA_LIGHTS = "test_vs_mitsuba_area_lights.py"
-FURNACE = "test_render.py::test_white_furnace"
-
-SHADOW_RAY_BETWEEN_OFFSET_POINTS = (
-    "Some(y) => {\n"
-    "            let to = offset(y.p, y.ng, -ls.d) - o;\n"
-    "            let tmax = to.length();\n"
-    "            Ray {\n"
-    "                o,\n"
-    "                d: if tmax > 0.0 { to / tmax } else { ls.d },\n"
-    "                tmax,\n"
-    "            }\n"
-    "        }"
-)
-SHADOW_RAY_BEFORE_ISSUE_31 = (
-    "Some(_) => Ray {\n"
-    "            o,\n"
-    "            d: ls.d,\n"
-    "            tmax: ls.d.dot(p + ls.d * ls.dist - o) * (1.0 - 1e-4),\n"
-    "        },"
-)
-
-RENDER_BUGS = [
-    plant("shadow-ray-issue-31",
-          "shadow ray keeps ls.d from the moved origin, tmax = d.(p + d dist - o)(1 - 1e-4): "
-          "the bias of issue 31",
-          INTEGRATOR,
-          (SHADOW_RAY_BETWEEN_OFFSET_POINTS, SHADOW_RAY_BEFORE_ISSUE_31),
-          cargo=RENDER, pytest=(f"{AREA_LIGHTS} -k 'not bsdf'",)),
-    plant("nee-drops-receiver-cosine",
-          "next-event estimation drops the cosine at the receiver (|wo.z|)",
-          INTEGRATOR,
-          ("let s = w * wo[2].abs() / ls.pdf;", "let s = w / ls.pdf;"),
-          cargo=RENDER, pytest=(FURNACE,)),
-    plant("light-pdf-dist-not-squared",
-          "sample_light turns the area density into solid angle with dist, not dist^2",
-          SCENE,
-          ("cone_pdf.unwrap_or(dist * dist / (cos * total_area))",
-           "cone_pdf.unwrap_or(dist / (cos * total_area))"),
-          cargo=RENDER, pytest=("test_emitters.py",)),
-    plant("light-pdf-off-by-3-percent",
-          "sample_light reports the area light's density 3 % too high",
-          SCENE,
-          ("pdf: pmf * pdf,", "pdf: pmf * pdf * 1.03,"),
-          cargo=RENDER, pytest=("test_emitters.py",)),
-    plant("light-sampling-two-sided",
-          "sample_light takes |cos| at the light: back faces are sampled as if they emitted",
-          SCENE,
-          ("let cos = -y.ng.dot(d);", "let cos = y.ng.dot(d).abs();"),
-          cargo=RENDER, pytest=("test_emitters.py",)),
-    plant("mis-weight-missing-on-bsdf-emission",
-          "emission found by BSDF sampling gets weight 1 under MIS (emission_weight)",
-          INTEGRATOR,
-          ("Strategy::Mis => settings.weight(bsdf_pdf, light_pdf()),", "Strategy::Mis => 1.0,"),
-          cargo=RENDER, pytest=(f"{AREA_LIGHTS} -k mis",)),
-    plant("mis-weight-missing-on-nee",
-          "next-event estimation gets weight 1 under MIS",
-          INTEGRATOR,
-          ("settings.weight(ls.pdf, pdf_wo)", "1.0"),
-          cargo=RENDER, pytest=(FURNACE,)),
-    plant("rr-survivors-not-divided-by-q",
-          "Russian roulette: survivors are not divided by their probability q",
-          INTEGRATOR,
-          ("            beta = beta.map(|b| b / q);\n", ""),
-          cargo=RENDER, pytest=(f"{AREA_LIGHTS} -k room",)),
-    plant("max-depth-off-by-one",
-          "paths get one segment more than max_depth (depth + 1 > max_depth)",
-          INTEGRATOR,
-          ("if depth + 1 >= max_depth {", "if depth + 1 > max_depth {"),
-          cargo=RENDER,
-          pytest=("test_render.py::test_camera_matches_mitsubas", f"{AREA_LIGHTS} -k room")),
-    plant("sphere-cone-density-4pi",
-          "uniform_cone_density is 1/(4 pi (1 - cos max)) instead of 1/(2 pi (1 - cos max))",
-          SPHERE,
-          ("(1.0 / (2.0 * std::f64::consts::PI * one_minus_cos_max)) as f32",
-           "(1.0 / (4.0 * std::f64::consts::PI * one_minus_cos_max)) as f32"),
-          cargo=RENDER, pytest=("test_emitters.py -k sphere",)),
-    plant("sphere-cone-sample-not-uniform",
-          "Sphere::sample_cone draws 1 - cos theta from u0^2, not u0: not uniform in the cone",
-          SPHERE,
-          ("let omc = f64::from(u[0]) * one_minus_cos_max;",
-           "let omc = f64::from(u[0]) * f64::from(u[0]) * one_minus_cos_max;"),
-          cargo=RENDER, pytest=("test_emitters.py -k sphere",)),
-    plant("disk-area-non-uniform-scale",
-          "Disk::new takes the area pi |Mx|^2, wrong under non-uniform scale",
-          DISK,
-          ("area: std::f32::consts::PI * cross.length(),",
-           "area: std::f32::consts::PI * m.x_axis.length() * m.x_axis.length(),"),
-          cargo=RENDER, pytest=("test_emitters.py -k disk",)),
-    plant("triangle-sample-not-uniform",
-          "Triangle::sample (area lights) forgets the square root: t = 1 - u0, not sqrt(1 - u0)",
-          TRIANGLE,
-          ("let [b1, b2] = warp::square_to_uniform_triangle(u);",
-           "let [b1, b2] = [u[0], (1.0 - u[0]) * u[1]];"),
-          cargo=RENDER, pytest=("test_emitters.py -k 'rectangle or cube or mesh'",)),
-    plant("env-mis-weight-swapped",
-          "add_escaped weighs escaped rays by h(p_light, p_bsdf): arguments swapped",
-          INTEGRATOR,
-          ("settings.weight(p, escaped.light_pdf[i])", "settings.weight(escaped.light_pdf[i], p)"),
-          cargo=RENDER, pytest=(FURNACE,)),
-    plant("light-pdf-ignores-choice",
-          "Scene::light_pdf leaves out the probability of choosing the light (pmf = 1)",
-          SCENE,
-          ("let pmf = self.choice_pmf(light);", "let pmf = 1.0f32;"),
-          cargo=RENDER, pytest=("test_emitters.py::test_the_choice_among_lights_is_by_power",)),
-]
-
-ENVMAP = ("envmap::",)
-ENVMAP_BUGS = [
-    plant("envmap-eval-texel-shift",
-          "lat-long Image::corners (eval and every lookup) is shifted by one texel in s",
-          "src/envmap/image.rs",
-          ("let x = p[0] - F::c(0.5 / w as f64);", "let x = p[0] - F::c(1.5 / w as f64);"),
-          cargo=ENVMAP,
-          pytest=("test_envmap.py::test_latlong_axes_are_mitsubas",
-                  "test_vs_mitsuba_envmap.py::test_eval_equals_mitsubas")),
-    plant("envmap-pdf-no-sin-theta",
-          "PolarTable::query (lat-long / angular pdf, pdf_into) drops sin theta from dw/dq",
-          "src/envmap/polar.rs",
-          ("let scaled_sin = (r.max(F::c(SIN_FLOOR) * length)).max(F::min_positive_value());",
-           "let scaled_sin = length.max(F::min_positive_value());"),
-          cargo=ENVMAP, pytest=("test_envmap.py::test_pdf_of_samples_and_weights",)),
-    plant("envmap-pdf-2-percent-upper-half",
-          "PolarTable::query (pdf, pdf_into) is 2 % too high for world directions with y > 0",
-          "src/envmap/polar.rs",
-          ("[row, col, length / (F::c(2.0 * PI * PI) * scaled_sin)]",
-           ("[row, col, length / (F::c(2.0 * PI * PI) * scaled_sin)"
-            " * if d[1] > F::zero() { F::c(1.02) } else { F::one() }]")),
-          cargo=ENVMAP,
-          pytest=("test_envmap.py::test_pdf_of_samples_and_weights",
-                  "test_envmap.py::test_pdf_integrates_to_one")),
-    plant("envmap-bilinear-weights-swapped",
-          "bilinear quad: the weights of texels (x1, y0) and (x0, y1) swapped (all mappings)",
-          "src/envmap/image.rs",
-          ("fx * (one - fy),\n            (one - fx) * fy,",
-           "(one - fx) * fy,\n            fx * (one - fy),"),
-          cargo=ENVMAP,
-          pytest=("test_vs_mitsuba_envmap.py::test_eval_equals_mitsubas", "test_envmap.py")),
-    plant("envmap-mitsuba-grid-density-transposed",
-          "BilinearGrid::place (Mitsuba mode) reports the density at (fy, fx) instead of (fx, fy)",
-          "src/envmap/bilinear.rs",
-          ("(q, bilerp(c, fx, fy) * self.inv_mean)", "(q, bilerp(c, fy, fx) * self.inv_mean)"),
-          cargo=ENVMAP,
-          pytest=("test_vs_mitsuba_envmap.py::test_mitsubas_samples_follow_our_mitsuba_mode_pdf",
-                  "test_envmap.py -k mitsuba")),
-]
-
-PHONG = ("phong",)
-PHONG_BUGS = [
-    plant("phong-glossy-norm-n-plus-2",
-          "the glossy lobe's density is normalised by (n + 2)/(2 pi) instead of (n + 1)/(2 pi)",
-          "src/phong.rs",
-          ("glossy_norm: F::c((n + 1.0) * 0.5 * inv_pi),",
-           "glossy_norm: F::c((n + 2.0) * 0.5 * inv_pi),"),
-          cargo=PHONG, pytest=("test_phong.py",)),
-    plant("phong-diffuse-pdf-no-cosine",
-          "the diffuse part of the pdf is 1/pi over the hemisphere, without its cos theta",
-          "src/phong.rs",
-          ("let diffuse = warp::square_to_cosine_hemisphere_pdf(wo);",
-           "let diffuse = if wo[2] > F::zero() { F::FRAC_1_PI() } else { F::zero() };"),
-          cargo=PHONG, pytest=("test_phong.py",)),
-    plant("phong-component-choice-inverted",
-          "sample and sample_one pick the diffuse part with probability 1 - p_d; pdf uses p_d",
-          "src/phong.rs",
-          ("let diffuse = u[2] < self.diffuse_probability;\n        // Both candidates",
-           "let diffuse = u[2] >= self.diffuse_probability;\n        // Both candidates"),
-          ("let diffuse = u[2] < self.diffuse_probability;\n        let wo = if diffuse {",
-           "let diffuse = u[2] >= self.diffuse_probability;\n        let wo = if diffuse {"),
-          cargo=PHONG, pytest=("test_phong.py::test_chi2_sample_against_pdf_on_the_sphere",)),
-    plant("phong-specular-eval-n-plus-1",
-          "eval normalises the specular part by (n + 1)/(2 pi) instead of (n + 2)/(2 pi)",
-          "src/phong.rs",
-          ("specular: self.specular.map(|v| F::c(v * (n + 2.0) * 0.5 * inv_pi)),",
-           "specular: self.specular.map(|v| F::c(v * (n + 1.0) * 0.5 * inv_pi)),"),
-          cargo=PHONG,
-          pytest=("test_vs_mitsuba_phong.py::test_plugin_eval_is_mcsample_eval_times_cosine",
-                  "test_phong.py")),
-]
-
-WARP = ("warp",)
-WARP_BUGS = [
-    plant("warp-cone-pdf-one-minus-cos-squared",
-          "square_to_uniform_cone_pdf divides by 2 pi (1 - c^2) instead of 2 pi (1 - c)",
-          "src/warp.rs",
-          ("(two_pi::<F>() * (F::one() - cos_cutoff))",
-           "(two_pi::<F>() * (F::one() - cos_cutoff * cos_cutoff))"),
-          cargo=WARP, pytest=("test_warp.py -k cone", "test_vs_mitsuba_warp.py -k cone")),
-    plant("warp-cosine-pdf-missing-pi",
-          "square_to_cosine_hemisphere_pdf is max(cos theta, 0), without the 1/pi",
-          "src/warp.rs",
-          ("d[2].max(F::zero()) * F::FRAC_1_PI()", "d[2].max(F::zero())"),
-          cargo=WARP, pytest=("test_warp.py -k cosine_hemisphere",)),
-    plant("warp-triangle-inverse-not-squared",
-          "uniform_triangle_to_square returns 1 - t instead of 1 - t^2",
-          "src/warp.rs",
-          ("[clamp01(F::one() - t * t), clamp01(v)]", "[clamp01(F::one() - t), clamp01(v)]"),
-          cargo=WARP, pytest=("test_vs_mitsuba_warp.py -k triangle",)),
-    plant("warp-power-exponent-off-by-one",
-          "interval_to_power draws u^(1/(n + 2)) instead of u^(1/(n + 1))",
-          "src/warp.rs",
-          ("F::pow_positive(u, F::one() / (exponent + F::one()))",
-           "F::pow_positive(u, F::one() / (exponent + F::c(2.0)))"),
-          cargo=WARP, pytest=("test_warp.py -k interval_to_power",)),
-]
-
-DISTR = ("distr",)
-DISTR_BUGS = [
-    plant("discrete-reuse-first-entry",
-          "Search::rescale (sample_reuse) subtracts C_0, not 0, for entry 0: its u' is always 0",
-          "src/distr/search.rs",
-          ("(u.f64() * self.sum - self.sum_before(i))",
-           "(u.f64() * self.sum - self.running(i.saturating_sub(1)))"),
-          cargo=DISTR,
-          pytest=("test_distr.py::test_sample_reuse_is_a_fresh_uniform",
-                  "test_distr.py::test_piecewise2d_spiky_chi2_inverse_and_normalisation")),
-    plant("piecewise1d-integral-n-minus-1",
-          "PiecewiseConstant1D::integral takes the cell width as (b - a)/(n - 1)",
-          "src/distr/piecewise.rs",
-          ("self.table.sum() * (self.axis.hi - self.axis.lo) / self.axis.n as f64",
-           "self.table.sum() * (self.axis.hi - self.axis.lo) / (self.axis.n - 1) as f64"),
-          cargo=DISTR, pytest=("test_distr.py::test_piecewise1d_chi2_inverse_and_normalisation",)),
-    plant("piecewise2d-integral-cols-squared",
-          "PiecewiseConstant2D::new divides the integral by cols * cols cells, not cols * rows",
-          "src/distr/piecewise.rs",
-          ("let integral = table.sum() * area / (cols * rows) as f64;",
-           "let integral = table.sum() * area / (cols * cols) as f64;"),
-          cargo=DISTR,
-          pytest=("test_distr.py::test_piecewise2d_spiky_chi2_inverse_and_normalisation",)),
-    plant("alias-threshold-off-by-one",
-          "AliasTable keeps a cell's own entry when fraction <= threshold (not <)",
-          "src/distr/alias.rs",
-          ("select_unpredictable(fraction < threshold, c as u32, alias)",
-           "select_unpredictable(fraction <= threshold, c as u32, alias)"),
-          cargo=DISTR, pytest=("test_distr.py -k alias",)),
-    plant("discrete2d-pmf-transposed",
-          "Discrete2D::pmf reads weight(col, row): row and column swapped",
-          "src/distr/discrete2d.rs",
-          ("self.weight(row, col) / self.sum()", "self.weight(col, row) / self.sum()"),
-          cargo=DISTR,
-          pytest=("test_distr.py::test_discrete2d_pmf_and_chi2",
-                  "test_vs_mitsuba_distr.py::test_discrete2d_same_cells_as_mitsuba")),
-]
-
-BUGS: list[Bug] = RENDER_BUGS + ENVMAP_BUGS + PHONG_BUGS + WARP_BUGS + DISTR_BUGS
+BUGS: list[Bug] = load_bugs(CATALOGUE)
 
 
 # --------------------------------------------------------------------------

@@ -124,68 +124,73 @@ impl Moments {
     }
 }
 
-/// The mean and standard error of `f(rng)` over `n` evaluations, each with
-/// its own stretch of `draws` numbers of the stream of `seed`.
-fn estimate(
-    n: usize,
-    seed: u64,
-    draws: u64,
-    f: impl Fn(&mut Rng) -> V3<f64> + Sync,
-) -> Result<Estimate> {
-    let base = Rng::new(seed, 0);
-    let parts = Mutex::new(Vec::new());
-    parallel::for_each_chunk(n, (), |range, ()| {
-        // One partial sum per block of CHUNK items, whatever the range a
-        // thread is handed: the same sums in the same order on any pool.
-        let mut local = Vec::new();
-        for start in range.clone().step_by(parallel::CHUNK) {
-            let mut rng = base.jumped(start as u64 * draws);
-            let mut m = Moments::default();
-            for _ in start..(start + parallel::CHUNK).min(range.end) {
-                m.push(f(&mut rng));
-            }
-            local.push((start, m));
+impl Plan {
+    /// The mean and standard error of `f(rng)` over `n` evaluations, each
+    /// with its own stretch of `draws` numbers of the stream of `seed`.
+    ///
+    /// # Errors
+    /// [`Error::Integer`] for `n = 0`.
+    fn estimate(self, draws: u64, f: impl Fn(&mut Rng) -> V3<f64> + Sync) -> Result<Estimate> {
+        let Plan { n, seed, .. } = self;
+        if n == 0 {
+            return Err(Error::Integer {
+                arg: "n",
+                value: "0".into(),
+                requirement: "must be at least 1".into(),
+            });
         }
-        parts
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .extend(local);
-        true
-    })?;
-    let mut parts = parts.into_inner().unwrap_or_else(|p| p.into_inner());
-    parts.sort_by_key(|p| p.0);
-    let m = parts
-        .into_iter()
-        .fold(Moments::default(), |acc, (_, m)| acc.merge(m));
-    let stderr = if n > 1 {
-        m.m2.map(|v| (v / (m.n - 1.0) / m.n).sqrt())
-    } else {
-        [f64::INFINITY; 3]
-    };
-    Ok(Estimate {
-        value: m.mean,
-        stderr,
-        n,
-    })
+        let base = Rng::new(seed, 0);
+        let parts = Mutex::new(Vec::new());
+        parallel::for_each_chunk(n, (), |range, ()| {
+            // One partial sum per block of CHUNK items, whatever the range a
+            // thread is handed: the same sums in the same order on any pool.
+            let mut local = Vec::new();
+            for start in range.clone().step_by(parallel::CHUNK) {
+                let mut rng = base.jumped(start as u64 * draws);
+                let mut m = Moments::default();
+                for _ in start..(start + parallel::CHUNK).min(range.end) {
+                    m.push(f(&mut rng));
+                }
+                local.push((start, m));
+            }
+            parts
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .extend(local);
+            true
+        })?;
+        let mut parts = parts.into_inner().unwrap_or_else(|p| p.into_inner());
+        parts.sort_by_key(|p| p.0);
+        let m = parts
+            .into_iter()
+            .fold(Moments::default(), |acc, (_, m)| acc.merge(m));
+        let stderr = if n > 1 {
+            m.m2.map(|v| (v / (m.n - 1.0) / m.n).sqrt())
+        } else {
+            [f64::INFINITY; 3]
+        };
+        Ok(Estimate {
+            value: m.mean,
+            stderr,
+            n,
+        })
+    }
 }
 
-fn check(n: usize, normal: V3<f64>) -> Result<V3<f64>> {
-    if n == 0 {
-        return Err(Error::Integer {
-            arg: "n",
-            value: "0".into(),
-            requirement: "must be at least 1".into(),
-        });
-    }
-    let len = dot(normal, normal).sqrt();
+/// `v` normalised.
+///
+/// # Errors
+/// [`Error::Parameter`] naming `arg` for a zero or non-finite vector.
+fn unit(arg: &'static str, v: V3<f64>) -> Result<V3<f64>> {
+    let len = dot(v, v).sqrt();
     if !(len > 0.0 && len.is_finite()) {
         return Err(Error::Parameter {
-            arg: "normal",
+            arg,
             value: len,
             requirement: "must be finite and non-zero (its length is shown)",
         });
     }
-    Ok(normal.map(|x| x / len))
+    Ok(v.map(|x| x / len))
 }
 
 fn unsupported(strategy: Strategy, allowed: &str) -> Error {
@@ -217,30 +222,24 @@ fn next2(rng: &mut Rng) -> [f64; 2] {
 /// [`Error::Integer`] for `n = 0`, [`Error::Parameter`] for a zero or
 /// non-finite normal, [`Error::Choice`] for [`Strategy::Bsdf`].
 pub fn irradiance(env: &EnvMap, normal: V3<f64>, plan: Plan) -> Result<Estimate> {
-    let Plan {
-        n,
-        strategy,
-        heuristic,
-        seed,
-    } = plan;
-    let normal = check(n, normal)?;
+    let (normal, heuristic) = (unit("normal", normal)?, plan.heuristic);
     let frame = Frame::from_normal(normal);
     let cosine_pdf = |d: V3<f64>| dot(d, normal).max(0.0) / PI;
-    match strategy {
-        Strategy::Uniform => estimate(n, seed, 2, |rng| {
+    match plan.strategy {
+        Strategy::Uniform => plan.estimate(2, |rng| {
             let d = frame.to_world(warp::square_to_uniform_hemisphere(next2(rng)));
             scaled(env.eval(d), dot(d, normal).max(0.0) * 2.0 * PI)
         }),
-        Strategy::Cosine => estimate(n, seed, 2, |rng| {
+        Strategy::Cosine => plan.estimate(2, |rng| {
             let local = warp::square_to_cosine_hemisphere(next2(rng));
             let f = if local[2] > 0.0 { PI } else { 0.0 };
             scaled(env.eval(frame.to_world(local)), f)
         }),
-        Strategy::Emitter => estimate(n, seed, 2, |rng| {
+        Strategy::Emitter => plan.estimate(2, |rng| {
             let s = env.sample(next2(rng));
             scaled(s.weight, dot(s.direction, normal).max(0.0))
         }),
-        Strategy::Mis => estimate(n, seed, 4, |rng| {
+        Strategy::Mis => plan.estimate(4, |rng| {
             let d = frame.to_world(warp::square_to_cosine_hemisphere(next2(rng)));
             let p = cosine_pdf(d);
             let from_cosine = if p > 0.0 {
@@ -257,7 +256,7 @@ pub fn irradiance(env: &EnvMap, normal: V3<f64>, plan: Plan) -> Result<Estimate>
             )
         }),
         Strategy::Bsdf => Err(unsupported(
-            strategy,
+            plan.strategy,
             r#""uniform", "cosine", "emitter" or "mis""#,
         )),
     }
@@ -276,23 +275,8 @@ pub fn reflected_radiance(
     wi: V3<f64>,
     plan: Plan,
 ) -> Result<Estimate> {
-    let Plan {
-        n,
-        strategy,
-        heuristic,
-        seed,
-    } = plan;
-    let normal = check(n, normal)?;
-    let wi = check(n, wi).map_err(|e| match e {
-        Error::Parameter {
-            value, requirement, ..
-        } => Error::Parameter {
-            arg: "wi",
-            value,
-            requirement,
-        },
-        other => other,
-    })?;
+    let (normal, wi) = (unit("normal", normal)?, unit("wi", wi)?);
+    let heuristic = plan.heuristic;
     let frame = Frame::from_normal(normal);
     // The BRDF seen from wi, built once for all n samples.
     let view = phong.view(frame.to_local(wi));
@@ -306,16 +290,16 @@ pub fn reflected_radiance(
         (frame.to_world(s.wo), s)
     };
     let times = |a: V3<f64>, b: V3<f64>| [a[0] * b[0], a[1] * b[1], a[2] * b[2]];
-    match strategy {
-        Strategy::Bsdf => estimate(n, seed, 3, |rng| {
+    match plan.strategy {
+        Strategy::Bsdf => plan.estimate(3, |rng| {
             let (d, s) = bsdf_sample(rng);
             times(s.weight, env.eval(d))
         }),
-        Strategy::Emitter => estimate(n, seed, 2, |rng| {
+        Strategy::Emitter => plan.estimate(2, |rng| {
             let s = env.sample(next2(rng));
             times(s.weight, reflect(s.direction))
         }),
-        Strategy::Mis => estimate(n, seed, 5, |rng| {
+        Strategy::Mis => plan.estimate(5, |rng| {
             let (d, b) = bsdf_sample(rng);
             let w = heuristic.weight(b.pdf, env.pdf(d));
             let from_bsdf = scaled(times(b.weight, env.eval(d)), w);
@@ -324,7 +308,7 @@ pub fn reflected_radiance(
             add(from_bsdf, scaled(times(s.weight, reflect(s.direction)), w))
         }),
         Strategy::Uniform | Strategy::Cosine => {
-            Err(unsupported(strategy, r#""bsdf", "emitter" or "mis""#))
+            Err(unsupported(plan.strategy, r#""bsdf", "emitter" or "mis""#))
         }
     }
 }

@@ -48,11 +48,6 @@ impl Raster {
         }
         Ok(())
     }
-
-    fn pixel(&self, x: usize, y: usize) -> &[f32] {
-        let start = (y * self.width + x) * self.channels;
-        &self.data[start..start + self.channels]
-    }
 }
 
 /// Reads the first RGB layer of an OpenEXR file (half, float or uint
@@ -104,46 +99,22 @@ pub fn read_exr(path: &Path) -> Result<Raster> {
 pub fn write_exr(path: &Path, image: &Raster, half: bool) -> Result<()> {
     use exr::prelude::*;
     image.check(path)?;
-    let size = (image.width, image.height);
-    let h = |v: f32| f16::from_f32(v);
-    let result = match (image.channels, half) {
-        (3, false) => Image::from_channels(
-            size,
-            SpecificChannels::rgb(|p: Vec2<usize>| {
-                let c = image.pixel(p.x(), p.y());
-                (c[0], c[1], c[2])
-            }),
-        )
+    let channels = ["R", "G", "B", "A"][..image.channels]
+        .iter()
+        .enumerate()
+        .map(|(c, &name)| {
+            let values = image.data.iter().skip(c).step_by(image.channels).copied();
+            let samples = if half {
+                FlatSamples::F16(values.map(f16::from_f32).collect())
+            } else {
+                FlatSamples::F32(values.collect())
+            };
+            AnyChannel::new(name, samples)
+        })
+        .collect();
+    let result = Image::from_channels((image.width, image.height), AnyChannels::sort(channels))
         .write()
-        .to_file(path),
-        (3, true) => Image::from_channels(
-            size,
-            SpecificChannels::rgb(|p: Vec2<usize>| {
-                let c = image.pixel(p.x(), p.y());
-                (h(c[0]), h(c[1]), h(c[2]))
-            }),
-        )
-        .write()
-        .to_file(path),
-        (_, false) => Image::from_channels(
-            size,
-            SpecificChannels::rgba(|p: Vec2<usize>| {
-                let c = image.pixel(p.x(), p.y());
-                (c[0], c[1], c[2], c[3])
-            }),
-        )
-        .write()
-        .to_file(path),
-        (_, true) => Image::from_channels(
-            size,
-            SpecificChannels::rgba(|p: Vec2<usize>| {
-                let c = image.pixel(p.x(), p.y());
-                (h(c[0]), h(c[1]), h(c[2]), h(c[3]))
-            }),
-        )
-        .write()
-        .to_file(path),
-    };
+        .to_file(path);
     result.map_err(|e| io_error(path, format!("cannot write OpenEXR: {e}")))
 }
 

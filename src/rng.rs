@@ -73,28 +73,26 @@ impl Rng {
     /// # Errors
     /// Only if the thread count cannot be determined.
     pub fn fill<F: Real>(&mut self, out: &mut [F]) -> Result<()> {
-        let n = out.len();
-        let base = &*self;
-        parallel::for_each_chunk(n, out, |range, chunk| {
-            let mut rng = base.jumped(range.start as u64);
-            chunk.iter_mut().for_each(|x| *x = rng.next_float());
-            true
-        })?;
-        self.advance(n as u64);
-        Ok(())
+        self.fill_with(out, Self::next_float)
     }
 
     /// Fills `out` with the next `out.len()` 32-bit outputs and advances past
     /// them.
     ///
     /// # Errors
-    /// Only if the thread count cannot be determined.
+    /// As [`Rng::fill`].
     pub fn fill_u32(&mut self, out: &mut [u32]) -> Result<()> {
+        self.fill_with(out, Self::next_u32)
+    }
+
+    /// `out[i]` = `next` of the stream advanced by `i` (one draw each), on
+    /// all cores; then advances past them.
+    fn fill_with<T: Send>(&mut self, out: &mut [T], next: fn(&mut Self) -> T) -> Result<()> {
         let n = out.len();
         let base = &*self;
         parallel::for_each_chunk(n, out, |range, chunk| {
             let mut rng = base.jumped(range.start as u64);
-            chunk.iter_mut().for_each(|x| *x = rng.next_u32());
+            chunk.iter_mut().for_each(|x| *x = next(&mut rng));
             true
         })?;
         self.advance(n as u64);

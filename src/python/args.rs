@@ -6,12 +6,13 @@
 
 use crate::error::Error;
 use crate::mis::Heuristic;
+use crate::python::Obj;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 
 /// `ob` as a Python int (anything with `__index__`, as numpy integers),
 /// else TypeError naming `arg`.
-fn int_arg<'py>(ob: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, PyAny>> {
+fn int_arg<'py>(ob: &Obj<'py>, arg: &str) -> PyResult<Obj<'py>> {
     let py = ob.py();
     py.import(pyo3::intern!(py, "operator"))?
         .call_method1(pyo3::intern!(py, "index"), (ob,))
@@ -20,8 +21,33 @@ fn int_arg<'py>(ob: &Bound<'py, PyAny>, arg: &str) -> PyResult<Bound<'py, PyAny>
         })
 }
 
+/// Three numbers: a sequence of three floats for `arg`, or, when `grey`,
+/// also one float for all three (an RGB value). A wrong type is a
+/// TypeError, a wrong length a ValueError, both naming `arg`.
+pub fn three_floats(ob: &Obj<'_>, arg: &'static str, grey: bool) -> PyResult<[f64; 3]> {
+    if grey && let Ok(v) = ob.extract::<f64>() {
+        return Ok([v; 3]);
+    }
+    let (what, expected) = if grey {
+        ("a number or three numbers (RGB)", "(3,) or a number")
+    } else {
+        ("three numbers", "(3,)")
+    };
+    let values: Vec<f64> = ob
+        .extract()
+        .map_err(|_| PyTypeError::new_err(format!("{arg} must be {what}")))?;
+    values.try_into().map_err(|v: Vec<f64>| {
+        Error::Shape {
+            arg,
+            expected: expected.into(),
+            got: format!("({},)", v.len()),
+        }
+        .into()
+    })
+}
+
 /// The name of `ob`'s type, for messages.
-pub fn type_name(ob: &Bound<'_, PyAny>) -> String {
+pub fn type_name(ob: &Obj<'_>) -> String {
     ob.get_type()
         .name()
         .map_or_else(|_| "?".into(), |n| n.to_string())
@@ -29,7 +55,7 @@ pub fn type_name(ob: &Bound<'_, PyAny>) -> String {
 
 /// An integer argument in `[min, max]`; values outside (however large)
 /// raise ValueError (never OverflowError), non-integers TypeError.
-pub fn index_arg(ob: &Bound<'_, PyAny>, arg: &'static str, min: u64, max: u64) -> PyResult<u64> {
+pub fn index_arg(ob: &Obj<'_>, arg: &'static str, min: u64, max: u64) -> PyResult<u64> {
     let int = int_arg(ob, arg)?;
     if int.lt(min)? || int.gt(max)? {
         return Err(Error::Integer {
@@ -45,7 +71,7 @@ pub fn index_arg(ob: &Bound<'_, PyAny>, arg: &'static str, min: u64, max: u64) -
 /// A path depth such as `max_depth`: -1 for unbounded (`None`), else an
 /// integer from 0 to `u32::MAX`; anything else (of any size) raises
 /// ValueError naming `arg`, a non-integer TypeError.
-pub fn depth_arg(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<Option<u32>> {
+pub fn depth_arg(ob: &Obj<'_>, arg: &'static str) -> PyResult<Option<u32>> {
     let int = int_arg(ob, arg)?;
     if int.eq(-1)? {
         return Ok(None);
@@ -68,7 +94,7 @@ pub fn depth_arg(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<Option<u3
 /// (the one definition): an int in `[0, 2⁶⁴)` as it is, None fresh entropy
 /// from the operating system, a `numpy.random.Generator` a seed drawn from
 /// it; anything else TypeError, an int out of range ValueError naming `arg`.
-pub fn seed_arg(ob: &Bound<'_, PyAny>, arg: &str) -> PyResult<u64> {
+pub fn seed_arg(ob: &Obj<'_>, arg: &str) -> PyResult<u64> {
     let py = ob.py();
     py.import(pyo3::intern!(py, "mcsample.seeds"))?
         .getattr(pyo3::intern!(py, "resolve_seed"))?
@@ -78,7 +104,7 @@ pub fn seed_arg(ob: &Bound<'_, PyAny>, arg: &str) -> PyResult<u64> {
 
 /// [`seed_arg`] for an argument named `seed`, as pyo3's `from_py_with`
 /// takes it (so that the signature can show the default `seed=0`).
-pub fn seed(ob: &Bound<'_, PyAny>) -> PyResult<u64> {
+pub fn seed(ob: &Obj<'_>) -> PyResult<u64> {
     seed_arg(ob, "seed")
 }
 

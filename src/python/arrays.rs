@@ -13,6 +13,7 @@
 use super::args::type_name;
 use crate::error::{Error, shape_str};
 use crate::math::Real;
+use crate::python::{Obj, Out};
 use numpy::{AllowTypeChange, Element, PyArray, PyArrayDescrMethods, PyArrayDyn, PyArrayLikeDyn};
 use numpy::{PyArrayMethods, PyReadwriteArrayDyn, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
@@ -26,7 +27,7 @@ impl PyFloat for f32 {}
 impl PyFloat for f64 {}
 
 /// Whether `ob` is a float32 array or numpy float32 scalar.
-pub fn is_float32(ob: &Bound<'_, PyAny>) -> bool {
+pub fn is_float32(ob: &Obj<'_>) -> bool {
     ob.getattr(pyo3::intern!(ob.py(), "dtype"))
         .ok()
         .and_then(|d| d.cast_into::<numpy::PyArrayDescr>().ok())
@@ -192,7 +193,7 @@ pub struct Points<'py, F: Element, const K: usize> {
 
 impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
     /// Reads `ob` as points of dimension `K`.
-    pub fn extract(ob: &Bound<'py, PyAny>, arg: &'static str) -> PyResult<Self> {
+    pub fn extract(ob: &Obj<'py>, arg: &'static str) -> PyResult<Self> {
         let array: PyArrayLikeDyn<'py, F, AllowTypeChange> = ob
             .extract()
             .map_err(|e| PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}")))?;
@@ -257,7 +258,7 @@ pub fn zeros<'py, F: Element>(py: Python<'py>, shape: &[usize]) -> Bound<'py, Py
 }
 
 /// `array` as returned to Python: a numpy scalar when it is 0-d.
-pub fn finish<'py, F: Element>(array: Bound<'py, PyArrayDyn<F>>) -> PyResult<Bound<'py, PyAny>> {
+pub fn finish<'py, F: Element>(array: Bound<'py, PyArrayDyn<F>>) -> PyResult<Obj<'py>> {
     if array.ndim() == 0 {
         array.get_item(PyTuple::empty(array.py()))
     } else {
@@ -271,7 +272,7 @@ pub fn finish<'py, F: Element>(array: Bound<'py, PyArrayDyn<F>>) -> PyResult<Bou
 pub fn output<'py, T: Element>(
     py: Python<'py>,
     shape: &[usize],
-    out: Option<&Bound<'py, PyAny>>,
+    out: Out<'_, 'py>,
     arg: &'static str,
 ) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     let Some(out) = out.filter(|o| !o.is_none()) else {
@@ -344,7 +345,7 @@ pub struct Indices<const K: usize> {
 impl<const K: usize> Indices<K> {
     /// Reads and checks `ob` (argument `arg`); floats raise TypeError, an
     /// index out of range (however large) ValueError naming its position.
-    pub fn extract(ob: &Bound<'_, PyAny>, arg: &'static str, bounds: [usize; K]) -> PyResult<Self> {
+    pub fn extract(ob: &Obj<'_>, arg: &'static str, bounds: [usize; K]) -> PyResult<Self> {
         let py = ob.py();
         let array = py
             .import(pyo3::intern!(py, "numpy"))?
@@ -412,7 +413,7 @@ impl<const K: usize> Indices<K> {
 }
 
 /// The TypeError for indices `arg` given as an array of `dtype`.
-fn not_integers(arg: &str, dtype: &Bound<'_, PyAny>) -> PyErr {
+fn not_integers(arg: &str, dtype: &Obj<'_>) -> PyErr {
     PyTypeError::new_err(format!(
         "{arg} must be integers, got an array of dtype {dtype}"
     ))
@@ -430,7 +431,7 @@ pub struct Table<'py> {
 
 impl<'py> Table<'py> {
     /// Reads `ob` (argument `arg`).
-    pub fn extract(ob: &Bound<'py, PyAny>, arg: &'static str, ndim: usize) -> PyResult<Self> {
+    pub fn extract(ob: &Obj<'py>, arg: &'static str, ndim: usize) -> PyResult<Self> {
         let array: PyArrayLikeDyn<'py, f64, AllowTypeChange> = ob
             .extract()
             .map_err(|e| PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}")))?;

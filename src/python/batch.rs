@@ -7,28 +7,13 @@
 use super::arrays::{Check, Indices, Points, PyFloat, broadcast, finish, output, result_shape};
 use super::arrays::{writable, zeros};
 use super::parallel::run_batch;
+use crate::python::{Obj, Out};
 use crate::simd::{STREAM_MIN_BYTES, map_rows};
 use numpy::{Element, PyArrayMethods};
 use pyo3::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Maps every point through `kernel` (`K` values in, `M` out, of any
-/// element type), checking each input value in the same pass; the GIL is
-/// released and the batch runs on all cores.
-pub fn map<'py, F, T, const K: usize, const M: usize>(
-    py: Python<'py>,
-    x: &Points<'py, F, K>,
-    check: Check,
-    kernel: impl Fn([F; K]) -> [T; M] + Sync + Send,
-) -> PyResult<Bound<'py, PyAny>>
-where
-    F: PyFloat,
-    T: Element + Copy + Default + Send,
-{
-    map_into(py, x, check, None, kernel)
-}
-
-/// [`map`] for kernels that cannot vectorise (table lookups, library
+/// [`map_into`] for kernels that cannot vectorise (table lookups, library
 /// calls): a plain loop per chunk, without the SIMD dispatch and the
 /// transposes of [`map_rows`], which would only add work to them.
 pub fn map_each<'py, F, T, const K: usize, const M: usize>(
@@ -36,7 +21,7 @@ pub fn map_each<'py, F, T, const K: usize, const M: usize>(
     x: &Points<'py, F, K>,
     check: Check,
     kernel: impl Fn([F; K]) -> [T; M] + Sync + Send,
-) -> PyResult<Bound<'py, PyAny>>
+) -> PyResult<Obj<'py>>
 where
     F: PyFloat,
     T: Element + Copy + Default + Send,
@@ -61,7 +46,7 @@ where
     finish(out)
 }
 
-/// [`map`] for kernels that take a whole chunk of points at once and
+/// [`map_into`] for kernels that take a whole chunk of points at once and
 /// write one value per point (for work shared across points, such as
 /// prefetching table cells): every input value is checked first, and the
 /// kernel runs only on chunks that pass.
@@ -70,7 +55,7 @@ pub fn map_chunks<'py, F, T, const K: usize>(
     x: &Points<'py, F, K>,
     check: Check,
     kernel: impl Fn(&[[F; K]], &mut [T]) + Sync + Send,
-) -> PyResult<Bound<'py, PyAny>>
+) -> PyResult<Obj<'py>>
 where
     F: PyFloat,
     T: Element + Copy + Default + Send,
@@ -94,14 +79,17 @@ where
     finish(out)
 }
 
-/// As [`map`], writing into `out` when it is given (see [`output`]).
+/// Maps every point through `kernel` (`K` values in, `M` out, of any
+/// element type), checking each input value in the same pass, into `out`
+/// when it is given (see [`output`]); the GIL is released and the batch
+/// runs on all cores.
 pub fn map_into<'py, F, T, const K: usize, const M: usize>(
     py: Python<'py>,
     x: &Points<'py, F, K>,
     check: Check,
-    out: Option<&Bound<'py, PyAny>>,
+    out: Out<'_, 'py>,
     kernel: impl Fn([F; K]) -> [T; M] + Sync + Send,
-) -> PyResult<Bound<'py, PyAny>>
+) -> PyResult<Obj<'py>>
 where
     F: PyFloat,
     T: Element + Copy + Default + Send,
@@ -168,7 +156,7 @@ pub fn map_pair<'py, F, T, const KA: usize, const KB: usize, const M: usize>(
     a: (&Points<'py, F, KA>, Check),
     b: (&Points<'py, F, KB>, Check),
     kernel: impl Fn([F; KA], [F; KB]) -> [T; M] + Sync + Send,
-) -> PyResult<Bound<'py, PyAny>>
+) -> PyResult<Obj<'py>>
 where
     F: PyFloat,
     T: Element + Copy + Default + Send,
@@ -228,14 +216,14 @@ where
     Ok((!bad_a.into_inner(), !bad_b.into_inner()))
 }
 
-/// As [`map`] for kernels with two results (`M` and `L` values per point),
+/// As [`map_into`] for kernels with two results (`M` and `L` values per point),
 /// returned as two arrays.
 pub fn map2<'py, F, T, S, const K: usize, const M: usize, const L: usize>(
     py: Python<'py>,
     x: &Points<'py, F, K>,
     check: Check,
     kernel: impl Fn([F; K]) -> ([T; M], [S; L]) + Sync + Send,
-) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)>
+) -> PyResult<(Obj<'py>, Obj<'py>)>
 where
     F: PyFloat,
     T: Element + Copy + Default + Send,
@@ -269,7 +257,7 @@ pub fn map_indices<'py, const K: usize>(
     py: Python<'py>,
     indices: &Indices<K>,
     f: impl Fn([usize; K]) -> f64 + Sync + Send,
-) -> PyResult<Bound<'py, PyAny>> {
+) -> PyResult<Obj<'py>> {
     let out = zeros::<f64>(py, &indices.batch);
     {
         let mut guard = out.readwrite();

@@ -4,10 +4,11 @@
 //! in the sampling pass.
 
 use super::arrays::{Check, Indices, Points, Table, with_precision};
-use super::batch::{map, map_chunks, map_indices, map2};
+use super::batch::{map_chunks, map_indices, map_into, map2};
 use super::parallel::detached;
 use super::records::record;
 use crate::distr;
+use crate::python::Obj;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
@@ -28,7 +29,7 @@ macro_rules! index_table_methods {
         #[pymethods]
         impl $py_type {
             #[new]
-            fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
+            fn new(py: Python<'_>, weights: &Obj<'_>) -> PyResult<Self> {
                 let w = Table::extract(weights, "weights", 1)?;
                 let w = w.values();
                 Ok(Self(detached(py, || <$table>::new(w))?))
@@ -46,8 +47,8 @@ macro_rules! index_table_methods {
             fn sample<'py>(
                 &self,
                 py: Python<'py>,
-                u: &Bound<'py, PyAny>,
-            ) -> PyResult<Bound<'py, PyAny>> {
+                u: &Obj<'py>,
+            ) -> PyResult<Obj<'py>> {
                 with_precision!(u, F => {
                     let u = Points::<F, 1>::extract(u, "u")?;
                     map_chunks(py, &u, Check::Unit, |u, out: &mut [i64]| {
@@ -70,8 +71,8 @@ macro_rules! index_table_methods {
             fn pmf<'py>(
                 &self,
                 py: Python<'py>,
-                i: Option<&Bound<'py, PyAny>>,
-            ) -> PyResult<Bound<'py, PyAny>> {
+                i: Option<&Obj<'py>>,
+            ) -> PyResult<Obj<'py>> {
                 let table = &self.0;
                 match i {
                     None => Ok(per_index(py, table.len(), |k| table.pmf(k)).into_any()),
@@ -148,18 +149,14 @@ index_table_methods!(PyDiscrete1D, distr::Discrete1D, "Discrete1D", {
     /// -------
     /// ReusedSample: ``.index`` ndarray (N,) int64 and ``.u`` ndarray (N,)
     /// float of u's precision; unpacks as ``index, u``.
-    fn sample_reuse<'py>(
-        &self,
-        py: Python<'py>,
-        u: &Bound<'py, PyAny>,
-    ) -> PyResult<PyReusedSample> {
+    fn sample_reuse<'py>(&self, py: Python<'py>, u: &Obj<'py>) -> PyResult<PyReusedSample> {
         with_precision!(u, F => {
             let u = Points::<F, 1>::extract(u, "u")?;
             let (index, u) = map2(py, &u, Check::Unit, |u| {
                 let (i, r) = self.0.sample_reuse(u[0]);
                 ([i as i64], [r])
             })?;
-            Ok(PyReusedSample { index: index.unbind(), u: u.unbind() })
+            Ok(PyReusedSample::new(index, u))
         })
     }
 
@@ -203,7 +200,7 @@ pub struct PyDiscrete2D(distr::Discrete2D);
 #[pymethods]
 impl PyDiscrete2D {
     #[new]
-    fn new(py: Python<'_>, weights: &Bound<'_, PyAny>) -> PyResult<Self> {
+    fn new(py: Python<'_>, weights: &Obj<'_>) -> PyResult<Self> {
         let t = Table::extract(weights, "weights", 2)?;
         let (w, rows, cols) = (t.values(), t.shape[0], t.shape[1]);
         Ok(Self(detached(py, || {
@@ -220,10 +217,10 @@ impl PyDiscrete2D {
     /// Returns
     /// -------
     /// ndarray, shape (N, 2) or (2,) int64: (row, col).
-    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn sample<'py>(&self, py: Python<'py>, u: &Obj<'py>) -> PyResult<Obj<'py>> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
-            map(py, &u, Check::Unit, |u| {
+            map_into(py, &u, Check::Unit, None, |u| {
                 let (r, c) = self.0.sample(u);
                 [r as i64, c as i64]
             })
@@ -237,18 +234,14 @@ impl PyDiscrete2D {
     /// -------
     /// ReusedSample: ``.index`` ndarray (N, 2) int64 (row, col) and ``.u``
     /// ndarray (N, 2) float of u's precision; unpacks as ``index, u``.
-    fn sample_reuse<'py>(
-        &self,
-        py: Python<'py>,
-        u: &Bound<'py, PyAny>,
-    ) -> PyResult<PyReusedSample> {
+    fn sample_reuse<'py>(&self, py: Python<'py>, u: &Obj<'py>) -> PyResult<PyReusedSample> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
             let (index, u) = map2(py, &u, Check::Unit, |u| {
                 let ((r, c), v) = self.0.sample_reuse(u);
                 ([r as i64, c as i64], v)
             })?;
-            Ok(PyReusedSample { index: index.unbind(), u: u.unbind() })
+            Ok(PyReusedSample::new(index, u))
         })
     }
 
@@ -263,11 +256,7 @@ impl PyDiscrete2D {
     /// -------
     /// ndarray, shape (N,) float64 (a scalar for one cell).
     #[pyo3(signature = (idx = None))]
-    fn pmf<'py>(
-        &self,
-        py: Python<'py>,
-        idx: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn pmf<'py>(&self, py: Python<'py>, idx: Option<&Obj<'py>>) -> PyResult<Obj<'py>> {
         let (rows, cols) = self.0.shape();
         match idx {
             None => {
@@ -317,7 +306,7 @@ pub struct PyPiecewiseConstant1D(distr::PiecewiseConstant1D);
 impl PyPiecewiseConstant1D {
     #[new]
     #[pyo3(signature = (values, *, a = 0.0, b = 1.0))]
-    fn new(py: Python<'_>, values: &Bound<'_, PyAny>, a: f64, b: f64) -> PyResult<Self> {
+    fn new(py: Python<'_>, values: &Obj<'_>, a: f64, b: f64) -> PyResult<Self> {
         let t = Table::extract(values, "values", 1)?;
         let v = t.values();
         Ok(Self(detached(py, || {
@@ -336,14 +325,14 @@ impl PyPiecewiseConstant1D {
     /// PiecewiseSample: ``.x`` and ``.pdf``, ndarrays of shape (N,) in u's
     /// precision (scalars for a scalar u), pdf per unit length; unpacks as
     /// ``x, pdf``.
-    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<PyPiecewiseSample> {
+    fn sample<'py>(&self, py: Python<'py>, u: &Obj<'py>) -> PyResult<PyPiecewiseSample> {
         with_precision!(u, F => {
             let u = Points::<F, 1>::extract(u, "u")?;
             let (x, pdf) = map2(py, &u, Check::Unit, |u| {
                 let (x, pdf) = self.0.sample(u[0]);
                 ([x], [pdf])
             })?;
-            Ok(PyPiecewiseSample { x: x.unbind(), pdf: pdf.unbind() })
+            Ok(PyPiecewiseSample::new(x, pdf))
         })
     }
 
@@ -352,10 +341,10 @@ impl PyPiecewiseConstant1D {
     /// Parameters
     /// ----------
     /// x : float or array_like, shape (N,)
-    fn pdf<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn pdf<'py>(&self, py: Python<'py>, x: &Obj<'py>) -> PyResult<Obj<'py>> {
         with_precision!(x, F => {
             let x = Points::<F, 1>::extract(x, "x")?;
-            map(py, &x, Check::Finite, |x| [self.0.pdf(x[0])])
+            map_into(py, &x, Check::Finite, None, |x| [self.0.pdf(x[0])])
         })
     }
 
@@ -364,10 +353,10 @@ impl PyPiecewiseConstant1D {
     /// Parameters
     /// ----------
     /// x : float or array_like, shape (N,)
-    fn cdf<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn cdf<'py>(&self, py: Python<'py>, x: &Obj<'py>) -> PyResult<Obj<'py>> {
         with_precision!(x, F => {
             let x = Points::<F, 1>::extract(x, "x")?;
-            map(py, &x, Check::Finite, |x| [self.0.cdf(x[0])])
+            map_into(py, &x, Check::Finite, None, |x| [self.0.cdf(x[0])])
         })
     }
 
@@ -381,11 +370,11 @@ impl PyPiecewiseConstant1D {
     /// ------
     /// ValueError
     ///     For x outside [a, b], naming the first such index.
-    fn invert<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn invert<'py>(&self, py: Python<'py>, x: &Obj<'py>) -> PyResult<Obj<'py>> {
         let (a, b) = self.0.domain();
         with_precision!(x, F => {
             let x = Points::<F, 1>::extract(x, "x")?;
-            map(py, &x, Check::Within([[a, b], [a, b]]), |x| {
+            map_into(py, &x, Check::Within([[a, b], [a, b]]), None, |x| {
                 [self.0.invert(x[0]).unwrap_or(0.0)]
             })
         })
@@ -435,11 +424,7 @@ pub struct PyPiecewiseConstant2D(distr::PiecewiseConstant2D);
 impl PyPiecewiseConstant2D {
     #[new]
     #[pyo3(signature = (values, *, domain = ((0.0, 1.0), (0.0, 1.0))))]
-    fn new(
-        py: Python<'_>,
-        values: &Bound<'_, PyAny>,
-        domain: ((f64, f64), (f64, f64)),
-    ) -> PyResult<Self> {
+    fn new(py: Python<'_>, values: &Obj<'_>, domain: ((f64, f64), (f64, f64))) -> PyResult<Self> {
         let t = Table::extract(values, "values", 2)?;
         let (v, rows, cols) = (t.values(), t.shape[0], t.shape[1]);
         let d = [[domain.0.0, domain.0.1], [domain.1.0, domain.1.1]];
@@ -458,14 +443,14 @@ impl PyPiecewiseConstant2D {
     /// -------
     /// PiecewiseSample: ``.x`` (N, 2) and ``.pdf`` (N,) in u's precision,
     /// pdf per unit area; unpacks as ``x, pdf``.
-    fn sample<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<PyPiecewiseSample> {
+    fn sample<'py>(&self, py: Python<'py>, u: &Obj<'py>) -> PyResult<PyPiecewiseSample> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
             let (x, pdf) = map2(py, &u, Check::Unit, |u| {
                 let (p, pdf) = self.0.sample(u);
                 (p, [pdf])
             })?;
-            Ok(PyPiecewiseSample { x: x.unbind(), pdf: pdf.unbind() })
+            Ok(PyPiecewiseSample::new(x, pdf))
         })
     }
 
@@ -474,10 +459,10 @@ impl PyPiecewiseConstant2D {
     /// Parameters
     /// ----------
     /// xy : array_like, shape (N, 2) or (2,)
-    fn pdf<'py>(&self, py: Python<'py>, xy: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn pdf<'py>(&self, py: Python<'py>, xy: &Obj<'py>) -> PyResult<Obj<'py>> {
         with_precision!(xy, F => {
             let xy = Points::<F, 2>::extract(xy, "xy")?;
-            map(py, &xy, Check::Finite, |p| [self.0.pdf(p)])
+            map_into(py, &xy, Check::Finite, None, |p| [self.0.pdf(p)])
         })
     }
 
@@ -492,11 +477,11 @@ impl PyPiecewiseConstant2D {
     /// ------
     /// ValueError
     ///     For a point outside the rectangle, naming the first such index.
-    fn invert<'py>(&self, py: Python<'py>, xy: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn invert<'py>(&self, py: Python<'py>, xy: &Obj<'py>) -> PyResult<Obj<'py>> {
         let domain = self.0.domain();
         with_precision!(xy, F => {
             let xy = Points::<F, 2>::extract(xy, "xy")?;
-            map(py, &xy, Check::Within(domain), |p| {
+            map_into(py, &xy, Check::Within(domain), None, |p| {
                 self.0.invert(p).unwrap_or([0.0; 2])
             })
         })

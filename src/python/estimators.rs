@@ -1,12 +1,12 @@
 //! `mcsample.estimators`: irradiance and reflected radiance under an
 //! environment map (see [`crate::estimators`]).
 
-use super::args::{choice, heuristic_arg, index_arg, seed};
+use super::args::{choice, heuristic_arg, index_arg, seed, three_floats};
 use super::envmap::PyEnvMap;
 use super::parallel::detached;
 use super::phong::PyPhong;
-use crate::error::Error;
 use crate::estimators::{self, Estimate, Plan, Strategy};
+use crate::python::Obj;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
@@ -56,20 +56,6 @@ impl PyEstimate {
     }
 }
 
-fn vector(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<[f64; 3]> {
-    let v: Vec<f64> = ob.extract().map_err(|_| {
-        pyo3::exceptions::PyTypeError::new_err(format!("{arg} must be three numbers"))
-    })?;
-    v.try_into().map_err(|v: Vec<f64>| {
-        Error::Shape {
-            arg,
-            expected: "(3,)".into(),
-            got: format!("({},)", v.len()),
-        }
-        .into()
-    })
-}
-
 /// The strategies of [`irradiance`] (and their names).
 const IRRADIANCE: &[(&str, Strategy)] = &[
     ("uniform", Strategy::Uniform),
@@ -116,13 +102,13 @@ const REFLECTED: &[(&str, Strategy)] = &[
 pub fn irradiance(
     py: Python<'_>,
     env: &Bound<'_, PyEnvMap>,
-    normal: &Bound<'_, PyAny>,
-    n: &Bound<'_, PyAny>,
+    normal: &Obj<'_>,
+    n: &Obj<'_>,
     strategy: &str,
     #[pyo3(from_py_with = seed)] seed: u64,
     heuristic: &str,
 ) -> PyResult<PyEstimate> {
-    let normal = vector(normal, "normal")?;
+    let normal = three_floats(normal, "normal", false)?;
     let plan = plan(
         n,
         seed,
@@ -165,14 +151,17 @@ pub fn reflected_radiance(
     py: Python<'_>,
     env: &Bound<'_, PyEnvMap>,
     phong: &Bound<'_, PyPhong>,
-    normal: &Bound<'_, PyAny>,
-    wi: &Bound<'_, PyAny>,
-    n: &Bound<'_, PyAny>,
+    normal: &Obj<'_>,
+    wi: &Obj<'_>,
+    n: &Obj<'_>,
     strategy: &str,
     #[pyo3(from_py_with = seed)] seed: u64,
     heuristic: &str,
 ) -> PyResult<PyEstimate> {
-    let (normal, wi) = (vector(normal, "normal")?, vector(wi, "wi")?);
+    let (normal, wi) = (
+        three_floats(normal, "normal", false)?,
+        three_floats(wi, "wi", false)?,
+    );
     let plan = plan(n, seed, choice("strategy", strategy, REFLECTED)?, heuristic)?;
     let (env, phong) = (env.get().inner(), phong.get().inner());
     let estimate = detached(py, || {
@@ -185,7 +174,7 @@ pub fn reflected_radiance(
 }
 
 /// The checked arguments of an estimator.
-fn plan(n: &Bound<'_, PyAny>, seed: u64, strategy: Strategy, heuristic: &str) -> PyResult<Plan> {
+fn plan(n: &Obj<'_>, seed: u64, strategy: Strategy, heuristic: &str) -> PyResult<Plan> {
     Ok(Plan {
         n: index_arg(n, "n", 1, 1 << 40)? as usize,
         strategy,

@@ -3,11 +3,12 @@
 
 use super::arrays::{Check, Points, PyFloat, broadcast, finish, position, result_shape};
 use super::arrays::{with_precision, zeros};
-use super::batch::map;
+use super::batch::map_into;
 use super::parallel::run_batch;
 use crate::error::{Error, shape_str};
 use crate::frame::Frame;
 use crate::math::Real;
+use crate::python::Obj;
 use numpy::PyArrayMethods;
 use pyo3::prelude::*;
 
@@ -44,14 +45,14 @@ impl PyFrame {
     fn apply<'py, F: PyFloat>(
         &self,
         py: Python<'py>,
-        v: &Bound<'py, PyAny>,
+        v: &Obj<'py>,
         op: fn(&Frame<F>, [F; 3]) -> [F; 3],
-    ) -> PyResult<Bound<'py, PyAny>> {
+    ) -> PyResult<Obj<'py>> {
         let v = Points::<F, 3>::extract(v, "v")?;
         let frames: Vec<Frame<F>> = self.frames.iter().map(cast).collect();
         if self.batch.is_empty() {
             let f = frames[0];
-            return map(py, &v, Check::Finite, move |x| op(&f, x));
+            return map_into(py, &v, Check::Finite, None, move |x| op(&f, x));
         }
         let batch =
             broadcast(("normal", &self.batch), ("v", &v.batch)).map_err(|_| Error::Shape {
@@ -87,11 +88,7 @@ impl PyFrame {
         result_shape(&self.batch, 3)
     }
 
-    fn axis<'py>(
-        &self,
-        py: Python<'py>,
-        pick: fn(&Frame<f64>) -> [f64; 3],
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn axis<'py>(&self, py: Python<'py>, pick: fn(&Frame<f64>) -> [f64; 3]) -> PyResult<Obj<'py>> {
         let out = zeros::<f64>(py, &self.shape());
         {
             let mut guard = out.readwrite();
@@ -107,7 +104,7 @@ impl PyFrame {
 #[pymethods]
 impl PyFrame {
     #[new]
-    fn new(normal: &Bound<'_, PyAny>) -> PyResult<Self> {
+    fn new(normal: &Obj<'_>) -> PyResult<Self> {
         let normals = Points::<f64, 3>::extract(normal, "normal")?;
         let mut frames = Vec::with_capacity(normals.n);
         for (i, n) in normals.rows().iter().enumerate() {
@@ -141,7 +138,7 @@ impl PyFrame {
     /// Returns
     /// -------
     /// ndarray, shape of the batch (N, 3) or (3,), in v's precision.
-    fn to_local<'py>(&self, py: Python<'py>, v: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn to_local<'py>(&self, py: Python<'py>, v: &Obj<'py>) -> PyResult<Obj<'py>> {
         with_precision!(v, F => self.apply::<F>(py, v, |f, x| f.to_local(x)))
     }
 
@@ -154,25 +151,25 @@ impl PyFrame {
     /// Returns
     /// -------
     /// ndarray, shape of the batch (N, 3) or (3,), in v's precision.
-    fn to_world<'py>(&self, py: Python<'py>, v: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn to_world<'py>(&self, py: Python<'py>, v: &Obj<'py>) -> PyResult<Obj<'py>> {
         with_precision!(v, F => self.apply::<F>(py, v, |f, x| f.to_world(x)))
     }
 
     /// First tangent(s), shape (3,) or (N, 3).
     #[getter]
-    fn s<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+    fn s<'py>(&self, py: Python<'py>) -> PyResult<Obj<'py>> {
         self.axis(py, |f| f.s)
     }
 
     /// Second tangent(s), shape (3,) or (N, 3).
     #[getter]
-    fn t<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+    fn t<'py>(&self, py: Python<'py>) -> PyResult<Obj<'py>> {
         self.axis(py, |f| f.t)
     }
 
     /// The unit normal(s), shape (3,) or (N, 3).
     #[getter]
-    fn n<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+    fn n<'py>(&self, py: Python<'py>) -> PyResult<Obj<'py>> {
         self.axis(py, |f| f.n)
     }
 

@@ -5,19 +5,20 @@
 use super::parallel::detached;
 use crate::error::{Error, shape_str};
 use crate::io::{self, Raster};
+use crate::python::Obj;
 use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use std::path::{Path, PathBuf};
 
-fn to_numpy<'py>(py: Python<'py>, raster: Raster) -> PyResult<Bound<'py, PyAny>> {
+fn to_numpy<'py>(py: Python<'py>, raster: Raster) -> PyResult<Obj<'py>> {
     let shape = [raster.height, raster.width, raster.channels];
     Ok(PyArray1::from_vec(py, raster.data)
         .reshape(shape)?
         .into_any())
 }
 
-fn from_numpy(image: &Bound<'_, PyAny>) -> PyResult<Raster> {
+fn from_numpy(image: &Obj<'_>) -> PyResult<Raster> {
     let array: PyArrayLikeDyn<'_, f32, AllowTypeChange> = image.extract()?;
     match *array.shape() {
         [height, width, channels @ (3 | 4)] if height > 0 && width > 0 => Ok(Raster {
@@ -47,7 +48,7 @@ fn from_numpy(image: &Bound<'_, PyAny>) -> PyResult<Raster> {
 /// ndarray, shape (H, W, 3), or (H, W, 4) if the file has alpha; float32
 /// linear RGB(A), row 0 at the top.
 #[pyfunction]
-pub fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+pub fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Obj<'py>> {
     let raster = detached(py, || io::read_exr(&path))?;
     to_numpy(py, raster)
 }
@@ -62,12 +63,7 @@ pub fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAn
 ///     Write 16-bit half floats instead of 32-bit floats.
 #[pyfunction]
 #[pyo3(signature = (path, image, half = false))]
-pub fn write_exr(
-    py: Python<'_>,
-    path: PathBuf,
-    image: &Bound<'_, PyAny>,
-    half: bool,
-) -> PyResult<()> {
+pub fn write_exr(py: Python<'_>, path: PathBuf, image: &Obj<'_>, half: bool) -> PyResult<()> {
     let raster = from_numpy(image)?;
     detached(py, || io::write_exr(&path, &raster, half))
 }
@@ -82,7 +78,7 @@ pub fn write_exr(
 /// -------
 /// ndarray, shape (H, W, 3), float32 linear RGB, row 0 at the top.
 #[pyfunction]
-pub fn read_hdr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+pub fn read_hdr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Obj<'py>> {
     let raster = detached(py, || io::read_hdr(&path))?;
     to_numpy(py, raster)
 }
@@ -105,7 +101,7 @@ pub fn read_hdr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAn
 pub fn write_png(
     py: Python<'_>,
     path: PathBuf,
-    image: &Bound<'_, PyAny>,
+    image: &Obj<'_>,
     exposure: f64,
     srgb: bool,
 ) -> PyResult<()> {
@@ -114,7 +110,7 @@ pub fn write_png(
 }
 
 /// The raster and exposure of a PNG to write, checked.
-fn png_input(image: &Bound<'_, PyAny>, exposure: f64) -> PyResult<(Raster, f32)> {
+fn png_input(image: &Obj<'_>, exposure: f64) -> PyResult<(Raster, f32)> {
     if !exposure.is_finite() {
         return Err(Error::Parameter {
             arg: "exposure",
@@ -140,7 +136,7 @@ fn png_input(image: &Bound<'_, PyAny>, exposure: f64) -> PyResult<(Raster, f32)>
 #[pyo3(signature = (image, exposure = 0.0, srgb = true))]
 pub fn encode_png<'py>(
     py: Python<'py>,
-    image: &Bound<'py, PyAny>,
+    image: &Obj<'py>,
     exposure: f64,
     srgb: bool,
 ) -> PyResult<Bound<'py, PyBytes>> {
@@ -168,13 +164,9 @@ pub fn encode_png<'py>(
 fn read_mesh<'py>(
     py: Python<'py>,
     path: PathBuf,
-) -> PyResult<(
-    Bound<'py, PyAny>,
-    Bound<'py, PyAny>,
-    Option<Bound<'py, PyAny>>,
-)> {
+) -> PyResult<(Obj<'py>, Obj<'py>, Option<Obj<'py>>)> {
     let mesh = detached(py, || crate::render::mesh_file::read_mesh(&path))?;
-    let rows3 = |v: Vec<[f64; 3]>| -> PyResult<Bound<'py, PyAny>> {
+    let rows3 = |v: Vec<[f64; 3]>| -> PyResult<Obj<'py>> {
         let n = v.len();
         Ok(PyArray1::from_vec(py, v.into_iter().flatten().collect())
             .reshape([n, 3])?

@@ -6,6 +6,7 @@ use super::batch::map_pair;
 use crate::error::Error;
 use crate::math::Real;
 use crate::mis;
+use crate::python::Obj;
 use pyo3::prelude::*;
 
 /// Balance heuristic p_a / (p_a + p_b): the MIS weight of a sample drawn by
@@ -24,9 +25,9 @@ use pyo3::prelude::*;
 #[pyfunction]
 pub fn balance_heuristic<'py>(
     py: Python<'py>,
-    pdf_a: &Bound<'py, PyAny>,
-    pdf_b: &Bound<'py, PyAny>,
-) -> PyResult<Bound<'py, PyAny>> {
+    pdf_a: &Obj<'py>,
+    pdf_b: &Obj<'py>,
+) -> PyResult<Obj<'py>> {
     heuristic(py, pdf_a, pdf_b, 1.0)
 }
 
@@ -45,10 +46,10 @@ pub fn balance_heuristic<'py>(
 #[pyo3(signature = (pdf_a, pdf_b, beta = 2.0))]
 pub fn power_heuristic<'py>(
     py: Python<'py>,
-    pdf_a: &Bound<'py, PyAny>,
-    pdf_b: &Bound<'py, PyAny>,
+    pdf_a: &Obj<'py>,
+    pdf_b: &Obj<'py>,
     beta: f64,
-) -> PyResult<Bound<'py, PyAny>> {
+) -> PyResult<Obj<'py>> {
     if !(beta > 0.0 && beta.is_finite()) {
         return Err(Error::Parameter {
             arg: "beta",
@@ -62,10 +63,10 @@ pub fn power_heuristic<'py>(
 
 fn heuristic<'py>(
     py: Python<'py>,
-    pdf_a: &Bound<'py, PyAny>,
-    pdf_b: &Bound<'py, PyAny>,
+    pdf_a: &Obj<'py>,
+    pdf_b: &Obj<'py>,
     beta: f64,
-) -> PyResult<Bound<'py, PyAny>> {
+) -> PyResult<Obj<'py>> {
     with_precision!(pdf_a, F => {
         let a = Points::<F, 1>::extract(pdf_a, "pdf_a")?;
         let b = Points::<F, 1>::extract(pdf_b, "pdf_b")?;

@@ -21,6 +21,13 @@ mod warp;
 
 use pyo3::prelude::*;
 
+/// Any Python object an argument or result may be (most arguments are
+/// array-likes converted in the function).
+pub type Obj<'py> = Bound<'py, PyAny>;
+
+/// The keyword `out` of the batch methods: an array to write into, or none.
+pub type Out<'a, 'py> = Option<&'a Obj<'py>>;
+
 fn submodule<'py>(
     parent: &Bound<'py, PyModule>,
     name: &str,

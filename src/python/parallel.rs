@@ -5,6 +5,7 @@
 use super::args::index_arg;
 use super::error::guarded;
 use crate::parallel::{self, MAX_THREADS, Outputs};
+use crate::python::Obj;
 use pyo3::prelude::*;
 use std::ops::Range;
 
@@ -34,7 +35,7 @@ where
 ///     From 1 to 1024. Overrides the ``MCSAMPLE_NUM_THREADS`` variable.
 ///     Results do not depend on it, only speed does.
 #[pyfunction]
-pub fn set_num_threads(n: &Bound<'_, PyAny>) -> PyResult<()> {
+pub fn set_num_threads(n: &Obj<'_>) -> PyResult<()> {
     let n = index_arg(n, "n", 1, MAX_THREADS as u64)? as usize;
     Ok(parallel::set_num_threads(n)?)
 }

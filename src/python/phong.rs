@@ -1,34 +1,15 @@
 //! `mcsample.Phong`: the energy-normalised Phong BRDF of [`crate::phong`],
 //! batched over directions.
 
-use super::args::choice;
-use super::arrays::{Check, Points, PyFloat, finish, result_shape, with_precision, zeros};
+use super::args::{choice, three_floats};
+use super::arrays::{Check, Points, PyFloat, result_shape, with_precision, zeros};
 use super::batch::{map_pair, pair_shape, run_batch_pair};
-use crate::error::Error;
 use crate::phong::{Phong, PhongSamples, Selection};
+use crate::python::Obj;
 use numpy::PyArrayMethods;
-use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 
 use super::records::record;
-
-/// An RGB reflectance: a number (grey) or three numbers.
-fn rgb(ob: &Bound<'_, PyAny>, arg: &'static str) -> PyResult<[f64; 3]> {
-    if let Ok(v) = ob.extract::<f64>() {
-        return Ok([v; 3]);
-    }
-    let values: Vec<f64> = ob.extract().map_err(|_| {
-        PyTypeError::new_err(format!("{arg} must be a number or three numbers (RGB)"))
-    })?;
-    values.try_into().map_err(|v: Vec<f64>| {
-        Error::Shape {
-            arg,
-            expected: "(3,) or a number".into(),
-            got: format!("({},)", v.len()),
-        }
-        .into()
-    })
-}
 
 record! {
     /// Samples of ``Phong.sample``.
@@ -73,10 +54,10 @@ impl PyPhong {
     fn pair<'py, F: PyFloat, const M: usize>(
         &self,
         py: Python<'py>,
-        wi: &Bound<'py, PyAny>,
-        wo: &Bound<'py, PyAny>,
+        wi: &Obj<'py>,
+        wo: &Obj<'py>,
         kernel: impl Fn(&Phong, [F; 3], [F; 3]) -> [F; M] + Sync + Send,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    ) -> PyResult<Obj<'py>> {
         let wi = Points::<F, 3>::extract(wi, "wi")?;
         let wo = Points::<F, 3>::extract(wo, "wo")?;
         let phong = &self.0;
@@ -91,8 +72,8 @@ impl PyPhong {
     #[new]
     #[pyo3(signature = (diffuse, specular, exponent, *, selection = "max"))]
     fn new(
-        diffuse: &Bound<'_, PyAny>,
-        specular: &Bound<'_, PyAny>,
+        diffuse: &Obj<'_>,
+        specular: &Obj<'_>,
         exponent: f64,
         selection: &str,
     ) -> PyResult<Self> {
@@ -101,7 +82,10 @@ impl PyPhong {
             selection,
             &[("max", Selection::Max), ("luminance", Selection::Luminance)],
         )?;
-        let (d, s) = (rgb(diffuse, "diffuse")?, rgb(specular, "specular")?);
+        let (d, s) = (
+            three_floats(diffuse, "diffuse", true)?,
+            three_floats(specular, "specular", true)?,
+        );
         Ok(Self(Phong::new(d, s, exponent, selection)?))
     }
 
@@ -115,12 +99,7 @@ impl PyPhong {
     /// Returns
     /// -------
     /// ndarray, shape (N, 3) or (3,), per steradian.
-    fn eval<'py>(
-        &self,
-        py: Python<'py>,
-        wi: &Bound<'py, PyAny>,
-        wo: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn eval<'py>(&self, py: Python<'py>, wi: &Obj<'py>, wo: &Obj<'py>) -> PyResult<Obj<'py>> {
         with_precision!(wo, F => self.pair::<F, 3>(py, wi, wo, |p, a, b| p.eval(a, b)))
     }
 
@@ -133,12 +112,7 @@ impl PyPhong {
     /// Returns
     /// -------
     /// ndarray, shape (N,) (a scalar for single directions).
-    fn pdf<'py>(
-        &self,
-        py: Python<'py>,
-        wi: &Bound<'py, PyAny>,
-        wo: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn pdf<'py>(&self, py: Python<'py>, wi: &Obj<'py>, wo: &Obj<'py>) -> PyResult<Obj<'py>> {
         with_precision!(wo, F => self.pair::<F, 1>(py, wi, wo, |p, a, b| [p.pdf(a, b)]))
     }
 
@@ -155,12 +129,7 @@ impl PyPhong {
     /// PhongSample
     ///     ``.wo`` (N, 3), ``.pdf`` (N,), ``.weight`` (N, 3), ``.component``
     ///     (N,) int64, in u's precision.
-    fn sample<'py>(
-        &self,
-        py: Python<'py>,
-        wi: &Bound<'py, PyAny>,
-        u: &Bound<'py, PyAny>,
-    ) -> PyResult<PyPhongSample> {
+    fn sample<'py>(&self, py: Python<'py>, wi: &Obj<'py>, u: &Obj<'py>) -> PyResult<PyPhongSample> {
         with_precision!(u, F => self.sample_as::<F>(py, wi, u))
     }
 
@@ -207,8 +176,8 @@ impl PyPhong {
     fn sample_as<'py, F: PyFloat>(
         &self,
         py: Python<'py>,
-        wi: &Bound<'py, PyAny>,
-        u: &Bound<'py, PyAny>,
+        wi: &Obj<'py>,
+        u: &Obj<'py>,
     ) -> PyResult<PyPhongSample> {
         let wi = Points::<F, 3>::extract(wi, "wi")?;
         let u = Points::<F, 3>::extract(u, "u")?;
@@ -274,11 +243,6 @@ impl PyPhong {
                 return Err(u.invalid(Check::Unit));
             }
         }
-        Ok(PyPhongSample {
-            wo: finish(wo)?.unbind(),
-            pdf: finish(pdf)?.unbind(),
-            weight: finish(weight)?.unbind(),
-            component: finish(component)?.unbind(),
-        })
+        PyPhongSample::finished(wo, pdf, weight, component)
     }
 }

@@ -57,17 +57,32 @@ macro_rules! record {
                 [$(stringify!($field)),+].len()
             }
 
-            fn __getitem__<'py>(&self, py: Python<'py>, index: isize) -> PyResult<Bound<'py, PyAny>> {
+            fn __getitem__<'py>(&self, py: Python<'py>, index: isize) -> PyResult<$crate::python::Obj<'py>> {
                 $crate::python::records::tuple(py, &[$(&self.$field),+])?
                     .as_any()
                     .get_item(index)
             }
 
-            fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+            fn __iter__<'py>(&self, py: Python<'py>) -> PyResult<$crate::python::Obj<'py>> {
                 Ok($crate::python::records::tuple(py, &[$(&self.$field),+])?
                     .as_any()
                     .try_iter()?
                     .into_any())
+            }
+        }
+
+        impl $rust {
+            /// The record of these values, in field order.
+            pub fn new($($field: $crate::python::Obj<'_>),+) -> Self {
+                Self { $($field: $field.unbind()),+ }
+            }
+
+            /// The record of freshly computed arrays, each through
+            /// [`finish`]($crate::python::arrays::finish).
+            pub fn finished<'py>(
+                $($field: Bound<'py, numpy::PyArrayDyn<impl numpy::Element>>),+
+            ) -> PyResult<Self> {
+                Ok(Self { $($field: $crate::python::arrays::finish($field)?.unbind()),+ })
             }
         }
     };

@@ -1,6 +1,7 @@
 //! `mcsample._core.render`: the scene builder, the compiled scene and the
 //! render call (GIL released, progress reported, Ctrl-C honoured).
 
+use crate::python::Obj;
 use std::sync::Arc;
 use std::sync::mpsc;
 use std::time::Duration;
@@ -180,8 +181,8 @@ impl PySceneBuilder {
         to_world: [[f64; 4]; 4],
         fov: f64,
         fov_axis: &str,
-        width: &Bound<'_, PyAny>,
-        height: &Bound<'_, PyAny>,
+        width: &Obj<'_>,
+        height: &Obj<'_>,
         near_clip: f64,
         far_clip: f64,
         aperture_radius: f64,
@@ -252,9 +253,9 @@ impl PyScene {
     fn sample_emitter<'py>(
         &self,
         py: Python<'py>,
-        x: &Bound<'py, PyAny>,
-        u: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+        x: &Obj<'py>,
+        u: &Obj<'py>,
+    ) -> PyResult<Obj<'py>> {
         let x = Points::<f64, 3>::extract(x, "x")?;
         let u = Points::<f64, 3>::extract(u, "u")?;
         let scene = &self.0;
@@ -272,12 +273,7 @@ impl PyScene {
     /// The density per steradian with which :meth:`sample_emitter` from
     /// points ``x`` (N, 3) or (3,) draws the unit directions ``d`` (N, 3)
     /// or (3,): float64 (N,) or a scalar.
-    fn emitter_pdf<'py>(
-        &self,
-        py: Python<'py>,
-        x: &Bound<'py, PyAny>,
-        d: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn emitter_pdf<'py>(&self, py: Python<'py>, x: &Obj<'py>, d: &Obj<'py>) -> PyResult<Obj<'py>> {
         let x = Points::<f64, 3>::extract(x, "x")?;
         let d = Points::<f64, 3>::extract(d, "d")?;
         let scene = &self.0;
@@ -304,15 +300,15 @@ impl PyScene {
 pub fn render<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyScene>,
-    spp: &Bound<'py, PyAny>,
-    seed: &Bound<'py, PyAny>,
+    spp: &Obj<'py>,
+    seed: &Obj<'py>,
     integrator: &str,
     strategy: &str,
     heuristic: &str,
-    max_depth: &Bound<'py, PyAny>,
-    rr_depth: &Bound<'py, PyAny>,
+    max_depth: &Obj<'py>,
+    rr_depth: &Obj<'py>,
     hide_emitters: bool,
-    callback: Option<Bound<'py, PyAny>>,
+    callback: Option<Obj<'py>>,
 ) -> PyResult<(
     Bound<'py, PyArray1<f32>>,
     Bound<'py, PyArray1<f32>>,

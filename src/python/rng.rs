@@ -4,6 +4,7 @@ use super::args::{index_arg, seed};
 use super::arrays::{finish, zeros};
 use super::parallel::detached;
 use crate::math::Real;
+use crate::python::Obj;
 use crate::rng::{MAX_STREAM, Rng};
 use numpy::{Element, PyArrayDescr, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods};
 use pyo3::exceptions::PyTypeError;
@@ -14,7 +15,7 @@ use pyo3::types::PyTuple;
 const MAX_COUNT: u64 = 1 << 40;
 
 /// The shape argument: None (one value), an int, or a sequence of ints.
-fn parse_shape(shape: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<usize>> {
+fn parse_shape(shape: Option<&Obj<'_>>) -> PyResult<Vec<usize>> {
     let Some(shape) = shape.filter(|s| !s.is_none()) else {
         return Ok(vec![]);
     };
@@ -45,7 +46,7 @@ fn parse_shape(shape: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<usize>> {
 
 /// Whether `dtype` (None, "float32", np.float32, ...) asks for float32;
 /// only float32 and float64 are offered.
-fn wants_float32(py: Python<'_>, dtype: Option<&Bound<'_, PyAny>>) -> PyResult<bool> {
+fn wants_float32(py: Python<'_>, dtype: Option<&Obj<'_>>) -> PyResult<bool> {
     let Some(dtype) = dtype.filter(|d| !d.is_none()) else {
         return Ok(false);
     };
@@ -67,7 +68,7 @@ fn random_array<'py, F: Element + Real>(
     py: Python<'py>,
     rng: &mut Rng,
     shape: &[usize],
-) -> PyResult<Bound<'py, PyAny>> {
+) -> PyResult<Obj<'py>> {
     let out: Bound<'py, PyArrayDyn<F>> = zeros(py, shape);
     {
         let mut guard = out.readwrite();
@@ -78,7 +79,7 @@ fn random_array<'py, F: Element + Real>(
 }
 
 /// The `stream` argument: 0 to [`MAX_STREAM`], or None for 0.
-fn stream_arg(ob: &Bound<'_, PyAny>) -> PyResult<u64> {
+fn stream_arg(ob: &Obj<'_>) -> PyResult<u64> {
     if ob.is_none() {
         return Ok(0);
     }
@@ -139,9 +140,9 @@ impl PyRng {
     fn random<'py>(
         &mut self,
         py: Python<'py>,
-        shape: Option<&Bound<'py, PyAny>>,
-        dtype: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+        shape: Option<&Obj<'py>>,
+        dtype: Option<&Obj<'py>>,
+    ) -> PyResult<Obj<'py>> {
         let shape = parse_shape(shape)?;
         if wants_float32(py, dtype)? {
             random_array::<f32>(py, &mut self.rng, &shape)
@@ -163,8 +164,8 @@ impl PyRng {
     fn next_uint32<'py>(
         &mut self,
         py: Python<'py>,
-        shape: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+        shape: Option<&Obj<'py>>,
+    ) -> PyResult<Obj<'py>> {
         let shape = parse_shape(shape)?;
         let out: Bound<'py, PyArrayDyn<u32>> = zeros(py, &shape);
         {
@@ -177,7 +178,7 @@ impl PyRng {
     }
 
     /// Skips ``n`` outputs (0 <= n < 2**64) in O(log n) steps.
-    fn advance(&mut self, n: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn advance(&mut self, n: &Obj<'_>) -> PyResult<()> {
         self.rng.advance(index_arg(n, "n", 0, u64::MAX)?);
         Ok(())
     }
@@ -203,7 +204,7 @@ impl PyRng {
         self.clone()
     }
 
-    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Self {
+    fn __deepcopy__(&self, _memo: &Obj<'_>) -> Self {
         self.clone()
     }
 
@@ -213,7 +214,7 @@ impl PyRng {
 }
 
 /// The `dim` argument of [`uniform`]: 0 to 2²⁰, or None for 2.
-fn dim_arg(ob: &Bound<'_, PyAny>) -> PyResult<usize> {
+fn dim_arg(ob: &Obj<'_>) -> PyResult<usize> {
     if ob.is_none() {
         return Ok(2);
     }
@@ -240,11 +241,11 @@ fn dim_arg(ob: &Bound<'_, PyAny>) -> PyResult<usize> {
 #[pyo3(signature = (n, dim = 2, seed = 0, dtype = None))]
 pub fn uniform<'py>(
     py: Python<'py>,
-    n: &Bound<'py, PyAny>,
+    n: &Obj<'py>,
     #[pyo3(from_py_with = dim_arg)] dim: usize,
     #[pyo3(from_py_with = seed)] seed: u64,
-    dtype: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyAny>> {
+    dtype: Option<&Obj<'py>>,
+) -> PyResult<Obj<'py>> {
     let n = index_arg(n, "n", 0, MAX_COUNT)? as usize;
     let shape = [n, dim];
     parse_shape(Some(&PyTuple::new(py, shape)?.into_any()))?;

@@ -8,6 +8,7 @@ use super::arrays::{Check, Points, PyFloat, with_precision};
 use super::batch::map_into;
 use crate::error::Error;
 use crate::math::Real;
+use crate::python::{Obj, Out};
 use crate::warp;
 use pyo3::prelude::*;
 
@@ -27,10 +28,10 @@ macro_rules! batch_fn {
         $(#[$meta])*
         pub fn $name<'py>(
             py: Python<'py>,
-            $x: &Bound<'py, PyAny>
+            $x: &Obj<'py>
             $(, $p: $pty)*,
-            out: Option<&Bound<'py, PyAny>>,
-        ) -> PyResult<Bound<'py, PyAny>> {
+            out: Out<'_, 'py>,
+        ) -> PyResult<Obj<'py>> {
             with_precision!($x, $F => {
                 let points = Points::<$F, $k>::extract($x, stringify!($x))?;
                 map_into(py, &points, Check::$check, out, $kernel)
@@ -240,10 +241,10 @@ batch_fn! {
 #[pyo3(signature = (u, method = "concentric", *, out = None))]
 pub fn square_to_cosine_hemisphere<'py>(
     py: Python<'py>,
-    u: &Bound<'py, PyAny>,
+    u: &Obj<'py>,
     method: &str,
-    out: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyAny>> {
+    out: Out<'_, 'py>,
+) -> PyResult<Obj<'py>> {
     with_precision!(u, F => by_method(
         py, u, "u", Check::Unit, method, out,
         warp::square_to_cosine_hemisphere_polar::<F>,
@@ -257,14 +258,14 @@ pub fn square_to_cosine_hemisphere<'py>(
 #[allow(clippy::too_many_arguments)]
 fn by_method<'py, F: PyFloat, const K: usize, const M: usize, P, C>(
     py: Python<'py>,
-    x: &Bound<'py, PyAny>,
+    x: &Obj<'py>,
     arg: &'static str,
     check: Check,
     method: &str,
-    out: Option<&Bound<'py, PyAny>>,
+    out: Out<'_, 'py>,
     polar: P,
     concentric: C,
-) -> PyResult<Bound<'py, PyAny>>
+) -> PyResult<Obj<'py>>
 where
     // Generic (not fn pointers), so that the kernels stay inlined into the
     // vectorised loop.
@@ -306,10 +307,10 @@ batch_fn! {
 #[pyo3(signature = (x, method = "concentric", *, out = None))]
 pub fn cosine_hemisphere_to_square<'py>(
     py: Python<'py>,
-    x: &Bound<'py, PyAny>,
+    x: &Obj<'py>,
     method: &str,
-    out: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyAny>> {
+    out: Out<'_, 'py>,
+) -> PyResult<Obj<'py>> {
     with_precision!(x, F => by_method(
         py, x, "x", Check::Finite, method, out,
         warp::cosine_hemisphere_to_square_polar::<F>,

@@ -278,6 +278,23 @@ where
     ok
 }
 
+/// Runs the permute `$call` of [`lanes`] and returns `true` from the
+/// enclosing function when `$level` is AVX-512 and [`lanes::handles`]
+/// `$n` components of `$T`; does nothing otherwise (and on other CPUs).
+macro_rules! permute_on_avx512 {
+    ($level:expr, $T:ty, $n:expr, $call:expr) => {
+        #[cfg(target_arch = "x86_64")]
+        if $level == Level::Avx512 && lanes::handles::<$T>($n, BLOCK) {
+            #[allow(unsafe_code)]
+            // SAFETY: `level` reports AVX-512 only when the CPU has AVX-512 F.
+            unsafe {
+                $call;
+            }
+            return true;
+        }
+    };
+}
+
 /// [`lanes::rows_to_columns`] where the CPU and the shape allow; returns
 /// whether it ran.
 #[inline(always)]
@@ -286,15 +303,7 @@ fn permute_rows_to_columns<F: Copy, const K: usize>(
     columns: &mut [[F; BLOCK]; K],
     level: Level,
 ) -> bool {
-    #[cfg(target_arch = "x86_64")]
-    if level == Level::Avx512 && lanes::handles::<F>(K, BLOCK) {
-        #[allow(unsafe_code)]
-        // SAFETY: `level` reports AVX-512 only when the CPU has AVX-512 F.
-        unsafe {
-            lanes::rows_to_columns(rows, columns);
-        }
-        return true;
-    }
+    permute_on_avx512!(level, F, K, lanes::rows_to_columns(rows, columns));
     let _ = (rows, columns, level);
     false
 }
@@ -308,15 +317,7 @@ fn permute_columns_to_rows<T: Copy, const M: usize>(
     level: Level,
     stream: bool,
 ) -> bool {
-    #[cfg(target_arch = "x86_64")]
-    if level == Level::Avx512 && lanes::handles::<T>(M, BLOCK) {
-        #[allow(unsafe_code)]
-        // SAFETY: `level` reports AVX-512 only when the CPU has AVX-512 F.
-        unsafe {
-            lanes::columns_to_rows(columns, rows, stream);
-        }
-        return true;
-    }
+    permute_on_avx512!(level, T, M, lanes::columns_to_rows(columns, rows, stream));
     let _ = (columns, rows, level, stream);
     false
 }

@@ -1,7 +1,7 @@
 """Type stub of mcsample's compiled core (``mcsample._core``)."""
 
 import os
-from typing import Any, Iterator, Literal, Sequence, Union, final
+from typing import Any, Final, Iterator, Literal, Sequence, Union, final
 
 import numpy as np
 from numpy.typing import ArrayLike, DTypeLike, NDArray
@@ -35,10 +35,8 @@ class Rng:
         """Raw 32-bit outputs of ``shape`` (uint32)."""
     def advance(self, n: int) -> None:
         """Skips ``n`` outputs in O(log n)."""
-    @property
-    def seed(self) -> int: ...
-    @property
-    def stream(self) -> int: ...
+    seed: Final[int]
+    stream: Final[int]
     def copy(self) -> Rng: ...
     def __copy__(self) -> Rng: ...
     def __deepcopy__(self, memo: Any) -> Rng: ...
@@ -65,19 +63,15 @@ class _Record:
 class PiecewiseSample(_Record):
     """Draws of a piecewise-constant density; unpacks as (x, pdf)."""
 
-    @property
-    def x(self) -> _Floats: ...
-    @property
-    def pdf(self) -> _Floats: ...
+    x: Final[_Floats]
+    pdf: Final[_Floats]
 
 @final
 class ReusedSample(_Record):
     """Draws of Discrete1D / Discrete2D.sample_reuse; unpacks as (index, u)."""
 
-    @property
-    def index(self) -> _Ints: ...
-    @property
-    def u(self) -> _Floats: ...
+    index: Final[_Ints]
+    u: Final[_Floats]
 
 @final
 class Discrete1D:
@@ -90,10 +84,8 @@ class Discrete1D:
         """Indices and u rescaled to [0, 1) within the chosen entry."""
     def pmf(self, i: ArrayLike | None = None) -> _Floats:
         """w[i] / sum (all entries when i is None)."""
-    @property
-    def cdf(self) -> NDArray[np.float64]: ...
-    @property
-    def sum(self) -> float: ...
+    cdf: Final[NDArray[np.float64]]
+    sum: Final[float]
     def __len__(self) -> int: ...
 
 @final
@@ -103,8 +95,7 @@ class AliasTable:
     def __new__(cls, weights: ArrayLike) -> AliasTable: ...
     def sample(self, u: ArrayLike) -> _Ints: ...
     def pmf(self, i: ArrayLike | None = None) -> _Floats: ...
-    @property
-    def sum(self) -> float: ...
+    sum: Final[float]
     def __len__(self) -> int: ...
 
 @final
@@ -116,10 +107,8 @@ class Discrete2D:
         """(N, 2) int64 (row, col): the row by u[:, 1], the column by u[:, 0]."""
     def sample_reuse(self, u: ArrayLike) -> ReusedSample: ...
     def pmf(self, idx: ArrayLike | None = None) -> _Floats: ...
-    @property
-    def shape(self) -> tuple[int, int]: ...
-    @property
-    def sum(self) -> float: ...
+    shape: Final[tuple[int, int]]
+    sum: Final[float]
 
 @final
 class PiecewiseConstant1D:
@@ -131,10 +120,8 @@ class PiecewiseConstant1D:
     def pdf(self, x: ArrayLike) -> _Floats: ...
     def cdf(self, x: ArrayLike) -> _Floats: ...
     def invert(self, x: ArrayLike) -> _Floats: ...
-    @property
-    def domain(self) -> tuple[float, float]: ...
-    @property
-    def integral(self) -> float: ...
+    domain: Final[tuple[float, float]]
+    integral: Final[float]
     def __len__(self) -> int: ...
 
 @final
@@ -148,12 +135,9 @@ class PiecewiseConstant2D:
         """Points x (N, 2) and pdf (N,); unpacks as (x, pdf)."""
     def pdf(self, xy: ArrayLike) -> _Floats: ...
     def invert(self, xy: ArrayLike) -> _Floats: ...
-    @property
-    def domain(self) -> tuple[tuple[float, float], tuple[float, float]]: ...
-    @property
-    def shape(self) -> tuple[int, int]: ...
-    @property
-    def integral(self) -> float: ...
+    domain: Final[tuple[tuple[float, float], tuple[float, float]]]
+    shape: Final[tuple[int, int]]
+    integral: Final[float]
 
 @final
 class Frame:
@@ -162,26 +146,19 @@ class Frame:
     def __new__(cls, normal: ArrayLike) -> Frame: ...
     def to_local(self, v: ArrayLike) -> _Floats: ...
     def to_world(self, v: ArrayLike) -> _Floats: ...
-    @property
-    def s(self) -> _Floats: ...
-    @property
-    def t(self) -> _Floats: ...
-    @property
-    def n(self) -> _Floats: ...
+    s: Final[_Floats]
+    t: Final[_Floats]
+    n: Final[_Floats]
     def __len__(self) -> int: ...
 
 @final
 class PhongSample(_Record):
     """Samples of Phong.sample."""
 
-    @property
-    def wo(self) -> _Floats: ...
-    @property
-    def pdf(self) -> _Floats: ...
-    @property
-    def weight(self) -> _Floats: ...
-    @property
-    def component(self) -> _Ints: ...
+    wo: Final[_Floats]
+    pdf: Final[_Floats]
+    weight: Final[_Floats]
+    component: Final[_Ints]
 
 @final
 class Phong:
@@ -194,25 +171,18 @@ class Phong:
     def pdf(self, wi: ArrayLike, wo: ArrayLike) -> _Floats:
         """Density of sample per steradian, (N,)."""
     def sample(self, wi: ArrayLike, u: ArrayLike) -> PhongSample: ...
-    @property
-    def diffuse_probability(self) -> float: ...
-    @property
-    def diffuse(self) -> list[float]: ...
-    @property
-    def specular(self) -> list[float]: ...
-    @property
-    def exponent(self) -> float: ...
+    diffuse_probability: Final[float]
+    diffuse: Final[list[float]]
+    specular: Final[list[float]]
+    exponent: Final[float]
 
 @final
 class EnvSample(_Record):
     """Samples of EnvMap.sample."""
 
-    @property
-    def direction(self) -> _Floats: ...
-    @property
-    def pdf(self) -> _Floats: ...
-    @property
-    def weight(self) -> _Floats: ...
+    direction: Final[_Floats]
+    pdf: Final[_Floats]
+    weight: Final[_Floats]
 
 @final
 class EnvMap:
@@ -223,8 +193,8 @@ class EnvMap:
     def __new__(cls, image: ArrayLike | None = None, *, mapping: _Mapping = "latlong",
                 to_world: Any = None, scale: float = 1.0, sampling: _Sampling = "piecewise",
                 compensate: bool = False) -> EnvMap: ...
-    @staticmethod
-    def load(path: str | os.PathLike[str], *, mapping: _Mapping = "latlong", to_world: Any = None,
+    @classmethod
+    def load(cls, path: str | os.PathLike[str], *, mapping: _Mapping = "latlong", to_world: Any = None,
              scale: float = 1.0, sampling: _Sampling = "piecewise",
              compensate: bool = False) -> EnvMap:
         """Reads an OpenEXR or Radiance .hdr file."""
@@ -240,15 +210,9 @@ class EnvMap:
         """World directions of map coordinates, (N, 3)."""
     def convert(self, mapping: _Mapping, resolution: int | tuple[int, int]) -> EnvMap: ...
     def _repr_png_(self) -> bytes: ...
-    @property
-    def image(self) -> NDArray[np.float32]: ...
-    @property
-    def mapping(self) -> _Mapping: ...
-    @property
-    def sampling(self) -> _Sampling: ...
-    @property
-    def scale(self) -> float: ...
-    @property
-    def compensate(self) -> bool: ...
-    @property
-    def to_world(self) -> NDArray[np.float64]: ...
+    image: Final[NDArray[np.float32]]
+    mapping: Final[_Mapping]
+    sampling: Final[_Sampling]
+    scale: Final[float]
+    compensate: Final[bool]
+    to_world: Final[NDArray[np.float64]]

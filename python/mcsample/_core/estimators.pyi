@@ -1,6 +1,6 @@
 """Estimators of irradiance and reflected radiance under an environment map."""
 
-from typing import Literal, final
+from typing import Final, Literal, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -13,14 +13,10 @@ _Strategy = Literal["uniform", "cosine", "bsdf", "emitter", "envmap", "mis"]
 class Estimate:
     """A Monte Carlo estimate of an RGB quantity."""
 
-    @property
-    def value(self) -> NDArray[np.float64]: ...
-    @property
-    def stderr(self) -> NDArray[np.float64]: ...
-    @property
-    def n(self) -> int: ...
-    @property
-    def strategy(self) -> str: ...
+    value: Final[NDArray[np.float64]]
+    stderr: Final[NDArray[np.float64]]
+    n: Final[int]
+    strategy: Final[str]
 
 def irradiance(env: EnvMap, normal: ArrayLike, n: int, *, strategy: _Strategy = "mis",
                seed: int | np.random.Generator | None = 0,

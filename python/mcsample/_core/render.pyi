@@ -1,7 +1,7 @@
 """Stub of ``mcsample._core.render``: see ``mcsample.scene`` and
 ``mcsample.rendering`` for the docs."""
 
-from typing import Callable, Literal, Sequence, final
+from typing import Callable, Final, Literal, Sequence, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -30,8 +30,7 @@ class SceneBuilder:
 
 @final
 class CompiledScene:
-    @property
-    def film(self) -> tuple[int, int]: ...
+    film: Final[tuple[int, int]]
     def sample_emitter(self, x: ArrayLike, u: ArrayLike) -> NDArray[np.float64]: ...
     def emitter_pdf(self, x: ArrayLike, d: ArrayLike) -> NDArray[np.float64] | float: ...
 

@@ -4,6 +4,7 @@
 use crate::envmap::{Mapping, Matrix3, Options, Sampling};
 use crate::error::{Error, shape_str};
 use crate::io;
+use crate::python::Obj;
 use crate::python::args::choice;
 use numpy::{AllowTypeChange, PyArrayLikeDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
@@ -25,7 +26,7 @@ fn sampling_arg(name: &str) -> PyResult<Sampling> {
 /// `to_world` as a 3×3 rotation: None (identity), a 3×3 or 4×4 array-like
 /// (translation ignored) or an object with a ``matrix`` (a Mitsuba
 /// transform).
-fn to_world_arg(ob: Option<&Bound<'_, PyAny>>) -> PyResult<Matrix3> {
+fn to_world_arg(ob: Option<&Obj<'_>>) -> PyResult<Matrix3> {
     let Some(ob) = ob.filter(|o| !o.is_none()) else {
         return Ok(Options::default().to_world);
     };
@@ -76,7 +77,7 @@ fn to_world_arg(ob: Option<&Bound<'_, PyAny>>) -> PyResult<Matrix3> {
 /// The texels of `image` for `mapping` as `(width, height, array)`: shape
 /// `(H, W, 3)`, or `(6, R, R, 3)` for cube maps (faces stacked).
 pub fn image_arg<'py>(
-    image: &Bound<'py, PyAny>,
+    image: &Obj<'py>,
     mapping: Mapping,
 ) -> PyResult<(usize, usize, PyArrayLikeDyn<'py, f32, AllowTypeChange>)> {
     let array: PyArrayLikeDyn<'py, f32, AllowTypeChange> = image
@@ -153,7 +154,7 @@ pub struct Settings {
 /// option among its names, `to_world` a finite 3×3 or 4×4 matrix.
 pub fn settings(
     mapping: &str,
-    to_world: Option<&Bound<'_, PyAny>>,
+    to_world: Option<&Obj<'_>>,
     scale: f64,
     sampling: &str,
     compensate: bool,

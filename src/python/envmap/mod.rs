@@ -5,17 +5,18 @@ mod input;
 
 use super::args::index_arg;
 use super::arrays::{Check, Points, PyFloat, finish, output, with_precision, writable};
-use super::batch::{map, map_each};
+use super::batch::{map_each, map_into};
 use super::parallel::{detached, run_batch};
 use super::records::record;
 use crate::envmap::{EnvMap, EnvSamples, Mapping, Options, TableFloat};
 use crate::error::Error;
 use crate::io::Raster;
+use crate::python::{Obj, Out};
 use input::{image_arg, mapping_arg, read_image, settings};
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::PyBytes;
+use pyo3::types::{PyBytes, PyDict, PyType};
 use std::path::PathBuf;
 
 /// A float type the envmap bindings compute in: a [`PyFloat`] whose
@@ -72,16 +73,13 @@ pub struct PyEnvMap(EnvMap);
 
 /// The three arrays of `EnvMap.sample`'s `out` (direction, pdf, weight), or
 /// none.
-fn sample_outputs<'py>(
-    out: Option<&Bound<'py, PyAny>>,
-) -> PyResult<[Option<Bound<'py, PyAny>>; 3]> {
+fn sample_outputs<'py>(out: Out<'_, 'py>) -> PyResult<[Option<Obj<'py>>; 3]> {
     let Some(out) = out.filter(|o| !o.is_none()) else {
         return Ok([None, None, None]);
     };
-    let (d, p, w): (Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>) =
-        out.extract().map_err(|_| {
-            PyTypeError::new_err("out must be a tuple of three arrays: (direction, pdf, weight)")
-        })?;
+    let (d, p, w): (Obj<'py>, Obj<'py>, Obj<'py>) = out.extract().map_err(|_| {
+        PyTypeError::new_err("out must be a tuple of three arrays: (direction, pdf, weight)")
+    })?;
     Ok([Some(d), Some(p), Some(w)])
 }
 
@@ -100,9 +98,9 @@ impl PyEnvMap {
     fn directions<'py, F: EnvFloat, const M: usize>(
         &self,
         py: Python<'py>,
-        d: &Bound<'py, PyAny>,
+        d: &Obj<'py>,
         kernel: impl Fn(&EnvMap, [f64; 3]) -> [f64; M] + Sync + Send,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    ) -> PyResult<Obj<'py>> {
         let d = Points::<F, 3>::extract(d, "d")?;
         let env = &self.0;
         map_each(py, &d, Check::Finite, |x: [F; 3]| {
@@ -117,10 +115,10 @@ impl PyEnvMap {
     fn batch_as<'py, F: EnvFloat, const M: usize>(
         &self,
         py: Python<'py>,
-        d: &Bound<'py, PyAny>,
-        out: Option<&Bound<'py, PyAny>>,
+        d: &Obj<'py>,
+        out: Out<'_, 'py>,
         kernel: impl Fn(&EnvMap, &[[F; 3]], &mut [[F; M]]) -> bool + Sync + Send,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    ) -> PyResult<Obj<'py>> {
         let d = Points::<F, 3>::extract(d, "d")?;
         let out = output::<F>(py, &d.out_shape(M), out, "out")?;
         {
@@ -143,8 +141,8 @@ impl PyEnvMap {
     fn sample_as<'py, F: EnvFloat>(
         &self,
         py: Python<'py>,
-        u: &Bound<'py, PyAny>,
-        out: Option<&Bound<'py, PyAny>>,
+        u: &Obj<'py>,
+        out: Out<'_, 'py>,
     ) -> PyResult<PyEnvSample> {
         let u = Points::<F, 2>::extract(u, "u")?;
         let (vec_shape, scalar_shape) = (u.out_shape(3), u.out_shape(1));
@@ -181,22 +179,14 @@ impl PyEnvMap {
                 return Err(u.invalid(Check::Unit));
             }
         }
-        Ok(PyEnvSample {
-            direction: finish(direction)?.unbind(),
-            pdf: finish(pdf)?.unbind(),
-            weight: finish(weight)?.unbind(),
-        })
+        PyEnvSample::finished(direction, pdf, weight)
     }
 
-    fn uv_to_dir_as<'py, F: EnvFloat>(
-        &self,
-        py: Python<'py>,
-        uv: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn uv_to_dir_as<'py, F: EnvFloat>(&self, py: Python<'py>, uv: &Obj<'py>) -> PyResult<Obj<'py>> {
         let uv = Points::<F, 2>::extract(uv, "uv")?;
         let env = &self.0;
         let bounds = [[0.0, 1.0], [0.0, env.options().mapping.t_max()]];
-        map(py, &uv, Check::Within(bounds), |p: [F; 2]| {
+        map_into(py, &uv, Check::Within(bounds), None, |p: [F; 2]| {
             env.uv_to_dir(p.map(F::f64)).map(F::c)
         })
     }
@@ -208,9 +198,9 @@ impl PyEnvMap {
     #[pyo3(signature = (image = None, *, mapping = "latlong", to_world = None, scale = 1.0, sampling = "piecewise", compensate = false))]
     fn new(
         py: Python<'_>,
-        image: Option<&Bound<'_, PyAny>>,
+        image: Option<&Obj<'_>>,
         mapping: &str,
-        to_world: Option<&Bound<'_, PyAny>>,
+        to_world: Option<&Obj<'_>>,
         scale: f64,
         sampling: &str,
         compensate: bool,
@@ -247,23 +237,38 @@ impl PyEnvMap {
     /// (alpha is dropped). Cube maps are a strip of six square faces,
     /// vertical (6R x R) or horizontal (R x 6R), in the order +x, -x, +y,
     /// -y, +z, -z. The other parameters are as for ``EnvMap``, and
-    /// keyword-only.
+    /// keyword-only (and checked as ``EnvMap`` checks them).
     ///
     /// Raises OSError naming the path for a file that cannot be read.
-    #[staticmethod]
-    #[pyo3(signature = (path, *, mapping = "latlong", to_world = None, scale = 1.0, sampling = "piecewise", compensate = false))]
-    fn load(
-        py: Python<'_>,
+    #[classmethod]
+    #[pyo3(
+        signature = (path, **options),
+        text_signature = "(path, *, mapping='latlong', to_world=None, scale=1.0, sampling='piecewise', compensate=False)"
+    )]
+    fn load<'py>(
+        cls: &Bound<'py, PyType>,
         path: PathBuf,
-        mapping: &str,
-        to_world: Option<&Bound<'_, PyAny>>,
-        scale: f64,
-        sampling: &str,
-        compensate: bool,
-    ) -> PyResult<Self> {
-        let s = settings(mapping, to_world, scale, sampling, compensate)?;
-        let (w, h, data) = detached(py, || read_image(&path, s.mapping))?;
-        Self::build(py, w, h, &data, s.options)
+        options: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Obj<'py>> {
+        let py = cls.py();
+        let mapping = match options
+            .map(|o| o.get_item("mapping"))
+            .transpose()?
+            .flatten()
+        {
+            Some(name) => mapping_arg(&name.extract::<String>()?)?,
+            None => Mapping::LatLong,
+        };
+        let (w, h, data) = detached(py, || read_image(&path, mapping))?;
+        // The constructor's layout: (6, R, R, 3) for a cube map's stacked
+        // faces, (H, W, 3) otherwise.
+        let shape = if mapping == Mapping::Cube {
+            vec![6, w, w, 3]
+        } else {
+            vec![h, w, 3]
+        };
+        let image = PyArray1::from_vec(py, data).reshape(shape)?;
+        cls.call((image,), options)
     }
 
     /// Radiance arriving from world directions d, per RGB channel.
@@ -281,12 +286,7 @@ impl PyEnvMap {
     /// it: for float32 directions the place on the map is good to a few
     /// float32 ulps, as in Mitsuba's float32 variants).
     #[pyo3(signature = (d, *, out = None))]
-    fn eval<'py>(
-        &self,
-        py: Python<'py>,
-        d: &Bound<'py, PyAny>,
-        out: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn eval<'py>(&self, py: Python<'py>, d: &Obj<'py>, out: Out<'_, 'py>) -> PyResult<Obj<'py>> {
         with_precision!(d, F => self.batch_as::<F, 3>(py, d, out, |env, d, out| {
             env.eval_into(d, out, finite::<F>)
         }))
@@ -304,12 +304,7 @@ impl PyEnvMap {
     /// -------
     /// ndarray, shape (N,) (a scalar for one direction), in d's precision.
     #[pyo3(signature = (d, *, out = None))]
-    fn pdf<'py>(
-        &self,
-        py: Python<'py>,
-        d: &Bound<'py, PyAny>,
-        out: Option<&Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn pdf<'py>(&self, py: Python<'py>, d: &Obj<'py>, out: Out<'_, 'py>) -> PyResult<Obj<'py>> {
         with_precision!(d, F => self.batch_as::<F, 1>(py, d, out, |env, d, out| {
             env.pdf_into(d, out.as_flattened_mut(), finite::<F>)
         }))
@@ -334,8 +329,8 @@ impl PyEnvMap {
     fn sample<'py>(
         &self,
         py: Python<'py>,
-        u: &Bound<'py, PyAny>,
-        out: Option<&Bound<'py, PyAny>>,
+        u: &Obj<'py>,
+        out: Out<'_, 'py>,
     ) -> PyResult<PyEnvSample> {
         with_precision!(u, F => self.sample_as::<F>(py, u, out))
     }
@@ -352,11 +347,7 @@ impl PyEnvMap {
     /// Returns
     /// -------
     /// ndarray, shape (N, 2) or (2,).
-    fn dir_to_uv<'py>(
-        &self,
-        py: Python<'py>,
-        d: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn dir_to_uv<'py>(&self, py: Python<'py>, d: &Obj<'py>) -> PyResult<Obj<'py>> {
         with_precision!(d, F => self.directions::<F, 2>(py, d, |e, x| e.dir_to_uv(x)))
     }
 
@@ -370,11 +361,7 @@ impl PyEnvMap {
     /// Returns
     /// -------
     /// ndarray, shape (N, 3) or (3,), unit vectors.
-    fn uv_to_dir<'py>(
-        &self,
-        py: Python<'py>,
-        uv: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn uv_to_dir<'py>(&self, py: Python<'py>, uv: &Obj<'py>) -> PyResult<Obj<'py>> {
         with_precision!(uv, F => self.uv_to_dir_as::<F>(py, uv))
     }
 
@@ -392,15 +379,10 @@ impl PyEnvMap {
     /// -------
     /// EnvMap with the same to_world, scale and compensate (and sampling,
     /// where the new mapping has it).
-    fn convert(
-        &self,
-        py: Python<'_>,
-        mapping: &str,
-        resolution: &Bound<'_, PyAny>,
-    ) -> PyResult<Self> {
+    fn convert(&self, py: Python<'_>, mapping: &str, resolution: &Obj<'_>) -> PyResult<Self> {
         let mapping = mapping_arg(mapping)?;
-        let side = |ob: &Bound<'_, PyAny>| index_arg(ob, "resolution", 1, 1 << 15);
-        let (w, h) = match resolution.extract::<(Bound<'_, PyAny>, Bound<'_, PyAny>)>() {
+        let side = |ob: &Obj<'_>| index_arg(ob, "resolution", 1, 1 << 15);
+        let (w, h) = match resolution.extract::<(Obj<'_>, Obj<'_>)>() {
             Ok((h, w)) if mapping == Mapping::LatLong => (side(&w)? as usize, side(&h)? as usize),
             Ok(_) => {
                 return Err(PyTypeError::new_err(
@@ -431,7 +413,7 @@ impl PyEnvMap {
     /// The texels, float32: (H, W, 3), or (6, R, R, 3) for cube maps (tiny
     /// lat-long maps as padded).
     #[getter]
-    fn image<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+    fn image<'py>(&self, py: Python<'py>) -> PyResult<Obj<'py>> {
         let img = self.0.image();
         let flat: Vec<f32> = img.texels().iter().flatten().copied().collect();
         let array = PyArray1::from_vec(py, flat);
@@ -468,7 +450,7 @@ impl PyEnvMap {
 
     /// The local-to-world rotation, (3, 3) float64.
     #[getter]
-    fn to_world<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+    fn to_world<'py>(&self, py: Python<'py>) -> PyResult<Obj<'py>> {
         let m = self.0.options().to_world;
         Ok(PyArray1::from_vec(py, m.concat())
             .reshape([3, 3])?
