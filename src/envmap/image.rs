@@ -247,13 +247,25 @@ mod tests {
     }
 
     #[test]
-    fn latlong_texel_centres_and_pole_rows() {
-        let img = Image::new(Mapping::LatLong, 4, 3, &ramp(4, 3)).unwrap();
-        assert_eq!(img.lookup(Mapping::LatLong, [0.125, 0.0])[0], 0.0);
-        assert_eq!(img.lookup(Mapping::LatLong, [0.375, 0.5])[0], 5.0);
-        assert_eq!(img.lookup(Mapping::LatLong, [0.875, 1.0])[0], 11.0);
-        // Periodic in s: half way between the last column and the first.
-        assert_eq!(img.lookup(Mapping::LatLong, [0.0, 0.0])[0], 1.5);
+    fn lookups_at_texel_centres_poles_edges_and_the_angular_circle() {
+        // Lat-long 4 × 3: texel centres and pole rows, periodic in s (s = 0
+        // is half way between the last column and the first). Angular 2 × 2:
+        // clamped edges, 0 outside the circle.
+        let cases = [
+            (Mapping::LatLong, (4, 3), [0.125, 0.0], 0.0),
+            (Mapping::LatLong, (4, 3), [0.375, 0.5], 5.0),
+            (Mapping::LatLong, (4, 3), [0.875, 1.0], 11.0),
+            (Mapping::LatLong, (4, 3), [0.0, 0.0], 1.5),
+            (Mapping::Angular, (2, 2), [0.25, 0.25], 0.0),
+            (Mapping::Angular, (2, 2), [0.5, 0.5], 1.5),
+            (Mapping::Angular, (2, 2), [0.0, 0.0], 0.0),
+            (Mapping::Angular, (2, 2), [0.99, 0.99], 0.0),
+            (Mapping::Angular, (2, 2), [0.8, 0.5], 2.0),
+        ];
+        for (mapping, (w, h), p, value) in cases {
+            let img = Image::new(mapping, w, h, &ramp(w, h)).unwrap();
+            assert_eq!(img.lookup(mapping, p)[0], value, "{mapping:?} at {p:?}");
+        }
     }
 
     #[test]
@@ -277,16 +289,6 @@ mod tests {
                 );
             }
         }
-    }
-
-    #[test]
-    fn clamped_edges_and_the_angular_circle() {
-        let img = Image::new(Mapping::Angular, 2, 2, &ramp(2, 2)).unwrap();
-        assert_eq!(img.lookup(Mapping::Angular, [0.25, 0.25])[0], 0.0);
-        assert_eq!(img.lookup(Mapping::Angular, [0.5, 0.5])[0], 1.5);
-        assert_eq!(img.lookup(Mapping::Angular, [0.0, 0.0])[0], 0.0);
-        assert_eq!(img.lookup(Mapping::Angular, [0.99, 0.99])[0], 0.0);
-        assert_eq!(img.lookup(Mapping::Angular, [0.8, 0.5])[0], 2.0);
     }
 
     #[test]

@@ -195,7 +195,15 @@ index_table_methods!(PyAliasTable, distr::AliasTable, "AliasTable", {});
 /// weights : array_like, shape (rows, cols)
 ///     Finite, >= 0, not all zero.
 #[pyclass(module = "mcsample._core", name = "Discrete2D", frozen)]
-pub struct PyDiscrete2D(distr::Discrete2D);
+pub struct PyDiscrete2D {
+    table: distr::Discrete2D,
+    /// (rows, cols) of the table.
+    #[pyo3(get)]
+    shape: (usize, usize),
+    /// The sum of the weights.
+    #[pyo3(get)]
+    sum: f64,
+}
 
 #[pymethods]
 impl PyDiscrete2D {
@@ -203,9 +211,13 @@ impl PyDiscrete2D {
     fn new(py: Python<'_>, weights: &Obj<'_>) -> PyResult<Self> {
         let t = Table::extract(weights, "weights", 2)?;
         let (w, rows, cols) = (t.values(), t.shape[0], t.shape[1]);
-        Ok(Self(detached(py, || {
-            distr::Discrete2D::new(w, rows, cols)
-        })?))
+        let table = detached(py, || distr::Discrete2D::new(w, rows, cols))?;
+        let sum = table.sum();
+        Ok(Self {
+            table,
+            shape: (rows, cols),
+            sum,
+        })
     }
 
     /// Cells drawn from the distribution.
@@ -221,7 +233,7 @@ impl PyDiscrete2D {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
             map_into(py, &u, Check::Unit, None, |u| {
-                let (r, c) = self.0.sample(u);
+                let (r, c) = self.table.sample(u);
                 [r as i64, c as i64]
             })
         })
@@ -238,7 +250,7 @@ impl PyDiscrete2D {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
             let (index, u) = map2(py, &u, Check::Unit, |u| {
-                let ((r, c), v) = self.0.sample_reuse(u);
+                let ((r, c), v) = self.table.sample_reuse(u);
                 ([r as i64, c as i64], v)
             })?;
             Ok(PyReusedSample::new(index, u))
@@ -257,34 +269,22 @@ impl PyDiscrete2D {
     /// ndarray, shape (N,) float64 (a scalar for one cell).
     #[pyo3(signature = (idx = None))]
     fn pmf<'py>(&self, py: Python<'py>, idx: Option<&Obj<'py>>) -> PyResult<Obj<'py>> {
-        let (rows, cols) = self.0.shape();
+        let (rows, cols) = self.table.shape();
         match idx {
             None => {
-                let flat = per_index(py, rows * cols, |k| self.0.pmf(k / cols, k % cols));
+                let flat = per_index(py, rows * cols, |k| self.table.pmf(k / cols, k % cols));
                 Ok(flat.call_method1("reshape", (rows, cols))?)
             }
             Some(idx) => {
                 let idx = Indices::<2>::extract(idx, "idx", [rows, cols])?;
-                map_indices(py, &idx, |[r, c]| self.0.pmf(r, c))
+                map_indices(py, &idx, |[r, c]| self.table.pmf(r, c))
             }
         }
     }
 
-    /// (rows, cols) of the table.
-    #[getter]
-    fn shape(&self) -> (usize, usize) {
-        self.0.shape()
-    }
-
-    /// The sum of the weights.
-    #[getter]
-    fn sum(&self) -> f64 {
-        self.0.sum()
-    }
-
     fn __repr__(&self) -> String {
-        let (rows, cols) = self.0.shape();
-        format!("Discrete2D(shape=({rows}, {cols}), sum={})", self.0.sum())
+        let (rows, cols) = self.shape;
+        format!("Discrete2D(shape=({rows}, {cols}), sum={})", self.sum)
     }
 }
 

@@ -18,7 +18,7 @@ pub fn mapping_arg(name: &str) -> PyResult<Mapping> {
 }
 
 /// `sampling`, by the names of [`Sampling::name`].
-fn sampling_arg(name: &str) -> PyResult<Sampling> {
+pub fn sampling_arg(name: &str) -> PyResult<Sampling> {
     let options = [Sampling::Piecewise, Sampling::Mitsuba].map(|m| (m.name(), m));
     choice("sampling", name, &options)
 }
@@ -26,7 +26,7 @@ fn sampling_arg(name: &str) -> PyResult<Sampling> {
 /// `to_world` as a 3×3 rotation: None (identity), a 3×3 or 4×4 array-like
 /// (translation ignored) or an object with a ``matrix`` (a Mitsuba
 /// transform).
-fn to_world_arg(ob: Option<&Obj<'_>>) -> PyResult<Matrix3> {
+pub fn to_world_arg(ob: Option<&Obj<'_>>) -> PyResult<Matrix3> {
     let Some(ob) = ob.filter(|o| !o.is_none()) else {
         return Ok(Options::default().to_world);
     };
@@ -140,34 +140,4 @@ pub fn read_image(path: &Path, mapping: Mapping) -> crate::Result<(usize, usize,
         }
     }
     Ok((h, 6 * h, stacked))
-}
-
-/// The checked options of ``EnvMap`` and ``EnvMap.load``.
-pub struct Settings {
-    /// The mapping (also in `options`).
-    pub mapping: Mapping,
-    /// The options of [`crate::envmap::EnvMap::new`].
-    pub options: Options,
-}
-
-/// The options of ``EnvMap`` and ``EnvMap.load`` checked: each named
-/// option among its names, `to_world` a finite 3×3 or 4×4 matrix.
-pub fn settings(
-    mapping: &str,
-    to_world: Option<&Obj<'_>>,
-    scale: f64,
-    sampling: &str,
-    compensate: bool,
-) -> PyResult<Settings> {
-    let mapping = mapping_arg(mapping)?;
-    Ok(Settings {
-        mapping,
-        options: Options {
-            mapping,
-            to_world: to_world_arg(to_world)?,
-            scale,
-            sampling: sampling_arg(sampling)?,
-            compensate,
-        },
-    })
 }

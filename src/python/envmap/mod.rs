@@ -12,7 +12,7 @@ use crate::envmap::{EnvMap, EnvSamples, Mapping, Options, TableFloat};
 use crate::error::Error;
 use crate::io::Raster;
 use crate::python::{Obj, Out};
-use input::{image_arg, mapping_arg, read_image, settings};
+use input::{image_arg, mapping_arg, read_image, sampling_arg, to_world_arg};
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -205,12 +205,18 @@ impl PyEnvMap {
         sampling: &str,
         compensate: bool,
     ) -> PyResult<Self> {
-        let s = settings(mapping, to_world, scale, sampling, compensate)?;
+        let options = Options {
+            mapping: mapping_arg(mapping)?,
+            to_world: to_world_arg(to_world)?,
+            scale,
+            sampling: sampling_arg(sampling)?,
+            compensate,
+        };
         let Some(image) = image.filter(|i| !i.is_none()) else {
-            if s.mapping != Mapping::LatLong {
+            if options.mapping != Mapping::LatLong {
                 return Err(Error::Choice {
                     arg: "mapping",
-                    value: s.mapping.name().into(),
+                    value: options.mapping.name().into(),
                     requirement: "the packaged sky (image=None) is lat-long; convert() it".into(),
                 }
                 .into());
@@ -220,15 +226,15 @@ impl PyEnvMap {
                 .call_method0("sky_path")?
                 .extract()?;
             let (w, h, data) = detached(py, || read_image(&path, Mapping::LatLong))?;
-            return Self::build(py, w, h, &data, s.options);
+            return Self::build(py, w, h, &data, options);
         };
-        let (w, h, array) = image_arg(image, s.mapping)?;
+        let (w, h, array) = image_arg(image, options.mapping)?;
         // Read a C-ordered array in place; copy anything else once.
         match array.as_slice().ok().filter(|_| array.is_c_contiguous()) {
-            Some(data) => Self::build(py, w, h, data, s.options),
+            Some(data) => Self::build(py, w, h, data, options),
             None => {
                 let data: Vec<f32> = array.as_array().iter().copied().collect();
-                Self::build(py, w, h, &data, s.options)
+                Self::build(py, w, h, &data, options)
             }
         }
     }
