@@ -9,7 +9,12 @@ all are unbiased) and prints the ratio of the mean luminances with its
 standard error (from each render's per-pixel variances, on both sides) and
 how many standard errors it lies from 1. Run on demand (not in CI):
 
-    python scripts/area_light_table.py [--seeds 16] [--spp 256] [--markdown]
+    python scripts/area_light_table.py [--seeds 16] [--spp 256] [--first-seed 0]
+                                       [--only TEXT] [--markdown]
+
+``--first-seed`` measures again with other seeds (mcsample's seeds start
+there, Mitsuba's at 1000 more); ``--only`` keeps the rows whose name
+contains TEXT.
 """
 
 from __future__ import annotations
@@ -81,12 +86,12 @@ def cases() -> dict[str, tuple[dict, str]]:
     return out
 
 
-def mean_luminance(scene: mcs.Scene, integrator: str, spp: int, seeds: int,
+def mean_luminance(scene: mcs.Scene, integrator: str, spp: int, seeds: range,
                    strategy: str | None) -> tuple[float, float]:
     """The image-mean luminance over the seeds' renders (Mitsuba's if
     strategy is None) and its variance, from the pixels' variances."""
     means, variances = [], []
-    for seed in range(seeds):
+    for seed in seeds:
         if strategy is None:
             r = mcs.mitsuba.render_reference(scene, spp, seed=1000 + seed, integrator=integrator,
                                              hide_emitters=True)
@@ -95,15 +100,18 @@ def mean_luminance(scene: mcs.Scene, integrator: str, spp: int, seeds: int,
                            hide_emitters=True, progress=False)
         means.append(r.luminance.mean())
         variances.append(r.luminance_variance.sum() / r.luminance.size ** 2)
-    return float(np.mean(means)), float(np.sum(variances)) / seeds ** 2
+    return float(np.mean(means)), float(np.sum(variances)) / len(seeds) ** 2
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", type=int, default=16)
     parser.add_argument("--spp", type=int, default=256)
+    parser.add_argument("--first-seed", type=int, default=0)
+    parser.add_argument("--only", default="", help="rows whose name contains this")
     parser.add_argument("--markdown", action="store_true", help="print a markdown table")
     args = parser.parse_args()
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
     strategies = ("emitter", "bsdf", "mis")
     print(f"mcsample / Mitsuba {mcs.mitsuba.load().__version__} ({mcs.mitsuba.choose_variant()}),"
           f" {args.seeds} seeds x {args.spp} spp per side (BSDF sampling x4); ratio ± SE "
@@ -112,12 +120,14 @@ def main() -> None:
         print("| light | " + " | ".join(f'strategy="{s}"' for s in strategies) + " |")
         print("|---|" + "---|" * len(strategies))
     for name, (d, integrator) in cases().items():
+        if args.only not in name:
+            continue
         scene = mcs.Scene.from_mitsuba(d)
-        ref, ref_var = mean_luminance(scene, integrator, args.spp, args.seeds, None)
+        ref, ref_var = mean_luminance(scene, integrator, args.spp, seeds, None)
         cells = []
         for strategy in strategies:
             spp = 4 * args.spp if strategy == "bsdf" else args.spp
-            ours, var = mean_luminance(scene, integrator, spp, args.seeds, strategy)
+            ours, var = mean_luminance(scene, integrator, spp, seeds, strategy)
             ratio = ours / ref
             se = ratio * np.hypot(np.sqrt(var) / ours, np.sqrt(ref_var) / ref)
             cells.append(f"{ratio:.4f} ± {se:.4f} (z = {(ratio - 1) / se:+.1f})")

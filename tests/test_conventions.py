@@ -64,13 +64,48 @@ def test_u_equal_one_is_valid_and_stays_inside():
     ([[0.1, float("nan")]], "u[0, 1] = NaN"),
     ([[-0.0, 0.5], [-1e-9, 0.5]], "u[1, 0] = -0.000000001"),
     ([0.5, 2.0], "u[1] = 2"),
-    ([[0.1, 0.2, 0.3]], "u must have shape (N, 2) or (2,), got (1, 3)"),
-    (np.zeros((2, 2, 2)), "got (2, 2, 2)"),
+    ([[0.1, 0.2, 0.3]], "u must have shape (N, 2), (..., 2) or (2,), got (1, 3)"),
+    (np.zeros((2, 2, 3)), "got (2, 2, 3)"),
+    (np.full((2, 3, 2), 0.5) + np.eye(3)[None, :, :2], "u[0, 0, 0] = 1.5"),
 ])
 def test_bad_u_names_argument_and_index(u, fragment):
     with pytest.raises(ValueError) as excinfo:
         warp.square_to_uniform_disk(u)
     assert fragment in str(excinfo.value)
+
+
+def test_leading_axes_as_numpys_ufuncs():
+    """(..., k) batches: the result keeps the leading axes, equal to the
+    flattened batch's result reshaped; pairs broadcast a single point
+    against them and refuse other batch shapes by name."""
+    u = mcs.uniform(24, 2, seed=3)
+    d = warp.square_to_uniform_sphere(u.reshape(2, 3, 4, 2))
+    assert d.shape == (2, 3, 4, 3)
+    assert np.array_equal(d, warp.square_to_uniform_sphere(u).reshape(2, 3, 4, 3))
+    pdf = warp.square_to_uniform_sphere_pdf(d)
+    assert pdf.shape == (2, 3, 4)
+    out = np.empty((2, 3, 4, 3))
+    assert warp.square_to_uniform_sphere(u.reshape(2, 3, 4, 2), out=out) is out
+    assert np.array_equal(out, d)
+
+    phong = mcs.Phong(0.3, 0.4, 20.0)
+    wi = np.array([0.0, 0.6, 0.8])
+    u3 = mcs.uniform(24, 3, seed=4)
+    s = phong.sample(wi, u3.reshape(4, 6, 3))
+    assert s.wo.shape == (4, 6, 3) and s.pdf.shape == (4, 6)
+    assert np.array_equal(s.wo, phong.sample(wi, u3).wo.reshape(4, 6, 3))
+    assert phong.eval(wi, s.wo).shape == (4, 6, 3)
+    with pytest.raises(ValueError, match=r"wi has batch shape \(4, 6\) and wo \(2, 6\)"):
+        phong.eval(s.wo, s.wo[:2])
+
+    env = mcs.EnvMap()
+    e = env.sample(u.reshape(3, 8, 2))
+    assert e.direction.shape == (3, 8, 3)
+    assert np.allclose(env.pdf(e.direction), e.pdf)
+    table = mcs.Discrete2D(np.arange(1.0, 7.0).reshape(2, 3))
+    cells = table.sample(u.reshape(6, 4, 2))
+    assert cells.shape == (6, 4, 2)
+    assert np.array_equal(table.pmf(cells), table.pmf(cells.reshape(-1, 2)).reshape(6, 4))
 
 
 def test_first_bad_index_found_in_a_large_parallel_batch():

@@ -107,12 +107,13 @@ fn batch_shape<const K: usize>(arg: &'static str, shape: &[usize]) -> PyResult<V
     match (K, shape) {
         (1, [] | [_]) => Ok(shape.to_vec()),
         (_, [k]) if *k == K => Ok(vec![]),
-        (_, [n, k]) if *k == K => Ok(vec![*n]),
+        // Leading axes, as numpy's ufuncs take them: (..., K).
+        (_, [batch @ .., k]) if *k == K => Ok(batch.to_vec()),
         _ => {
             let expected = if K == 1 {
                 "(N,) or ()".to_string()
             } else {
-                format!("(N, {K}) or ({K},)")
+                format!("(N, {K}), (..., {K}) or ({K},)")
             };
             Err(Error::Shape {
                 arg,
@@ -154,8 +155,8 @@ pub fn position(batch: &[usize], i: usize, k: Option<usize>) -> String {
 
 /// The batch shape of the result of a pair of inputs of batch shapes `a`
 /// and `b` (argument names `arg_a`, `arg_b`): a single point, or a batch of
-/// one row, is used for every row of the other input; otherwise both must
-/// have as many rows.
+/// one point, is used for every point of the other input; otherwise both
+/// must have the same batch shape.
 pub fn broadcast(
     (arg_a, a): (&'static str, &[usize]),
     (arg_b, b): (&'static str, &[usize]),
@@ -166,26 +167,37 @@ pub fn broadcast(
         (true, false) => Ok(b.to_vec()),
         (true, true) => Ok((if a.len() >= b.len() { a } else { b }).to_vec()),
         (false, false) if a == b => Ok(a.to_vec()),
-        (false, false) => Err(Error::Rows {
+        (false, false) if a.len() <= 1 && b.len() <= 1 => Err(Error::Rows {
             arg_a,
             rows_a: n_a,
             arg_b,
             rows_b: n_b,
         }
         .into()),
+        (false, false) => Err(Error::Argument {
+            arg: arg_b,
+            message: format!(
+                "{arg_a} has batch shape {} and {arg_b} {}: give both the same batch shape, \
+                 or one of them as a single point (used for every point of the other)",
+                shape_str(a),
+                shape_str(b)
+            ),
+        }
+        .into()),
     }
 }
 
-/// A batch of `K`-vectors read from an array-like: `(N, K)` or `(K,)`, or
-/// for `K = 1`, `(N,)` or a scalar.
+/// A batch of `K`-vectors read from an array-like: `(N, K)`, `(..., K)`
+/// (any leading axes, as numpy's ufuncs) or `(K,)`, or for `K = 1`, `(N,)`
+/// or a scalar.
 pub struct Points<'py, F: Element, const K: usize> {
     array: PyArrayLikeDyn<'py, F, AllowTypeChange>,
     /// A C-ordered copy when the input is not contiguous.
     owned: Option<Vec<F>>,
     /// Number of points.
     pub n: usize,
-    /// The batch shape, `(N,)`; empty for a single point given without the
-    /// batch axis.
+    /// The batch shape: the input's shape without its last axis (`(N,)`
+    /// for `(N, K)`); empty for a single point given without a batch axis.
     pub batch: Vec<usize>,
     /// Argument name, for messages.
     pub arg: &'static str,
