@@ -402,3 +402,124 @@ fn floor_under_a_constant_sky_reflects_its_albedo() {
         }
     }
 }
+
+/// A wall `z = 5` of four emitting quadrants (radiance 1, 2, 3, 4) facing
+/// the camera at the origin, which looks along +z with a 40° field of view:
+/// each 2 × 2 block of the 4 × 4 film sees one quadrant only, so each
+/// pixel is exactly that quadrant's radiance (the film position of every
+/// sample, from its pixel's own x and y, decides it).
+#[test]
+fn render_puts_each_sample_in_its_own_pixel() {
+    let quadrant = |x: f32, y: f32, radiance: f64| {
+        let m = Affine3A::from_translation(Vec3::new(x, y, 5.0))
+            * Affine3A::from_quat(Quat::from_rotation_y(std::f32::consts::PI));
+        light(rectangle(m), radiance)
+    };
+    let wall = vec![
+        quadrant(-1.0, -1.0, 1.0),
+        quadrant(1.0, -1.0, 2.0),
+        quadrant(-1.0, 1.0, 3.0),
+        quadrant(1.0, 1.0, 4.0),
+    ];
+    let scene = Scene::new(wall, None, camera(), 4, 4).unwrap();
+    let s = settings(Integrator::Direct, Strategy::Mis);
+    let image = super::render(&scene, 8, 3, &s, &super::Progress::default()).unwrap();
+    assert_eq!((image.width, image.height), (4, 4));
+    let red = |row: usize, col: usize| image.mean[(row * 4 + col) * 3];
+    let mut seen = Vec::new();
+    for (block_row, block_col) in [(0, 0), (0, 2), (2, 0), (2, 2)] {
+        let value = red(block_row, block_col);
+        for (r, c) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
+            assert_eq!(
+                red(block_row + r, block_col + c),
+                value,
+                "pixel ({}, {})",
+                block_row + r,
+                block_col + c
+            );
+        }
+        seen.push(value);
+    }
+    seen.sort_by(f32::total_cmp);
+    assert_eq!(seen, [1.0, 2.0, 3.0, 4.0]);
+    assert!(image.variance.iter().all(|&v| v == 0.0));
+}
+
+/// Inside a glowing room every pixel is an independent estimate of
+/// `L / (1 − ρ)`: the image's mean agrees with it, the variance each pixel
+/// reports agrees with the spread of its mean over seeds (per channel and
+/// in luminance), seeds give different images, and one sample per pixel
+/// has no variance estimate (infinite).
+#[test]
+fn render_reports_the_variance_of_each_pixels_mean() {
+    let (rho, l) = (0.5, 0.4);
+    let room = Shape {
+        geometry: Geometry::sphere([0.0, 0.0, 0.0], 1.0, true).unwrap(),
+        material: diffuse(rho),
+        emission: Some([l; 3]),
+    };
+    let scene = Scene::new(vec![room], None, camera(), 4, 4).unwrap();
+    let s = Settings {
+        rr_depth: 2,
+        ..settings(Integrator::Path, Strategy::Mis)
+    };
+    let seeds = 24;
+    let images: Vec<_> = (0..seeds)
+        .map(|seed| super::render(&scene, 16, seed, &s, &super::Progress::default()).unwrap())
+        .collect();
+    assert_ne!(
+        images[0].mean, images[1].mean,
+        "seeds must give different images"
+    );
+    let pixels = 16;
+    let mean_of = |f: &dyn Fn(&super::Image, usize) -> f64, p: usize| {
+        images.iter().map(|im| f(im, p)).sum::<f64>() / seeds as f64
+    };
+    let red = |im: &super::Image, p: usize| f64::from(im.mean[p * 3]);
+    let lum = |im: &super::Image, p: usize| {
+        let c = &im.mean[p * 3..p * 3 + 3];
+        0.2126 * f64::from(c[0]) + 0.7152 * f64::from(c[1]) + 0.0722 * f64::from(c[2])
+    };
+    for (name, value, reported) in [
+        (
+            "red",
+            &red as &dyn Fn(&super::Image, usize) -> f64,
+            &(|im: &super::Image, p: usize| f64::from(im.variance[p * 3]))
+                as &dyn Fn(&super::Image, usize) -> f64,
+        ),
+        ("luminance", &lum, &|im: &super::Image, p: usize| {
+            f64::from(im.luminance_variance[p])
+        }),
+    ] {
+        let (mut spread, mut said, mut total) = (0.0, 0.0, 0.0);
+        for p in 0..pixels {
+            let m = mean_of(value, p);
+            spread += images
+                .iter()
+                .map(|im| (value(im, p) - m).powi(2))
+                .sum::<f64>()
+                / (seeds - 1) as f64;
+            said += mean_of(reported, p);
+            total += m;
+        }
+        let ratio = spread / said;
+        assert!(
+            (0.6..1.6).contains(&ratio),
+            "{name}: spread {spread} against reported {said}"
+        );
+        // Each pixel-and-seed mean has variance said / pixels; the grand mean averages them all.
+        let se = (said / pixels as f64 / (pixels * seeds as usize) as f64).sqrt();
+        let expected = l / (1.0 - rho);
+        assert!(
+            (total / pixels as f64 - expected).abs() < 5.0 * se,
+            "{name}: {total} ± {se}"
+        );
+    }
+    let one = super::render(&scene, 1, 0, &s, &super::Progress::default()).unwrap();
+    assert!(
+        one.variance
+            .iter()
+            .chain(&one.luminance_variance)
+            .all(|v| v.is_infinite())
+    );
+}
