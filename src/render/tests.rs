@@ -523,3 +523,30 @@ fn render_reports_the_variance_of_each_pixels_mean() {
             .all(|v| v.is_infinite())
     );
 }
+
+/// A pixel's moments in closed form: the sample mean, and the unbiased
+/// sample variance divided by the count (the variance of the mean), per
+/// channel and of the Rec. 709 luminance.
+#[test]
+fn pixel_moments_are_the_mean_and_the_variance_of_the_mean() {
+    let samples: [[f32; 3]; 4] = [
+        [1.0, 2.0, 3.0],
+        [3.0, 2.0, 1.0],
+        [2.0, 5.0, 0.0],
+        [6.0, 3.0, 0.0],
+    ];
+    let m = super::moments(&samples);
+    assert_eq!(m.mean, [3.0, 3.0, 1.0]);
+    // Squared deviations 14, 6 and 6 over n − 1 = 3, over n = 4.
+    let expected = [14.0 / 12.0, 0.5, 0.5];
+    for (&v, e) in m.variance.iter().zip(expected) {
+        assert!((f64::from(v) - e).abs() < 1e-6, "{:?}", m.variance);
+    }
+    let y: Vec<f64> = samples
+        .iter()
+        .map(|s| 0.2126 * f64::from(s[0]) + 0.7152 * f64::from(s[1]) + 0.0722 * f64::from(s[2]))
+        .collect();
+    let mean = y.iter().sum::<f64>() / 4.0;
+    let var = y.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 3.0 / 4.0;
+    assert!((f64::from(m.luminance_variance) - var).abs() < 1e-5 * var);
+}
