@@ -87,7 +87,11 @@ impl Rng {
 
     /// `out[i]` = `next` of the stream advanced by `i` (one draw each), on
     /// all cores; then advances past them.
-    fn fill_with<T: Send>(&mut self, out: &mut [T], next: fn(&mut Self) -> T) -> Result<()> {
+    fn fill_with<T: Send>(
+        &mut self,
+        out: &mut [T],
+        next: impl Fn(&mut Self) -> T + Sync,
+    ) -> Result<()> {
         let n = out.len();
         let base = &*self;
         parallel::for_each_chunk(n, out, |range, chunk| {

@@ -336,6 +336,17 @@ fn shadow_rays_reach_the_light_samples() {
     }
 }
 
+/// The unit sphere around the origin, seen from inside (normals inward):
+/// diffuse of albedo `rho`, glowing with radiance `l`.
+fn glowing_room(rho: f64, l: f64) -> Scene {
+    let room = Shape {
+        geometry: Geometry::sphere([0.0, 0.0, 0.0], 1.0, true).unwrap(),
+        material: diffuse(rho),
+        emission: Some([l; 3]),
+    };
+    Scene::new(vec![room], None, camera(), 4, 4).unwrap()
+}
+
 /// A closed room that glows: inside a sphere of radiance `L` and albedo
 /// `ρ` (normals inward), every point sees `L (1 + ρ + … + ρ^(k−1))` with
 /// paths of at most `k` segments, `L / (1 − ρ)` with any length (Russian
@@ -343,12 +354,7 @@ fn shadow_rays_reach_the_light_samples() {
 #[test]
 fn glowing_room_sums_its_bounces() {
     let (rho, l) = (0.6, 0.5);
-    let room = Shape {
-        geometry: Geometry::sphere([0.0, 0.0, 0.0], 1.0, true).unwrap(),
-        material: diffuse(rho),
-        emission: Some([l; 3]),
-    };
-    let scene = Scene::new(vec![room], None, camera(), 4, 4).unwrap();
+    let scene = glowing_room(rho, l);
     let from = Vec3A::new(0.1, 0.2, -0.3);
     for strategy in [Strategy::Emitter, Strategy::Bsdf, Strategy::Mis] {
         for (max_depth, expected) in [
@@ -453,12 +459,7 @@ fn render_puts_each_sample_in_its_own_pixel() {
 #[test]
 fn render_reports_the_variance_of_each_pixels_mean() {
     let (rho, l) = (0.5, 0.4);
-    let room = Shape {
-        geometry: Geometry::sphere([0.0, 0.0, 0.0], 1.0, true).unwrap(),
-        material: diffuse(rho),
-        emission: Some([l; 3]),
-    };
-    let scene = Scene::new(vec![room], None, camera(), 4, 4).unwrap();
+    let scene = glowing_room(rho, l);
     let s = Settings {
         rr_depth: 2,
         ..settings(Integrator::Path, Strategy::Mis)
