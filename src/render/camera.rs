@@ -242,6 +242,11 @@ mod tests {
         let r = cam.ray([0.0, 0.0], [0.5, 0.5]);
         let expected = Vec3A::new(1.0, 0.5, 1.0).normalize();
         assert!((r.d - expected).length() < 1e-6);
+        // It starts on the near plane and ends on the far one: z from 1e-3
+        // to 1e4 along (1, 0.5, 1), of length 1.5 per unit of z.
+        assert!((r.o.z - 1e-3).abs() < 1e-9, "{}", r.o);
+        let tmax = (1e4 - 1e-3) * 1.5;
+        assert!((r.tmax - tmax).abs() < 1e-6 * tmax, "{}", r.tmax);
     }
 
     #[test]
