@@ -551,3 +551,18 @@ fn pixel_moments_are_the_mean_and_the_variance_of_the_mean() {
     let var = y.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 3.0 / 4.0;
     assert!((f64::from(m.luminance_variance) - var).abs() < 1e-5 * var);
 }
+
+/// A face that names a vertex the mesh does not have (past the end, or
+/// negative) is refused by index, before anything reads it.
+#[test]
+fn mesh_faces_must_index_its_vertices() {
+    let v = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    assert!(Geometry::mesh(&v, &[[0, 1, 2]], None, true).is_ok());
+    for bad in [[0, 1, 3], [0, -1, 2]] {
+        let result = Geometry::mesh(&v, &[bad], None, true);
+        assert!(
+            matches!(result, Err(crate::error::Error::Index { .. })),
+            "{bad:?}"
+        );
+    }
+}
