@@ -236,11 +236,16 @@ impl<F: Real> PhongView<F> {
 
     #[inline(always)]
     fn eval_with_lobe(&self, wo: V3<F>, lobe: F) -> V3<F> {
-        let above = self.wi_above && wo[2] > F::zero();
-        std::array::from_fn(|k| {
-            let f = self.diffuse[k] + self.specular[k] * lobe;
-            if above { f } else { F::zero() }
-        })
+        // Masked by a product, not a branch: LLVM would move the loads of
+        // the two terms behind a branch, and a loop with loads it cannot
+        // prove readable on every lane stays scalar. (`f` is finite and
+        // ≥ 0, so `f·0 = +0` and `f·1 = f`, bit for bit.)
+        let above = if self.wi_above && wo[2] > F::zero() {
+            F::one()
+        } else {
+            F::zero()
+        };
+        std::array::from_fn(|k| (self.diffuse[k] + self.specular[k] * lobe) * above)
     }
 
     #[inline(always)]
