@@ -1,7 +1,8 @@
 //! `mcsample.warp`: batched bindings of [`crate::warp`]. Every function
-//! takes an array-like of points (`(N, K)` or `(K,)`), keeps float32 input in
-//! float32, checks `u ∈ [0, 1]` (or finiteness of points) in the kernel's
-//! own pass, and runs on all cores with the GIL released.
+//! takes an array-like of points (`(..., K)`, or any shape for the interval
+//! warps), keeps float32 input in float32, checks `u ∈ [0, 1]` (or
+//! finiteness of points) in the kernel's own pass, and runs on all cores
+//! with the GIL released.
 
 use super::args::choice;
 use super::arrays::{Check, Points, PyFloat, with_precision};
@@ -12,20 +13,37 @@ use crate::python::{Obj, Out};
 use crate::warp;
 use pyo3::prelude::*;
 
-/// Defines one `#[pyfunction]` mapping `$x` (points of `$k` values, checked
-/// with `Check::$check`) through the kernel `$kernel` (built with the
-/// precision alias `$F` in scope; `?` may be used to validate parameters).
-/// Every function also takes a keyword `out`: an array to write into, as
-/// numpy's ufuncs do (it must have the result's shape and dtype).
-macro_rules! batch_fn {
-    (
-        $(#[$meta:meta])*
-        fn $name:ident($x:ident: [$k:literal; $check:ident] $(, $p:ident: $pty:ty)*)
-        = |$F:ident| $kernel:expr
-    ) => {
+/// Defines one `#[pyfunction]` per entry, mapping `$x` (points of `$k`
+/// values, checked with `Check::$check`) to `$m` values through the kernel
+/// `$kernel` (built with the precision alias `$F` in scope; `?` may be used
+/// to validate parameters). The docstring is the entry's summary followed
+/// by Parameters and Returns sections made from the shapes and the
+/// phrases given (`$k` and `$m` are checked against the kernel's). Every
+/// function also takes a keyword `out`: an array to write into, as numpy's
+/// ufuncs do.
+macro_rules! warps {
+    ($(
+        $(#[doc = $summary:literal])*
+        fn $name:ident(
+            $x:ident: [$k:tt; $check:ident] $x_doc:literal
+            $(, $p:ident: $pty:ty = $p_doc:literal)*
+        ) -> [$m:tt] $result_doc:literal
+        = |$F:ident| $kernel:expr;
+    )*) => {$(
         #[pyfunction]
         #[pyo3(signature = ($x $(, $p)*, *, out = None))]
-        $(#[$meta])*
+        $(#[doc = $summary])*
+        #[doc = ""]
+        #[doc = "Parameters"]
+        #[doc = "----------"]
+        #[doc = concat!(stringify!($x), " : ", points_doc!($k), ", ", $x_doc)]
+        $(#[doc = concat!(stringify!($p), " : ", $p_doc)])*
+        #[doc = "out : ndarray, optional, keyword only"]
+        #[doc = "     Written with the result and returned (its shape and dtype)."]
+        #[doc = ""]
+        #[doc = "Returns"]
+        #[doc = "-------"]
+        #[doc = concat!(result_doc!($m), ", ", $result_doc, ".")]
         pub fn $name<'py>(
             py: Python<'py>,
             $x: &Obj<'py>
@@ -34,10 +52,36 @@ macro_rules! batch_fn {
         ) -> PyResult<Obj<'py>> {
             with_precision!($x, $F => {
                 let points = Points::<$F, $k>::extract($x, stringify!($x))?;
-                map_into(py, &points, Check::$check, out, $kernel)
+                let kernel = shaped::<$F, $k, $m, _>($kernel);
+                map_into(py, &points, Check::$check, out, kernel)
             })
         }
+    )*};
+}
+
+/// The input line of a warp's docstring for points of `$k` values.
+macro_rules! points_doc {
+    (1) => {
+        "float or array_like, any shape (one value a point)"
     };
+    ($k:tt) => {
+        concat!("array_like, shape (..., ", $k, ")")
+    };
+}
+
+/// The result line of a warp's docstring for `$m` values per point.
+macro_rules! result_doc {
+    (1) => {
+        "ndarray, the points' batch shape (a scalar for one point)"
+    };
+    ($m:tt) => {
+        concat!("ndarray, shape (..., ", $m, ")")
+    };
+}
+
+/// `kernel`, with the point and result sizes a [`warps!`] entry states.
+fn shaped<F, const K: usize, const M: usize, G: Fn([F; K]) -> [F; M]>(kernel: G) -> G {
+    kernel
 }
 
 /// `exponent`, checked: finite and >= 0.
@@ -74,169 +118,208 @@ fn polar_arg(method: &str) -> PyResult<bool> {
     choice("method", method, &[("concentric", false), ("polar", true)])
 }
 
-batch_fn! {
-    /// Uniform points on the unit disk by the polar map r = sqrt(u[:, 1]),
-    /// phi = 2 pi u[:, 0] (Mitsuba's order).
-    ///
-    /// Parameters
-    /// ----------
-    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 2) or (2,); density 1/pi per unit area.
-    fn square_to_uniform_disk(u: [2; Unit]) = |F| warp::square_to_uniform_disk::<F>
-}
-batch_fn! {
+warps! {
+    /// Uniform points on the unit disk by the polar map r = sqrt(u[..., 1]),
+    /// phi = 2 pi u[..., 0] (Mitsuba's order).
+    fn square_to_uniform_disk(u: [2; Unit] "values in [0, 1]")
+        -> [2] "points of the unit disk; density 1/pi per unit area"
+        = |F| warp::square_to_uniform_disk::<F>;
+
     /// Density of ``square_to_uniform_disk``: 1/pi on the unit disk, else 0.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 2) or (2,)
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) (a scalar for one point), per unit area.
-    fn square_to_uniform_disk_pdf(x: [2; Finite]) = |F| |p| [warp::square_to_uniform_disk_pdf::<F>(p)]
-}
-batch_fn! {
+    fn square_to_uniform_disk_pdf(x: [2; Finite] "points of the plane")
+        -> [1] "per unit area"
+        = |F| |p| [warp::square_to_uniform_disk_pdf::<F>(p)];
+
     /// Inverse of ``square_to_uniform_disk``: (phi / 2 pi, r^2).
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 2) or (2,), points of the unit disk
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
-    fn uniform_disk_to_square(x: [2; Finite]) = |F| warp::uniform_disk_to_square::<F>
-}
-batch_fn! {
+    fn uniform_disk_to_square(x: [2; Finite] "points of the unit disk")
+        -> [2] "in [0, 1]^2"
+        = |F| warp::uniform_disk_to_square::<F>;
+
     /// Uniform points on the unit disk by Shirley and Chiu's concentric map.
-    ///
-    /// Parameters
-    /// ----------
-    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 2) or (2,); density 1/pi per unit area.
-    fn square_to_uniform_disk_concentric(u: [2; Unit]) = |F| warp::square_to_uniform_disk_concentric::<F>
-}
-batch_fn! {
+    fn square_to_uniform_disk_concentric(u: [2; Unit] "values in [0, 1]")
+        -> [2] "points of the unit disk; density 1/pi per unit area"
+        = |F| warp::square_to_uniform_disk_concentric::<F>;
+
     /// Density of ``square_to_uniform_disk_concentric``: 1/pi on the unit
     /// disk, else 0.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 2) or (2,)
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) (a scalar for one point), per unit area.
-    fn square_to_uniform_disk_concentric_pdf(x: [2; Finite]) = |F| |p| [warp::square_to_uniform_disk_concentric_pdf::<F>(p)]
-}
-batch_fn! {
+    fn square_to_uniform_disk_concentric_pdf(x: [2; Finite] "points of the plane")
+        -> [1] "per unit area"
+        = |F| |p| [warp::square_to_uniform_disk_concentric_pdf::<F>(p)];
+
     /// Inverse of ``square_to_uniform_disk_concentric``.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 2) or (2,), points of the unit disk
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2; the origin gives (0.5, 0.5).
-    fn uniform_disk_to_square_concentric(x: [2; Finite]) = |F| warp::uniform_disk_to_square_concentric::<F>
-}
-batch_fn! {
-    /// Uniform directions on the unit sphere: z = 1 - 2 u[:, 1],
-    /// phi = 2 pi u[:, 0].
-    ///
-    /// Parameters
-    /// ----------
-    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 3) or (3,), unit vectors; density 1/(4 pi) per sr.
-    fn square_to_uniform_sphere(u: [2; Unit]) = |F| warp::square_to_uniform_sphere::<F>
-}
-batch_fn! {
+    fn uniform_disk_to_square_concentric(x: [2; Finite] "points of the unit disk")
+        -> [2] "in [0, 1]^2; the origin gives (0.5, 0.5)"
+        = |F| warp::uniform_disk_to_square_concentric::<F>;
+
+    /// Uniform directions on the unit sphere: z = 1 - 2 u[..., 1],
+    /// phi = 2 pi u[..., 0].
+    fn square_to_uniform_sphere(u: [2; Unit] "values in [0, 1]")
+        -> [3] "unit vectors; density 1/(4 pi) per sr"
+        = |F| warp::square_to_uniform_sphere::<F>;
+
     /// Density of ``square_to_uniform_sphere``: 1/(4 pi) per steradian.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 3) or (3,), unit vectors
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) (a scalar for one direction).
-    fn square_to_uniform_sphere_pdf(x: [3; Finite]) = |F| |d| [warp::square_to_uniform_sphere_pdf::<F>(d)]
-}
-batch_fn! {
+    fn square_to_uniform_sphere_pdf(x: [3; Finite] "unit vectors")
+        -> [1] "per steradian"
+        = |F| |d| [warp::square_to_uniform_sphere_pdf::<F>(d)];
+
     /// Inverse of ``square_to_uniform_sphere``: (phi / 2 pi, (1 - z) / 2).
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 3) or (3,), unit vectors
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
-    fn uniform_sphere_to_square(x: [3; Finite]) = |F| warp::uniform_sphere_to_square::<F>
-}
-batch_fn! {
+    fn uniform_sphere_to_square(x: [3; Finite] "unit vectors")
+        -> [2] "in [0, 1]^2"
+        = |F| warp::uniform_sphere_to_square::<F>;
+
     /// Uniform directions on the +z hemisphere (a concentric disk point
     /// lifted by an area-preserving map).
-    ///
-    /// Parameters
-    /// ----------
-    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 3) or (3,), unit vectors with z >= 0; density
-    /// 1/(2 pi) per sr.
-    fn square_to_uniform_hemisphere(u: [2; Unit]) = |F| warp::square_to_uniform_hemisphere::<F>
-}
-batch_fn! {
+    fn square_to_uniform_hemisphere(u: [2; Unit] "values in [0, 1]")
+        -> [3] "unit vectors with z >= 0; density 1/(2 pi) per sr"
+        = |F| warp::square_to_uniform_hemisphere::<F>;
+
     /// Density of ``square_to_uniform_hemisphere``: 1/(2 pi) per steradian
     /// for z >= 0, else 0.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 3) or (3,), unit vectors
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) (a scalar for one direction).
-    fn square_to_uniform_hemisphere_pdf(x: [3; Finite]) = |F| |d| [warp::square_to_uniform_hemisphere_pdf::<F>(d)]
-}
-batch_fn! {
+    fn square_to_uniform_hemisphere_pdf(x: [3; Finite] "unit vectors")
+        -> [1] "per steradian"
+        = |F| |d| [warp::square_to_uniform_hemisphere_pdf::<F>(d)];
+
     /// Inverse of ``square_to_uniform_hemisphere``.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 3) or (3,), unit vectors with z >= 0
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
-    fn uniform_hemisphere_to_square(x: [3; Finite]) = |F| warp::uniform_hemisphere_to_square::<F>
+    fn uniform_hemisphere_to_square(x: [3; Finite] "unit vectors with z >= 0")
+        -> [2] "in [0, 1]^2"
+        = |F| warp::uniform_hemisphere_to_square::<F>;
+
+    /// Density of ``square_to_cosine_hemisphere`` (either method):
+    /// max(cos theta, 0) / pi per steradian.
+    fn square_to_cosine_hemisphere_pdf(x: [3; Finite] "unit vectors")
+        -> [1] "per steradian"
+        = |F| |d| [warp::square_to_cosine_hemisphere_pdf::<F>(d)];
+
+    /// Directions of the cos^n lobe around +z (the Phong lobe):
+    /// cos theta = u1^(1/(n+1)), phi = 2 pi u0.
+    fn square_to_cosine_power_hemisphere(
+        u: [2; Unit] "values in [0, 1]",
+        exponent: f64 = "float >= 0, the lobe's n"
+    ) -> [3] "unit vectors; density (n + 1)/(2 pi) cos^n theta per sr"
+        = |F| {
+            let n = exponent_arg::<F>(exponent)?;
+            #[inline(always)]
+            move |u| warp::square_to_cosine_power_hemisphere(u, n)
+        };
+
+    /// Density of ``square_to_cosine_power_hemisphere``:
+    /// (n + 1)/(2 pi) cos^n theta per steradian for cos theta > 0, else 0.
+    fn square_to_cosine_power_hemisphere_pdf(
+        x: [3; Finite] "unit vectors",
+        exponent: f64 = "float >= 0, the lobe's n"
+    ) -> [1] "per steradian"
+        = |F| {
+            let n = exponent_arg::<F>(exponent)?;
+            #[inline(always)]
+            move |d| [warp::square_to_cosine_power_hemisphere_pdf(d, n)]
+        };
+
+    /// Inverse of ``square_to_cosine_power_hemisphere``:
+    /// (phi / 2 pi, cos^(n+1) theta).
+    fn cosine_power_hemisphere_to_square(
+        x: [3; Finite] "unit vectors with z >= 0",
+        exponent: f64 = "float >= 0, the lobe's n"
+    ) -> [2] "in [0, 1]^2"
+        = |F| {
+            let n = exponent_arg::<F>(exponent)?;
+            #[inline(always)]
+            move |d| warp::cosine_power_hemisphere_to_square(d, n)
+        };
+
+    /// Uniform directions in the cone cos theta >= cos_cutoff around +z.
+    fn square_to_uniform_cone(
+        u: [2; Unit] "values in [0, 1]",
+        cos_cutoff: f64 = "float in [-1, 1)"
+    ) -> [3] "unit vectors; density 1 / (2 pi (1 - cos_cutoff)) per sr"
+        = |F| {
+            let c = cos_cutoff_arg::<F>(cos_cutoff)?;
+            #[inline(always)]
+            move |u| warp::square_to_uniform_cone(u, c)
+        };
+
+    /// Density of ``square_to_uniform_cone``: 1 / (2 pi (1 - cos_cutoff))
+    /// per steradian inside the cone, else 0.
+    fn square_to_uniform_cone_pdf(
+        x: [3; Finite] "unit vectors",
+        cos_cutoff: f64 = "float in [-1, 1)"
+    ) -> [1] "per steradian"
+        = |F| {
+            let c = cos_cutoff_arg::<F>(cos_cutoff)?;
+            #[inline(always)]
+            move |d| [warp::square_to_uniform_cone_pdf(d, c)]
+        };
+
+    /// Inverse of ``square_to_uniform_cone``.
+    fn uniform_cone_to_square(
+        x: [3; Finite] "unit vectors inside the cone",
+        cos_cutoff: f64 = "float in [-1, 1)"
+    ) -> [2] "in [0, 1]^2"
+        = |F| {
+            let c = cos_cutoff_arg::<F>(cos_cutoff)?;
+            #[inline(always)]
+            move |d| warp::uniform_cone_to_square(d, c)
+        };
+
+    /// Uniform points on the triangle (0, 0), (1, 0), (0, 1):
+    /// t = sqrt(1 - u0), point (1 - t, t u1).
+    fn square_to_uniform_triangle(u: [2; Unit] "values in [0, 1]")
+        -> [2] "barycentric coordinates; density 2 per unit area"
+        = |F| warp::square_to_uniform_triangle::<F>;
+
+    /// Density of ``square_to_uniform_triangle``: 2 inside the triangle,
+    /// else 0.
+    fn square_to_uniform_triangle_pdf(x: [2; Finite] "points of the plane")
+        -> [1] "per unit area"
+        = |F| |p| [warp::square_to_uniform_triangle_pdf::<F>(p)];
+
+    /// Inverse of ``square_to_uniform_triangle``.
+    fn uniform_triangle_to_square(x: [2; Finite] "points of the triangle")
+        -> [2] "in [0, 1]^2"
+        = |F| warp::uniform_triangle_to_square::<F>;
+
+    /// The power density (n + 1) x^n on [0, 1] by inversion:
+    /// x = u^(1/(n+1)).
+    fn interval_to_power(u: [1; Unit] "values in [0, 1]", exponent: f64 = "float >= 0")
+        -> [1] "in [0, 1]"
+        = |F| {
+            let n = exponent_arg::<F>(exponent)?;
+            #[inline(always)]
+            move |u: [F; 1]| [warp::interval_to_power(u[0], n)]
+        };
+
+    /// Density of ``interval_to_power``: (n + 1) x^n on [0, 1], else 0.
+    fn interval_to_power_pdf(x: [1; Finite] "finite", exponent: f64 = "float >= 0")
+        -> [1] "per unit length"
+        = |F| {
+            let n = exponent_arg::<F>(exponent)?;
+            #[inline(always)]
+            move |x: [F; 1]| [warp::interval_to_power_pdf(x[0], n)]
+        };
+
+    /// Inverse of ``interval_to_power``: u = x^(n+1).
+    fn power_to_interval(x: [1; Finite] "values in [0, 1]", exponent: f64 = "float >= 0")
+        -> [1] "in [0, 1]"
+        = |F| {
+            let n = exponent_arg::<F>(exponent)?;
+            #[inline(always)]
+            move |x: [F; 1]| [warp::power_to_interval(x[0], n)]
+        };
 }
+
 /// Cosine-weighted directions on the +z hemisphere (Malley's method).
 ///
 /// Parameters
 /// ----------
-/// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+/// u : array_like, shape (..., 2), values in [0, 1]
 /// method : "concentric" (default; lifts a concentric disk point, as
 ///     ``mi.warp`` does) or "polar" (x = cos(2 pi u0) sqrt(1 - u1),
 ///     y = sin(2 pi u0) sqrt(1 - u1), z = sqrt(u1))
+/// out : ndarray, optional, keyword only
+///     Written with the result and returned (its shape and dtype).
 ///
 /// Returns
 /// -------
-/// ndarray, shape (N, 3) or (3,), unit vectors; density cos(theta)/pi
-/// per sr.
+/// ndarray, shape (..., 3), unit vectors; density cos(theta)/pi per sr.
 #[pyfunction]
 #[pyo3(signature = (u, method = "concentric", *, out = None))]
 pub fn square_to_cosine_hemisphere<'py>(
@@ -280,29 +363,19 @@ where
         map_into(py, &points, check, out, concentric)
     }
 }
-batch_fn! {
-    /// Density of ``square_to_cosine_hemisphere`` (either method):
-    /// max(cos theta, 0) / pi per steradian.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 3) or (3,), unit vectors
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) (a scalar for one direction).
-    fn square_to_cosine_hemisphere_pdf(x: [3; Finite]) = |F| |d| [warp::square_to_cosine_hemisphere_pdf::<F>(d)]
-}
+
 /// Inverse of ``square_to_cosine_hemisphere`` for the same ``method``.
 ///
 /// Parameters
 /// ----------
-/// x : array_like, shape (N, 3) or (3,), unit vectors with z >= 0
+/// x : array_like, shape (..., 3), unit vectors with z >= 0
 /// method : "concentric" (default) or "polar"
+/// out : ndarray, optional, keyword only
+///     Written with the result and returned (its shape and dtype).
 ///
 /// Returns
 /// -------
-/// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
+/// ndarray, shape (..., 2), in [0, 1]^2.
 #[pyfunction]
 #[pyo3(signature = (x, method = "concentric", *, out = None))]
 pub fn cosine_hemisphere_to_square<'py>(
@@ -316,206 +389,6 @@ pub fn cosine_hemisphere_to_square<'py>(
         warp::cosine_hemisphere_to_square_polar::<F>,
         warp::cosine_hemisphere_to_square::<F>,
     ))
-}
-batch_fn! {
-    /// Directions of the cos^n lobe around +z (the Phong lobe):
-    /// cos theta = u1^(1/(n+1)), phi = 2 pi u0.
-    ///
-    /// Parameters
-    /// ----------
-    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
-    /// exponent : float >= 0
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 3) or (3,), unit vectors; density
-    /// (n + 1)/(2 pi) cos^n theta per sr.
-    fn square_to_cosine_power_hemisphere(u: [2; Unit], exponent: f64) = |F| {
-        let n = exponent_arg::<F>(exponent)?;
-        #[inline(always)]
-        move |u| warp::square_to_cosine_power_hemisphere(u, n)
-    }
-}
-batch_fn! {
-    /// Density of ``square_to_cosine_power_hemisphere``:
-    /// (n + 1)/(2 pi) cos^n theta per steradian for cos theta > 0, else 0.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 3) or (3,), unit vectors
-    /// exponent : float >= 0
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) (a scalar for one direction).
-    fn square_to_cosine_power_hemisphere_pdf(x: [3; Finite], exponent: f64) = |F| {
-        let n = exponent_arg::<F>(exponent)?;
-        #[inline(always)]
-        move |d| [warp::square_to_cosine_power_hemisphere_pdf(d, n)]
-    }
-}
-batch_fn! {
-    /// Inverse of ``square_to_cosine_power_hemisphere``:
-    /// (phi / 2 pi, cos^(n+1) theta).
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 3) or (3,), unit vectors with z >= 0
-    /// exponent : float >= 0
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
-    fn cosine_power_hemisphere_to_square(x: [3; Finite], exponent: f64) = |F| {
-        let n = exponent_arg::<F>(exponent)?;
-        #[inline(always)]
-        move |d| warp::cosine_power_hemisphere_to_square(d, n)
-    }
-}
-batch_fn! {
-    /// Uniform directions in the cone cos theta >= cos_cutoff around +z.
-    ///
-    /// Parameters
-    /// ----------
-    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
-    /// cos_cutoff : float in [-1, 1)
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 3) or (3,), unit vectors; density
-    /// 1 / (2 pi (1 - cos_cutoff)) per sr.
-    fn square_to_uniform_cone(u: [2; Unit], cos_cutoff: f64) = |F| {
-        let c = cos_cutoff_arg::<F>(cos_cutoff)?;
-        #[inline(always)]
-        move |u| warp::square_to_uniform_cone(u, c)
-    }
-}
-batch_fn! {
-    /// Density of ``square_to_uniform_cone``: 1 / (2 pi (1 - cos_cutoff))
-    /// per steradian inside the cone, else 0.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 3) or (3,), unit vectors
-    /// cos_cutoff : float in [-1, 1)
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) (a scalar for one direction).
-    fn square_to_uniform_cone_pdf(x: [3; Finite], cos_cutoff: f64) = |F| {
-        let c = cos_cutoff_arg::<F>(cos_cutoff)?;
-        #[inline(always)]
-        move |d| [warp::square_to_uniform_cone_pdf(d, c)]
-    }
-}
-batch_fn! {
-    /// Inverse of ``square_to_uniform_cone``.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 3) or (3,), unit vectors inside the cone
-    /// cos_cutoff : float in [-1, 1)
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
-    fn uniform_cone_to_square(x: [3; Finite], cos_cutoff: f64) = |F| {
-        let c = cos_cutoff_arg::<F>(cos_cutoff)?;
-        #[inline(always)]
-        move |d| warp::uniform_cone_to_square(d, c)
-    }
-}
-batch_fn! {
-    /// Uniform points on the triangle (0, 0), (1, 0), (0, 1):
-    /// t = sqrt(1 - u0), point (1 - t, t u1).
-    ///
-    /// Parameters
-    /// ----------
-    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 2) or (2,) (barycentric coordinates); density 2
-    /// per unit area.
-    fn square_to_uniform_triangle(u: [2; Unit]) = |F| warp::square_to_uniform_triangle::<F>
-}
-batch_fn! {
-    /// Density of ``square_to_uniform_triangle``: 2 inside the triangle,
-    /// else 0.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 2) or (2,)
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) (a scalar for one point), per unit area.
-    fn square_to_uniform_triangle_pdf(x: [2; Finite]) = |F| |p| [warp::square_to_uniform_triangle_pdf::<F>(p)]
-}
-batch_fn! {
-    /// Inverse of ``square_to_uniform_triangle``.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : array_like, shape (N, 2) or (2,), points of the triangle
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N, 2) or (2,), in [0, 1]^2.
-    fn uniform_triangle_to_square(x: [2; Finite]) = |F| warp::uniform_triangle_to_square::<F>
-}
-batch_fn! {
-    /// The power density (n + 1) x^n on [0, 1] by inversion:
-    /// x = u^(1/(n+1)).
-    ///
-    /// Parameters
-    /// ----------
-    /// u : float or array_like, shape (N,), values in [0, 1]
-    /// exponent : float >= 0
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) (a scalar for a scalar u).
-    fn interval_to_power(u: [1; Unit], exponent: f64) = |F| {
-        let n = exponent_arg::<F>(exponent)?;
-        #[inline(always)]
-        move |u: [F; 1]| [warp::interval_to_power(u[0], n)]
-    }
-}
-batch_fn! {
-    /// Density of ``interval_to_power``: (n + 1) x^n on [0, 1], else 0,
-    /// per unit length.
-    ///
-    /// Parameters
-    /// ----------
-    /// x : float or array_like, shape (N,)
-    /// exponent : float >= 0
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) (a scalar for a scalar x).
-    fn interval_to_power_pdf(x: [1; Finite], exponent: f64) = |F| {
-        let n = exponent_arg::<F>(exponent)?;
-        #[inline(always)]
-        move |x: [F; 1]| [warp::interval_to_power_pdf(x[0], n)]
-    }
-}
-batch_fn! {
-    /// Inverse of ``interval_to_power``: u = x^(n+1).
-    ///
-    /// Parameters
-    /// ----------
-    /// x : float or array_like, shape (N,), values in [0, 1]
-    /// exponent : float >= 0
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (N,) (a scalar for a scalar x).
-    fn power_to_interval(x: [1; Finite], exponent: f64) = |F| {
-        let n = exponent_arg::<F>(exponent)?;
-        #[inline(always)]
-        move |x: [F; 1]| [warp::power_to_interval(x[0], n)]
-    }
 }
 
 /// Registers the warp functions in module `m`.
