@@ -16,6 +16,7 @@
 //! - [`estimators`]: irradiance and reflected radiance under an envmap,
 //!   by several strategies and MIS.
 //! - [`phong`]: the energy-normalised Phong BRDF and its sampling.
+//! - [`qmc`]: quasi-Monte Carlo point sets (Sobol', Halton).
 //! - [`mis`]: multiple importance sampling heuristics.
 //! - [`render`]: a compact renderer (BVH, camera, direct and path
 //!   integrators) for comparing sampling strategies with Mitsuba 3.
@@ -47,6 +48,7 @@ pub mod math;
 pub mod mis;
 pub mod parallel;
 pub mod phong;
+pub mod qmc;
 #[cfg(test)]
 mod quadrature;
 pub mod render;

@@ -6,7 +6,7 @@ Conventions (sample-major batches, float32 in / float32 out, densities per
 steradian on directions, +z normal) are in the README.
 """
 
-from . import data, distr, estimators, io, mis, mitsuba, plot, stats, warp
+from . import data, distr, estimators, io, mis, mitsuba, plot, qmc, stats, warp
 from .rendering import render
 from .results import EmitterSample, RenderResult
 from .scene import Scene, look_at
@@ -65,5 +65,6 @@ __all__ = [
     "set_num_threads",
     "stats",
     "uniform",
+    "qmc",
     "warp",
 ]

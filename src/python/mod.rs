@@ -14,6 +14,7 @@ mod io;
 mod mis;
 mod parallel;
 mod phong;
+mod qmc;
 mod records;
 mod render;
 mod rng;
@@ -66,5 +67,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     submodule(m, "mis", mis::register)?;
     submodule(m, "estimators", estimators::register)?;
     submodule(m, "render", render::register)?;
+    submodule(m, "qmc", qmc::register)?;
     Ok(())
 }

@@ -46,7 +46,7 @@ fn parse_shape(shape: Option<&Obj<'_>>) -> PyResult<Vec<usize>> {
 
 /// Whether `dtype` (None, "float32", np.float32, ...) asks for float32;
 /// only float32 and float64 are offered.
-fn wants_float32(py: Python<'_>, dtype: Option<&Obj<'_>>) -> PyResult<bool> {
+pub(super) fn wants_float32(py: Python<'_>, dtype: Option<&Obj<'_>>) -> PyResult<bool> {
     let Some(dtype) = dtype.filter(|d| !d.is_none()) else {
         return Ok(false);
     };

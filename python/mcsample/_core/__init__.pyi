@@ -9,6 +9,7 @@ from numpy.typing import ArrayLike, DTypeLike, NDArray
 from . import estimators as estimators
 from . import io as io
 from . import mis as mis
+from . import qmc as qmc
 from . import render as render
 from . import warp as warp
 

@@ -1,0 +1,166 @@
+//! `mcsample._core.qmc`: the point generators of [`crate::qmc`], filled
+//! from any index into fresh arrays with the GIL released. The engines of
+//! `mcsample.qmc` (scipy's interface, their position, seeds) wrap them.
+
+use super::args::{choice, index_arg, seed};
+use super::arrays::zeros;
+use super::parallel::detached;
+use super::rng::wants_float32;
+use crate::math::Real;
+use crate::python::Obj;
+use crate::qmc::{HALTON_MAX_INDEX, Halton, Scramble, Sobol};
+use numpy::{Element, PyArrayDyn, PyArrayMethods};
+use pyo3::prelude::*;
+
+/// Points `first .. first + n` of `fill`'s sequence in `d` dimensions, as a
+/// fresh `(n, d)` array of `F`.
+fn points<'py, F: Element + Real>(
+    py: Python<'py>,
+    d: usize,
+    n: usize,
+    fill: impl FnOnce(&mut [F]) -> crate::Result<()> + Send,
+) -> PyResult<Obj<'py>> {
+    let out: Bound<'py, PyArrayDyn<F>> = zeros(py, &[n, d]);
+    {
+        let mut guard = out.readwrite();
+        let flat = guard.as_slice_mut()?;
+        detached(py, || fill(flat))?;
+    }
+    Ok(out.into_any())
+}
+
+/// Sobol' points with Joe and Kuo's direction numbers (scipy's), in
+/// scipy's Gray-code order: the engine behind ``mcsample.qmc.Sobol``.
+///
+/// Parameters
+/// ----------
+/// d : int
+///     Dimensions, 1 to 21201.
+/// scramble : "none", "owen" or "lms"
+///     The plain sequence (scipy's ``scramble=False`` points, bit for bit),
+///     Owen's nested uniform scrambling (a hash per dimension), or a random
+///     linear matrix scramble with a digital shift (scipy's kind).
+/// seed : int, None or numpy.random.Generator
+///     The scramble's random bits (default 0).
+#[pyclass(module = "mcsample._core.qmc", name = "SobolPoints", frozen)]
+pub struct PySobolPoints(Sobol);
+
+#[pymethods]
+impl PySobolPoints {
+    #[new]
+    #[pyo3(signature = (d, scramble = "owen", seed = 0))]
+    fn new(d: &Obj<'_>, scramble: &str, #[pyo3(from_py_with = seed)] seed: u64) -> PyResult<Self> {
+        let d = index_arg(d, "d", 1, crate::qmc::SOBOL_MAX_DIMENSIONS as u64)? as usize;
+        let scramble = choice(
+            "scramble",
+            scramble,
+            &[
+                ("none", Scramble::None),
+                ("owen", Scramble::Owen),
+                ("lms", Scramble::LinearMatrix),
+            ],
+        )?;
+        Ok(Self(Sobol::new(d, scramble, seed)?))
+    }
+
+    /// Points ``first .. first + n - 1`` (indices below 2**32).
+    ///
+    /// Parameters
+    /// ----------
+    /// first, n : int >= 0
+    /// dtype : float64 (default) or float32
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (n, d), in [0, 1): float64 multiples of 2**-32
+    /// (float32: of 2**-23).
+    #[pyo3(signature = (first, n, dtype = None))]
+    fn points<'py>(
+        &self,
+        py: Python<'py>,
+        first: &Obj<'py>,
+        n: &Obj<'py>,
+        dtype: Option<&Obj<'py>>,
+    ) -> PyResult<Obj<'py>> {
+        let first = index_arg(first, "first", 0, u64::MAX)?;
+        let n = index_arg(n, "n", 0, 1 << 32)? as usize;
+        let (sobol, d) = (&self.0, self.0.dims());
+        if wants_float32(py, dtype)? {
+            points::<f32>(py, d, n, |out| sobol.fill(first, out))
+        } else {
+            points::<f64>(py, d, n, |out| sobol.fill(first, out))
+        }
+    }
+
+    /// The number of dimensions.
+    #[getter]
+    fn d(&self) -> usize {
+        self.0.dims()
+    }
+}
+
+/// Halton points (the first ``d`` primes as bases), plain or with random
+/// digit permutations: the engine behind ``mcsample.qmc.Halton``.
+///
+/// Parameters
+/// ----------
+/// d : int
+///     Dimensions, 1 to 65536.
+/// scramble : bool
+///     False: scipy's ``scramble=False`` points, bit for bit; True: a random
+///     permutation of the digits per digit position and dimension.
+/// seed : int, None or numpy.random.Generator
+///     The permutations' random bits (default 0).
+#[pyclass(module = "mcsample._core.qmc", name = "HaltonPoints", frozen)]
+pub struct PyHaltonPoints(Halton);
+
+#[pymethods]
+impl PyHaltonPoints {
+    #[new]
+    #[pyo3(signature = (d, scramble = true, seed = 0))]
+    fn new(d: &Obj<'_>, scramble: bool, #[pyo3(from_py_with = seed)] seed: u64) -> PyResult<Self> {
+        let d = index_arg(d, "d", 1, crate::qmc::HALTON_MAX_DIMENSIONS as u64)? as usize;
+        Ok(Self(Halton::new(d, scramble, seed)?))
+    }
+
+    /// Points ``first .. first + n - 1`` (indices below 2**53).
+    ///
+    /// Parameters
+    /// ----------
+    /// first, n : int >= 0
+    /// dtype : float64 (default) or float32
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (n, d), in [0, 1).
+    #[pyo3(signature = (first, n, dtype = None))]
+    fn points<'py>(
+        &self,
+        py: Python<'py>,
+        first: &Obj<'py>,
+        n: &Obj<'py>,
+        dtype: Option<&Obj<'py>>,
+    ) -> PyResult<Obj<'py>> {
+        let first = index_arg(first, "first", 0, u64::MAX)?;
+        let n = index_arg(n, "n", 0, HALTON_MAX_INDEX)? as usize;
+        let (halton, d) = (&self.0, self.0.dims());
+        if wants_float32(py, dtype)? {
+            points::<f32>(py, d, n, |out| halton.fill(first, out))
+        } else {
+            points::<f64>(py, d, n, |out| halton.fill(first, out))
+        }
+    }
+
+    /// The number of dimensions.
+    #[getter]
+    fn d(&self) -> usize {
+        self.0.dims()
+    }
+}
+
+/// Registers the point generators in module `m`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PySobolPoints>()?;
+    m.add_class::<PyHaltonPoints>()?;
+    Ok(())
+}

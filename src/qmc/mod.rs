@@ -1,0 +1,76 @@
+//! Quasi-Monte Carlo point sets: [`Sobol`] (plain, Owen-scrambled, or by a
+//! linear matrix scramble) and [`Halton`] (plain or digit-permuted). Each
+//! fills rows of `d` coordinates in `[0, 1)` from any index on, on all
+//! cores, with the same bits at any thread count; a point is computed from
+//! its index alone, so skipping ahead costs nothing.
+
+mod directions;
+mod halton;
+mod sobol;
+
+pub use directions::MAX_DIMENSIONS as SOBOL_MAX_DIMENSIONS;
+pub use halton::{Halton, MAX_DIMENSIONS as HALTON_MAX_DIMENSIONS, MAX_INDEX as HALTON_MAX_INDEX};
+pub use sobol::{Scramble, Sobol, owen};
+
+use crate::error::{Error, Result};
+use crate::parallel::Outputs;
+
+/// A row-major block of rows of `width` values, split between threads at
+/// row boundaries.
+struct Rows<'a, T> {
+    values: &'a mut [T],
+    width: usize,
+}
+
+impl<'a, T> Rows<'a, T> {
+    fn new(values: &'a mut [T], width: usize) -> Self {
+        Rows { values, width }
+    }
+
+    fn chunks_mut(self) -> std::slice::ChunksExactMut<'a, T> {
+        self.values.chunks_exact_mut(self.width)
+    }
+}
+
+impl<T: Send> Outputs for Rows<'_, T> {
+    fn split_at_item(self, mid: usize) -> (Self, Self) {
+        let (a, b) = self.values.split_at_mut(mid * self.width);
+        (Rows::new(a, self.width), Rows::new(b, self.width))
+    }
+}
+
+/// Checks a dimension count: `1 ≤ dims ≤ max`.
+fn check_dims(dims: usize, max: usize) -> Result<()> {
+    if (1..=max).contains(&dims) {
+        Ok(())
+    } else {
+        Err(Error::Integer {
+            arg: "d",
+            value: dims.to_string(),
+            requirement: format!("must be in [1, {max}]"),
+        })
+    }
+}
+
+/// The number of rows of `width` values in `len` values, checked to be
+/// whole and to keep every index from `first` below `end`.
+fn check_range(len: usize, width: usize, first: u64, end: u64) -> Result<usize> {
+    if !len.is_multiple_of(width) {
+        return Err(Error::Integer {
+            arg: "out",
+            value: len.to_string(),
+            requirement: format!("must hold whole rows of {width} values"),
+        });
+    }
+    let n = len / width;
+    match first.checked_add(n as u64) {
+        Some(last) if last <= end => Ok(n),
+        _ => Err(Error::Integer {
+            arg: "n",
+            value: n.to_string(),
+            requirement: format!(
+                "points {first} .. {first} + n must stay below index {end} (the sequence's end)"
+            ),
+        }),
+    }
+}

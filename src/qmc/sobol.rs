@@ -1,0 +1,253 @@
+//! [`Sobol`]: the Sobol' sequence in base 2, plain (scipy's points), Owen
+//! scrambled, or by a random linear matrix scramble and digital shift.
+
+use super::directions::{BITS, MAX_DIMENSIONS, columns};
+use super::{Rows, check_dims, check_range};
+use crate::error::Result;
+use crate::math::Real;
+use crate::parallel;
+use crate::rng::Rng;
+
+/// How [`Sobol`] randomises its points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scramble {
+    /// The plain sequence: the points of `scipy.stats.qmc.Sobol(d,
+    /// scramble=False)`, bit for bit (its first point is the origin).
+    None,
+    /// Owen's nested uniform scrambling, each dimension with its own seed,
+    /// by a hash (Burley 2020, after Laine and Karras 2011): every point
+    /// is uniform on `[0, 1)^d` over seeds, and every `2^m`-point prefix
+    /// keeps the sequence's net structure.
+    Owen,
+    /// A random lower-triangular (in bit significance) binary matrix with
+    /// ones on its diagonal applied to every generator matrix, then a
+    /// random digital shift (Matoušek 1998): scipy's `scramble=True`
+    /// (with other random bits).
+    LinearMatrix,
+}
+
+/// The Sobol' sequence in `d` dimensions with Joe and Kuo's direction
+/// numbers, in Gray-code order as scipy generates it: point `i` is
+///
+/// `x_i,j = (⊕_{b : bit b of g(i) set} v_j,b) / 2^32`, `g(i) = i ⊕ ⌊i/2⌋`,
+///
+/// then scrambled as [`Scramble`] says. Indices run from 0 to `2^32 − 1`.
+#[derive(Clone, Debug)]
+pub struct Sobol {
+    columns: Vec<[u32; BITS]>,
+    scramble: Scramble,
+    /// Per dimension: the Owen seed, or the digital shift (0 for plain).
+    keys: Vec<u32>,
+}
+
+impl Sobol {
+    /// The first `dims` dimensions of the sequence, scrambled by `scramble`
+    /// with random bits from `seed`.
+    ///
+    /// # Errors
+    /// [`Error::Integer`] unless `1 ≤ dims ≤` [`MAX_DIMENSIONS`].
+    pub fn new(dims: usize, scramble: Scramble, seed: u64) -> Result<Self> {
+        check_dims(dims, MAX_DIMENSIONS)?;
+        let mut columns = columns(dims);
+        let mut rng = Rng::new(seed, 0);
+        let keys = match scramble {
+            Scramble::None => vec![0; dims],
+            Scramble::Owen => (0..dims).map(|_| rng.next_u32()).collect(),
+            Scramble::LinearMatrix => {
+                for v in &mut columns {
+                    let rows = lower_triangular(&mut rng);
+                    *v = v.map(|c| multiply(&rows, c));
+                }
+                (0..dims).map(|_| rng.next_u32()).collect()
+            }
+        };
+        Ok(Sobol {
+            columns,
+            scramble,
+            keys,
+        })
+    }
+
+    /// Number of dimensions.
+    pub fn dims(&self) -> usize {
+        self.columns.len()
+    }
+
+    /// Coordinate `dim` of point `index`, as 32 bits (`x·2^32`).
+    pub fn bits(&self, index: u32, dim: usize) -> u32 {
+        self.finish(unscrambled(&self.columns[dim], index), dim)
+    }
+
+    /// Points `first ..` into `out` (row-major, `dims` values a row, as many
+    /// rows as fit), on all cores; the same bits at any thread count.
+    ///
+    /// # Errors
+    /// [`Error::Integer`] if the points would pass index `2^32 − 1`, or
+    /// if `out` does not hold whole rows.
+    pub fn fill<F: Real>(&self, first: u64, out: &mut [F]) -> Result<()> {
+        let d = self.dims();
+        let n = check_range(out.len(), d, first, 1 << BITS)?;
+        parallel::for_each_chunk(n, Rows::new(out, d), |range, rows| {
+            let start = (first + range.start as u64) as u32;
+            let mut x: Vec<u32> = self.columns.iter().map(|v| unscrambled(v, start)).collect();
+            for (r, row) in rows.chunks_mut().enumerate() {
+                if r > 0 {
+                    // g(i) ⊕ g(i − 1) is the lowest set bit of i.
+                    let bit = (start + r as u32).trailing_zeros() as usize;
+                    for (x, v) in x.iter_mut().zip(&self.columns) {
+                        *x ^= v[bit];
+                    }
+                }
+                for (j, (value, &x)) in row.iter_mut().zip(&x).enumerate() {
+                    *value = F::from_random_bits(self.finish(x, j));
+                }
+            }
+            true
+        })
+        .map(|_| ())
+    }
+
+    /// The scramble's last step on coordinate `dim`'s bits `x`.
+    #[inline(always)]
+    fn finish(&self, x: u32, dim: usize) -> u32 {
+        match self.scramble {
+            Scramble::Owen => owen(x, self.keys[dim]),
+            Scramble::None | Scramble::LinearMatrix => x ^ self.keys[dim],
+        }
+    }
+}
+
+/// Point `index` of one dimension with columns `v`, before any shift.
+fn unscrambled(v: &[u32; BITS], index: u32) -> u32 {
+    let gray = index ^ (index >> 1);
+    (0..BITS)
+        .filter(|&b| gray >> b & 1 == 1)
+        .fold(0, |acc, b| acc ^ v[b])
+}
+
+/// Owen's nested uniform scramble of `x` by a hash: reversed, its bits
+/// read from the most significant become the least significant, and the
+/// Laine–Karras permutation (additions and multiplications by even
+/// constants, each changing only bits above those it reads) flips each bit
+/// by a function of the bits before it and `seed` (Burley 2020's
+/// constants).
+#[inline(always)]
+pub fn owen(x: u32, seed: u32) -> u32 {
+    let mut v = x.reverse_bits().wrapping_add(seed);
+    v ^= v.wrapping_mul(0x6c50_b47c);
+    v ^= v.wrapping_mul(0xb82f_1e52);
+    v ^= v.wrapping_mul(0xc7af_e638);
+    v ^= v.wrapping_mul(0x8d22_f6e6);
+    v.reverse_bits()
+}
+
+/// A random binary matrix, lower triangular when bit 31 is row 0 and
+/// unit on the diagonal: row `i` as the mask of the input bits that output
+/// bit `31 − i` sums.
+fn lower_triangular(rng: &mut Rng) -> [u32; BITS] {
+    std::array::from_fn(|i| {
+        let diagonal = 1u32 << (BITS - 1 - i);
+        // The bits above the diagonal (more significant): i of them.
+        let above = !(diagonal | (diagonal - 1));
+        diagonal | (rng.next_u32() & above)
+    })
+}
+
+/// The matrix `rows` times the bit vector `c` over GF(2).
+fn multiply(rows: &[u32; BITS], c: u32) -> u32 {
+    rows.iter().enumerate().fold(0, |acc, (i, &row)| {
+        acc | (((row & c).count_ones() & 1) << (BITS - 1 - i))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::Error;
+
+    fn points(s: &Sobol, first: u64, n: usize) -> Vec<f64> {
+        let mut out = vec![0.0; n * s.dims()];
+        s.fill(first, &mut out).unwrap();
+        out
+    }
+
+    /// The first points of the plain sequence, by hand: 0, 1/2, then the
+    /// Gray-code walk (scipy's order).
+    #[test]
+    fn plain_points_start_at_the_origin_in_gray_code_order() {
+        let s = Sobol::new(2, Scramble::None, 0).unwrap();
+        assert_eq!(
+            points(&s, 0, 4),
+            [0.0, 0.0, 0.5, 0.5, 0.75, 0.25, 0.25, 0.75]
+        );
+    }
+
+    /// A block started anywhere, and one split across threads, equal the
+    /// points computed one at a time.
+    #[test]
+    fn fill_agrees_with_bits_from_any_start() {
+        for scramble in [Scramble::None, Scramble::Owen, Scramble::LinearMatrix] {
+            let s = Sobol::new(5, scramble, 7).unwrap();
+            let first = 123_456;
+            let out = points(&s, first, 70_000);
+            for (r, row) in out.chunks(5).enumerate().step_by(997) {
+                for (j, &x) in row.iter().enumerate() {
+                    let bits = s.bits((first + r as u64) as u32, j);
+                    assert_eq!(x, f64::from(bits) / 2f64.powi(32));
+                }
+            }
+        }
+    }
+
+    /// Each scramble keeps the (0, m, 2)-net property of dimensions 0 and
+    /// 1: every prefix of 2^m points puts one point in each elementary box
+    /// of area 2^−m.
+    #[test]
+    fn scrambles_keep_the_net_of_the_first_two_dimensions() {
+        for scramble in [Scramble::None, Scramble::Owen, Scramble::LinearMatrix] {
+            let s = Sobol::new(2, scramble, 3).unwrap();
+            for m in 0..=10u32 {
+                for a in 0..=m {
+                    let top = |v: u32, k: u32| if k == 0 { 0 } else { v >> (32 - k) };
+                    let mut seen = vec![false; 1 << m];
+                    for i in 0..1u32 << m {
+                        let cell = (top(s.bits(i, 0), a) << (m - a)) | top(s.bits(i, 1), m - a);
+                        let cell = cell as usize;
+                        assert!(!seen[cell], "{scramble:?} m {m} a {a} point {i}");
+                        seen[cell] = true;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Past index 2^32 − 1 there are no points.
+    #[test]
+    fn the_last_index_is_2_to_the_32_minus_1() {
+        let s = Sobol::new(1, Scramble::None, 0).unwrap();
+        let mut out = [0.0f64; 2];
+        assert!(s.fill((1 << 32) - 2, &mut out).is_ok());
+        assert!(matches!(
+            s.fill((1 << 32) - 1, &mut out),
+            Err(Error::Integer { .. })
+        ));
+        assert!(Sobol::new(0, Scramble::None, 0).is_err());
+        assert!(Sobol::new(MAX_DIMENSIONS + 1, Scramble::None, 0).is_err());
+    }
+
+    /// Owen's scramble permutes: bijective on the top bits it is fed, and
+    /// a bit depends only on the bits above it.
+    #[test]
+    fn owen_scrambling_is_nested() {
+        for seed in [0, 1, 0xdead_beef] {
+            for x in (0..1u32 << 12).map(|k| k << 20) {
+                let y = owen(x, seed);
+                // Flipping bit 19 (below all of x's) changes only bits ≤ 19.
+                assert_eq!(owen(x ^ (1 << 19), seed) >> 20, y >> 20);
+            }
+            let mut top: Vec<u32> = (0..1u32 << 12).map(|k| owen(k << 20, seed) >> 20).collect();
+            top.sort_unstable();
+            assert!(top.iter().enumerate().all(|(k, &t)| t == k as u32));
+        }
+    }
+}
