@@ -9,12 +9,18 @@ from scipy.stats import qmc as scipy_qmc
 import mcsample as mcs
 from mcsample import qmc, stats, warp
 
-SCRAMBLED = [
+SEQUENCES = [
     lambda d, seed: qmc.Sobol(d, scramble=True, seed=seed),
     lambda d, seed: qmc.Sobol(d, scramble="lms", seed=seed),
     lambda d, seed: qmc.Halton(d, scramble=True, seed=seed),
 ]
-SCRAMBLED_IDS = ["sobol-owen", "sobol-lms", "halton"]
+PATTERNS = [
+    lambda d, seed: qmc.LatinHypercube(d, seed=seed),
+    lambda d, seed: qmc.Stratified(d, seed=seed),
+    lambda d, seed: qmc.MultiJitter(d, seed=seed),
+]
+SCRAMBLED = SEQUENCES + PATTERNS
+SCRAMBLED_IDS = ["sobol-owen", "sobol-lms", "halton", "lhs", "stratified", "multijitter"]
 
 
 def test_plain_sobol_is_scipys_for_every_dimension():
@@ -126,8 +132,11 @@ def test_engine_interface(make):
     assert first.shape == (10, 3) and first.dtype == np.float64
     assert ((first >= 0) & (first < 1)).all()
     assert e.num_generated == 10
+    assert not np.array_equal(e.random(10), first)
     assert np.array_equal(e.reset().random(10), first)
-    assert np.array_equal(e.reset().fast_forward(4).random(6), first[4:])
+    if make in SEQUENCES:
+        # A sequence continues: skipping 4 points gives the rest.
+        assert np.array_equal(e.reset().fast_forward(4).random(6), first[4:])
     f32 = e.reset().random(10, dtype=np.float32)
     assert f32.dtype == np.float32 and np.allclose(f32, first, atol=2**-23)
     assert ((f32 >= 0) & (f32 < 1)).all()
@@ -147,6 +156,28 @@ def test_scipy_interface_of_random_base2():
         e.random_base2(-1)
 
 
+@pytest.mark.parametrize("n", [64, 100, 37])
+def test_patterns_are_stratified(n):
+    """LHS: one point per interval of 1/n in each dimension; Stratified: one
+    per stratum of the r x r grid when n = r**2 (else distinct strata);
+    MultiJitter: one per interval along y, and along x when n = m k."""
+    def intervals(column, count):
+        return len(np.unique((column * count).astype(int))) == len(column)
+
+    lhs = qmc.LatinHypercube(5, seed=1).random(n)
+    assert all(intervals(lhs[:, j], n) for j in range(5))
+    centred = qmc.LatinHypercube(2, scramble=False, seed=1).random(n)
+    assert np.allclose((centred * n) % 1, 0.5)
+    r = int(np.ceil(np.sqrt(n)))
+    strat = qmc.Stratified(3, seed=1).random(n)
+    cells = (strat[:, 0] * r).astype(int) * r + (strat[:, 1] * r).astype(int)
+    assert len(np.unique(cells)) == n
+    assert intervals(strat[:, 2], n)
+    mj = qmc.MultiJitter(2, seed=1).random(n)
+    assert intervals(mj[:, 1], n)
+    assert intervals(mj[:, 0], n) == (n != 37)
+
+
 def test_bad_input():
     with pytest.raises(ValueError, match="d = 0"):
         qmc.Sobol(0)
@@ -158,6 +189,12 @@ def test_bad_input():
         qmc.Sobol(2, scramble="owen")
     with pytest.raises(ValueError, match="scramble"):
         qmc.Halton(2, scramble="lms")
+    with pytest.raises(ValueError, match="scramble"):
+        qmc.LatinHypercube(2, scramble="lms")
+    with pytest.raises(ValueError, match="d = 0"):
+        qmc.MultiJitter(0)
+    with pytest.raises(ValueError, match="n = 1073741825"):
+        qmc.Stratified(1).random(2**30 + 1)
     with pytest.raises(ValueError, match="n = -3"):
         qmc.Sobol(2).fast_forward(-3)
     with pytest.raises(ValueError, match="n = -1"):

@@ -533,6 +533,40 @@ def suite_convergence(n: int, repeat: int, mi, target: float = 0.01, spp: int = 
     return out
 
 
+def suite_qmc(n: int, repeat: int, mi) -> list[Timing]:
+    """QMC engines drawing 2^20 points (values counted: points × d),
+    beside scipy.stats.qmc's engines of the same kind, from a reset engine
+    each time."""
+    from scipy.stats import qmc as scipy_qmc
+
+    points = 2**20
+    cases: list[tuple[str, list[tuple[str, Callable[[], object]]]]] = []
+    for d in (2, 8):
+        for ours, theirs, label in [(False, False, "plain"), (True, True, "scrambled"),
+                                    ("lms", True, "lms")]:
+            e, s = mcs.qmc.Sobol(d, scramble=ours, seed=1), scipy_qmc.Sobol(d, scramble=theirs, rng=1)
+            cases.append((f"Sobol d={d} {label}",
+                          [("mcsample", lambda e=e: e.reset().random(points)),
+                           ("scipy", lambda s=s: s.reset().random(points))]))
+    for scramble in (False, True):
+        e, s = mcs.qmc.Halton(8, scramble=scramble, seed=1), scipy_qmc.Halton(8, scramble=scramble, rng=1)
+        cases.append((f"Halton d=8 {'scrambled' if scramble else 'plain'}",
+                      [("mcsample", lambda e=e: e.reset().random(points)),
+                       ("scipy", lambda s=s: s.reset().random(points))]))
+    e, s = mcs.qmc.LatinHypercube(8, seed=1), scipy_qmc.LatinHypercube(8, rng=1)
+    cases.append(("LatinHypercube d=8", [("mcsample", lambda: e.random(points)),
+                                         ("scipy", lambda: s.random(points))]))
+    for engine in (mcs.qmc.Stratified(8, seed=1), mcs.qmc.MultiJitter(8, seed=1)):
+        cases.append((f"{type(engine).__name__} d=8",
+                      [("mcsample", lambda engine=engine: engine.random(points))]))
+    out = []
+    for case, runs in cases:
+        d = int(case.split("d=")[1].split()[0])
+        seconds = measure_side_by_side([f for _, f in runs], repeat=repeat, warmup=1)
+        out += [Timing(case, impl, "float64", points * d, t) for (impl, _), t in zip(runs, seconds)]
+    return out
+
+
 SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
     "rng": suite_rng,
     "warps": suite_warps,
@@ -541,6 +575,7 @@ SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
     "envmap": suite_envmap,
     "render": suite_render,
     "convergence": suite_convergence,
+    "qmc": suite_qmc,
 }
 
 

@@ -17,6 +17,19 @@ thread count; ``fast_forward`` costs O(1)), and draws float64 or, with
   dimension (as scipy does), ``False`` gives ``scipy.stats.qmc.Halton(d,
   scramble=False)``'s points, bit for bit.
 
+The stratified patterns are drawn whole: each ``random(n)`` is one
+pattern of ``n`` points (its seed derived from the engine's and from the
+points drawn before it, so ``reset()`` replays the same calls):
+
+- ``LatinHypercube(d, scramble=True, seed=None)``: one point per interval
+  of length 1/n in every dimension, jittered (``scramble=False``: at the
+  intervals' centres), as scipy's ``LatinHypercube``.
+- ``Stratified(d, seed=None)``: Mitsuba's ``stratified`` sampler, the
+  strata of an r x r grid (r = ceil(sqrt(n))) in a random order per pair of
+  dimensions, jittered (one point per stratum when n is a square).
+- ``MultiJitter(d, seed=None)``: Kensler's correlated multi-jittered
+  points per pair of dimensions, as Mitsuba's ``multijitter`` sampler.
+
 Seeds are an int, None (fresh entropy) or a ``numpy.random.Generator``, as
 everywhere in mcsample; the same seed gives the same points.
 """
@@ -33,7 +46,7 @@ from scipy.stats import qmc as _scipy_qmc
 from ._core import qmc as _core
 from .seeds import SeedLike, resolve_seed
 
-__all__ = ["Sobol", "Halton"]
+__all__ = ["Sobol", "Halton", "LatinHypercube", "Stratified", "MultiJitter"]
 
 DType = Union[type[np.float64], type[np.float32], np.dtype, str]
 
@@ -52,11 +65,13 @@ def _count(n: object, arg: str) -> int:
 class _Engine(_scipy_qmc.QMCEngine):
     """The shared part: position, ``random``, ``fast_forward``, ``reset``."""
 
-    _points: _core.SobolPoints | _core.HaltonPoints
+    _points: _core.SobolPoints | _core.HaltonPoints | _core.PatternPoints
     seed: int
     """The 64-bit seed the scramble was drawn from."""
 
-    def __init__(self, points: _core.SobolPoints | _core.HaltonPoints, seed: int) -> None:
+    def __init__(
+        self, points: _core.SobolPoints | _core.HaltonPoints | _core.PatternPoints, seed: int
+    ) -> None:
         self._points = points
         self.seed = seed
         super().__init__(d=points.d)
@@ -97,10 +112,12 @@ class _Engine(_scipy_qmc.QMCEngine):
         return self
 
     def __repr__(self) -> str:
-        return (f"{type(self).__name__}(d={self.d}, scramble={self._scramble!r}, "
-                f"seed={self.seed}) at point {self.num_generated}")
+        scramble = "" if self._scramble is None else f"scramble={self._scramble!r}, "
+        return (f"{type(self).__name__}(d={self.d}, {scramble}seed={self.seed}) "
+                f"at point {self.num_generated}")
 
-    _scramble: object
+    _scramble: object = None
+    """The ``scramble`` argument, for the repr (None: the engine has none)."""
 
 
 class Sobol(_Engine):
@@ -177,3 +194,66 @@ class Halton(_Engine):
         self._scramble = bool(scramble)
         value = resolve_seed(seed)
         super().__init__(_core.HaltonPoints(d, bool(scramble), value), value)
+
+
+class LatinHypercube(_Engine):
+    """Latin hypercube patterns: each ``random(n)`` puts one point in each
+    interval of length 1/n of every dimension.
+
+    Parameters
+    ----------
+    d : int
+        Dimensions, 1 to 65536.
+    scramble : bool, keyword only
+        True (default): a uniform point in each interval; False: its centre
+        (scipy's meaning).
+    seed : int, None or numpy.random.Generator, keyword only
+        None (default) draws fresh random bits.
+    """
+
+    def __init__(self, d: int, *, scramble: bool = True, seed: SeedLike = None) -> None:
+        if not isinstance(scramble, (bool, np.bool_)):
+            raise ValueError(f"scramble = {scramble!r}: must be True or False")
+        self._scramble = bool(scramble)
+        value = resolve_seed(seed)
+        kind: Literal["lhs", "lhs-centered"] = "lhs" if scramble else "lhs-centered"
+        super().__init__(_core.PatternPoints(kind, d, value), value)
+
+
+class Stratified(_Engine):
+    """Jittered strata, as Mitsuba's ``stratified`` sampler: each
+    ``random(n)`` shuffles the strata of an r x r grid (r = ceil(sqrt(n)))
+    per pair of dimensions and jitters each point in its stratum (a last odd
+    dimension is stratified in n intervals). With n a square every stratum
+    gets one point.
+
+    Parameters
+    ----------
+    d : int
+        Dimensions, 1 to 65536.
+    seed : int, None or numpy.random.Generator, keyword only
+        None (default) draws fresh random bits.
+    """
+
+    def __init__(self, d: int, *, seed: SeedLike = None) -> None:
+        value = resolve_seed(seed)
+        super().__init__(_core.PatternPoints("stratified", d, value), value)
+
+
+class MultiJitter(_Engine):
+    """Kensler's correlated multi-jittered points (2013), as Mitsuba's
+    ``multijitter`` sampler: per pair of dimensions, each ``random(n)`` is
+    stratified in an m x k grid (m = floor(sqrt(n)), k = ceil(n/m)) and in
+    n intervals along y (and along x when n = m k).
+
+    Parameters
+    ----------
+    d : int
+        Dimensions, 1 to 65536.
+    seed : int, None or numpy.random.Generator, keyword only
+        None (default) draws fresh random bits.
+    """
+
+    def __init__(self, d: int, *, seed: SeedLike = None) -> None:
+        value = resolve_seed(seed)
+        super().__init__(_core.PatternPoints("multijitter", d, value), value)

@@ -8,7 +8,9 @@ use super::parallel::detached;
 use super::rng::wants_float32;
 use crate::math::Real;
 use crate::python::Obj;
-use crate::qmc::{HALTON_MAX_INDEX, Halton, Scramble, Sobol};
+use crate::qmc::{
+    HALTON_MAX_INDEX, Halton, PATTERN_MAX_POINTS, Pattern, Patterns, Scramble, Sobol,
+};
 use numpy::{Element, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 
@@ -158,9 +160,82 @@ impl PyHaltonPoints {
     }
 }
 
+/// Stratified patterns of ``n`` points drawn whole: the engine behind
+/// ``mcsample.qmc.LatinHypercube``, ``Stratified`` and ``MultiJitter``.
+///
+/// Parameters
+/// ----------
+/// kind : "lhs", "lhs-centered", "stratified" or "multijitter"
+///     A Latin hypercube (jittered in its intervals, or at their centres);
+///     shuffled strata of a square grid per pair of dimensions (Mitsuba's
+///     ``stratified``); Kensler's correlated multi-jitter per pair
+///     (Mitsuba's ``multijitter``).
+/// d : int
+///     Dimensions, 1 to 65536.
+/// seed : int, None or numpy.random.Generator
+///     The patterns' random bits (default 0).
+#[pyclass(module = "mcsample._core.qmc", name = "PatternPoints", frozen)]
+pub struct PyPatternPoints(Patterns);
+
+#[pymethods]
+impl PyPatternPoints {
+    #[new]
+    #[pyo3(signature = (kind, d, seed = 0))]
+    fn new(kind: &str, d: &Obj<'_>, #[pyo3(from_py_with = seed)] seed: u64) -> PyResult<Self> {
+        let kind = choice(
+            "kind",
+            kind,
+            &[
+                ("lhs", Pattern::LatinHypercube { centered: false }),
+                ("lhs-centered", Pattern::LatinHypercube { centered: true }),
+                ("stratified", Pattern::Stratified),
+                ("multijitter", Pattern::MultiJitter),
+            ],
+        )?;
+        let d = index_arg(d, "d", 1, crate::qmc::PATTERN_MAX_DIMENSIONS as u64)? as usize;
+        Ok(Self(Patterns::new(kind, d, seed)?))
+    }
+
+    /// The pattern numbered ``draw`` (the points drawn before it), of ``n``
+    /// points (at most 2**30).
+    ///
+    /// Parameters
+    /// ----------
+    /// draw, n : int >= 0
+    /// dtype : float64 (default) or float32
+    ///
+    /// Returns
+    /// -------
+    /// ndarray, shape (n, d), in [0, 1).
+    #[pyo3(signature = (draw, n, dtype = None))]
+    fn points<'py>(
+        &self,
+        py: Python<'py>,
+        draw: &Obj<'py>,
+        n: &Obj<'py>,
+        dtype: Option<&Obj<'py>>,
+    ) -> PyResult<Obj<'py>> {
+        let draw = index_arg(draw, "draw", 0, u64::MAX)?;
+        let n = index_arg(n, "n", 0, PATTERN_MAX_POINTS)? as usize;
+        let (patterns, d) = (&self.0, self.0.dims());
+        if wants_float32(py, dtype)? {
+            points::<f32>(py, d, n, |out| patterns.fill(draw, out))
+        } else {
+            points::<f64>(py, d, n, |out| patterns.fill(draw, out))
+        }
+    }
+
+    /// The number of dimensions.
+    #[getter]
+    fn d(&self) -> usize {
+        self.0.dims()
+    }
+}
+
 /// Registers the point generators in module `m`.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PySobolPoints>()?;
     m.add_class::<PyHaltonPoints>()?;
+    m.add_class::<PyPatternPoints>()?;
     Ok(())
 }

@@ -1,15 +1,21 @@
-//! Quasi-Monte Carlo point sets: [`Sobol`] (plain, Owen-scrambled, or by a
-//! linear matrix scramble) and [`Halton`] (plain or digit-permuted). Each
-//! fills rows of `d` coordinates in `[0, 1)` from any index on, on all
-//! cores, with the same bits at any thread count; a point is computed from
-//! its index alone, so skipping ahead costs nothing.
+//! Quasi-Monte Carlo point sets: the sequences [`Sobol`] (plain,
+//! Owen-scrambled, or by a linear matrix scramble) and [`Halton`] (plain or
+//! digit-permuted), and the stratified [`Patterns`] drawn `n` points at a
+//! time (Latin hypercube, stratified, multi-jittered). Each fills rows of
+//! `d` coordinates in `[0, 1)` on all cores, with the same bits at any
+//! thread count; a point is computed from its index alone, so skipping
+//! ahead costs nothing.
 
 mod directions;
 mod halton;
+mod patterns;
 mod sobol;
 
 pub use directions::MAX_DIMENSIONS as SOBOL_MAX_DIMENSIONS;
 pub use halton::{Halton, MAX_DIMENSIONS as HALTON_MAX_DIMENSIONS, MAX_INDEX as HALTON_MAX_INDEX};
+pub use patterns::{
+    MAX_DIMENSIONS as PATTERN_MAX_DIMENSIONS, MAX_POINTS as PATTERN_MAX_POINTS, Pattern, Patterns,
+};
 pub use sobol::{Scramble, Sobol, owen};
 
 use crate::error::{Error, Result};

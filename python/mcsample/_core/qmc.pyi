@@ -31,3 +31,18 @@ class HaltonPoints:
         """Points ``first .. first + n - 1``, shape (n, d)."""
     @property
     def d(self) -> int: ...
+
+@final
+class PatternPoints:
+    """Stratified patterns of n points drawn whole."""
+
+    def __new__(
+        cls,
+        kind: Literal["lhs", "lhs-centered", "stratified", "multijitter"],
+        d: int,
+        seed: int | None | np.random.Generator = 0,
+    ) -> PatternPoints: ...
+    def points(self, draw: int, n: int, dtype: DTypeLike | None = None) -> NDArray[Any]:
+        """The pattern numbered ``draw``, of ``n`` points, shape (n, d)."""
+    @property
+    def d(self) -> int: ...

@@ -1,0 +1,284 @@
+//! Stratified patterns of `n` points drawn whole: [`Pattern::LatinHypercube`],
+//! [`Pattern::Stratified`] (Mitsuba's `stratified` sampler) and
+//! [`Pattern::MultiJitter`] (Kensler's correlated multi-jittered sampling,
+//! Mitsuba's `multijitter`). Each point is computed from its index, the
+//! pattern's size and seed alone (Kensler's hashed permutations instead of
+//! shuffles), so a pattern fills on all cores with the same bits at any
+//! thread count.
+
+use super::{Rows, check_dims, check_range};
+use crate::error::Result;
+use crate::math::Real;
+use crate::parallel;
+
+/// Dimensions a pattern accepts.
+pub const MAX_DIMENSIONS: usize = 1 << 16;
+
+/// Points a pattern may have: `2^30`, so that the strata of
+/// [`Pattern::Stratified`]'s square grid are counted in 32 bits.
+pub const MAX_POINTS: u64 = 1 << 30;
+
+/// How a pattern of `n` points stratifies `[0, 1)^d`. `π` is a random
+/// permutation (Kensler's hash, its own seed per dimension or pair) and
+/// `ξ` a uniform jitter; point `s` of `n` gets:
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pattern {
+    /// `x_j = (π_j(s) + ξ)/n` in every dimension (McKay et al. 1979): each
+    /// dimension has one point per interval of length `1/n`; `centered`
+    /// puts `ξ = 1/2` (scipy's `scramble=False`).
+    LatinHypercube {
+        /// Points at their intervals' centres.
+        centered: bool,
+    },
+    /// Per pair of dimensions, the strata of an `r × r` grid (`r = ⌈√n⌉`)
+    /// in a random order, `(x, y) = ((c mod r + ξ)/r, (⌊c/r⌋ + ξ')/r)` with
+    /// `c = π(s)`: one point per stratum when `n` is a square (Mitsuba
+    /// rounds its sample count up to one); a last odd dimension is
+    /// stratified in `n` intervals.
+    Stratified,
+    /// Per pair of dimensions, Kensler's correlated multi-jitter (2013):
+    /// `m = ⌊√n⌋`, `k = ⌈n/m⌉`, `s' = π(s)`, `x = (π_x(s' mod m) +
+    /// (π_y(⌊s'/m⌋) + ξ)/k)/m`, `y = (s' + ξ')/n`: stratified in the `m × k`
+    /// grid and in `n` intervals along each axis; a last odd dimension is
+    /// stratified in `n` intervals.
+    MultiJitter,
+}
+
+/// A pattern of `n` points in `d` dimensions, seeded.
+#[derive(Clone, Copy, Debug)]
+pub struct Patterns {
+    pattern: Pattern,
+    dims: usize,
+    seed: u64,
+}
+
+impl Patterns {
+    /// Patterns of kind `pattern` in `dims` dimensions from `seed`.
+    ///
+    /// # Errors
+    /// [`crate::Error::Integer`] unless `1 ≤ dims ≤` [`MAX_DIMENSIONS`].
+    pub fn new(pattern: Pattern, dims: usize, seed: u64) -> Result<Self> {
+        check_dims(dims, MAX_DIMENSIONS)?;
+        Ok(Patterns {
+            pattern,
+            dims,
+            seed,
+        })
+    }
+
+    /// Number of dimensions.
+    pub fn dims(&self) -> usize {
+        self.dims
+    }
+
+    /// The pattern numbered `draw` (any number: the engine's count of
+    /// points drawn before it), of as many points as `out` holds rows
+    /// (row-major, `dims` values a row), on all cores.
+    ///
+    /// # Errors
+    /// [`crate::Error::Integer`] for more than [`MAX_POINTS`] points, or if
+    /// `out` does not hold whole rows.
+    pub fn fill<F: Real>(&self, draw: u64, out: &mut [F]) -> Result<()> {
+        let d = self.dims;
+        let n = check_range(out.len(), d, 0, MAX_POINTS)? as u32;
+        let key = mix64(self.seed ^ mix64(draw));
+        // One 32-bit seed per dimension (LHS) or pair (the others).
+        let seeds: Vec<u32> = (0..d as u64)
+            .map(|j| (mix64(key ^ j) >> 32) as u32)
+            .collect();
+        let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
+        parallel::for_each_chunk(n as usize, Rows::new(out, d), |range, rows| {
+            for (s, row) in (range.start as u32..).zip(rows.chunks_mut()) {
+                self.point(s, n, &seeds, row, unit);
+            }
+            true
+        })
+        .map(|_| ())
+    }
+
+    /// Point `s` of `n` into `row`.
+    fn point<F>(&self, s: u32, n: u32, seeds: &[u32], row: &mut [F], unit: impl Fn(f64) -> F) {
+        let n_f = f64::from(n);
+        // The last dimension of an odd count (and every LHS dimension):
+        // stratified in n intervals.
+        let single = |p: u32, centered: bool| {
+            let jitter = if centered { 0.5 } else { jitter(s, p) };
+            (f64::from(permute(s, n, p)) + jitter) / n_f
+        };
+        match self.pattern {
+            Pattern::LatinHypercube { centered } => {
+                for (x, &p) in row.iter_mut().zip(seeds) {
+                    *x = unit(single(p, centered));
+                }
+            }
+            Pattern::Stratified | Pattern::MultiJitter => {
+                let mut pairs = row.chunks_exact_mut(2);
+                for (pair, &p) in pairs.by_ref().zip(seeds) {
+                    let (x, y) = if self.pattern == Pattern::Stratified {
+                        stratified(s, n, p)
+                    } else {
+                        multi_jitter(s, n, p)
+                    };
+                    pair[0] = unit(x);
+                    pair[1] = unit(y);
+                }
+                if let [last] = pairs.into_remainder() {
+                    *last = unit(single(seeds[self.dims / 2], false));
+                }
+            }
+        }
+    }
+}
+
+/// Point `s` of `n` in a shuffled `r × r` grid of strata, `r = ⌈√n⌉`.
+fn stratified(s: u32, n: u32, p: u32) -> (f64, f64) {
+    let r = (f64::from(n).sqrt().ceil() as u32).max(1);
+    let cell = permute(s, r * r, p);
+    let r_f = f64::from(r);
+    (
+        (f64::from(cell % r) + jitter(s, p ^ 0x68bc_21eb)) / r_f,
+        (f64::from(cell / r) + jitter(s, p ^ 0x02e5_be93)) / r_f,
+    )
+}
+
+/// Point `s` of `n` of Kensler's correlated multi-jittered pattern.
+fn multi_jitter(s: u32, n: u32, p: u32) -> (f64, f64) {
+    let m = (f64::from(n).sqrt() as u32).max(1);
+    let k = n.div_ceil(m);
+    let s = permute(s, n, p.wrapping_mul(0x5163_3e2d));
+    let sx = permute(s % m, m, p.wrapping_mul(0x68bc_21eb));
+    let sy = permute(s / m, k, p.wrapping_mul(0x02e5_be93));
+    let (jx, jy) = (
+        jitter(s, p.wrapping_mul(0x967a_889b)),
+        jitter(s, p.wrapping_mul(0x368c_c8b7)),
+    );
+    let (m, k, n) = (f64::from(m), f64::from(k), f64::from(n));
+    (
+        (f64::from(sx) + (f64::from(sy) + jx) / k) / m,
+        (f64::from(s) + jy) / n,
+    )
+}
+
+/// Kensler's hashed permutation of `0 .. len` (2013): a bijection on the
+/// smallest power-of-two range holding `len`, built of steps each
+/// invertible on those low bits (xor, multiplication by odd constants,
+/// xor-shifts), applied again while the result is `≥ len` (cycle
+/// walking), then rotated by `seed`. `i < len`.
+fn permute(mut i: u32, len: u32, seed: u32) -> u32 {
+    let w = u32::MAX >> (len.max(2) - 1).leading_zeros();
+    loop {
+        i ^= seed;
+        i = i.wrapping_mul(0xe170_893d);
+        i ^= seed >> 16;
+        i ^= (i & w) >> 4;
+        i ^= seed >> 8;
+        i = i.wrapping_mul(0x0929_eb3f);
+        i ^= seed >> 23;
+        i ^= (i & w) >> 1;
+        i = i.wrapping_mul(1 | seed >> 27);
+        i = i.wrapping_mul(0x6935_fa69);
+        i ^= (i & w) >> 11;
+        i = i.wrapping_mul(0x74dc_b303);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0x9e50_1cc3);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0xc860_a3df);
+        i &= w;
+        i ^= i >> 5;
+        if i < len {
+            return ((u64::from(i) + u64::from(seed)) % u64::from(len)) as u32;
+        }
+    }
+}
+
+/// A uniform jitter in `[0, 1)` for index `i` and seed `p`: 32 bits of
+/// Wellons' `lowbias32` hash, as a multiple of `2^−32`.
+fn jitter(i: u32, p: u32) -> f64 {
+    f64::from(lowbias32(i ^ lowbias32(p))) * (1.0 / 4_294_967_296.0)
+}
+
+/// Chris Wellons' `lowbias32` integer hash.
+fn lowbias32(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^ (x >> 16)
+}
+
+/// SplitMix64's finaliser: a bijective 64-bit mix.
+fn mix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn permute_is_a_permutation_for_every_length() {
+        for len in (1..300).chain([1000, 4096, 4097]) {
+            for seed in [0, 1, 0xdead_beef] {
+                let mut seen = vec![false; len as usize];
+                for i in 0..len {
+                    let j = permute(i, len, seed) as usize;
+                    assert!(!seen[j], "len {len} seed {seed}");
+                    seen[j] = true;
+                }
+            }
+        }
+    }
+
+    fn pattern(pattern: Pattern, d: usize, n: usize) -> Vec<f64> {
+        let mut out = vec![0.0; n * d];
+        Patterns::new(pattern, d, 5)
+            .unwrap()
+            .fill(3, &mut out)
+            .unwrap();
+        out
+    }
+
+    /// Which of `n` equal intervals each value of column `j` falls in:
+    /// each once.
+    fn one_per_interval(points: &[f64], d: usize, j: usize, n: usize) -> bool {
+        let mut seen = vec![false; n];
+        points.chunks(d).all(|row| {
+            let k = (row[j] * n as f64) as usize;
+            !std::mem::replace(&mut seen[k], true)
+        })
+    }
+
+    #[test]
+    fn latin_hypercube_has_one_point_per_interval_in_every_dimension() {
+        for centered in [false, true] {
+            let x = pattern(Pattern::LatinHypercube { centered }, 3, 1000);
+            assert!((0..3).all(|j| one_per_interval(&x, 3, j, 1000)));
+        }
+    }
+
+    #[test]
+    fn stratified_fills_every_stratum_of_a_square_count() {
+        let x = pattern(Pattern::Stratified, 3, 64);
+        let mut cells: Vec<usize> = x
+            .chunks(3)
+            .map(|r| (r[0] * 8.0) as usize * 8 + (r[1] * 8.0) as usize)
+            .collect();
+        cells.sort_unstable();
+        assert!(cells.iter().enumerate().all(|(k, &c)| c == k));
+        assert!(one_per_interval(&x, 3, 2, 64));
+    }
+
+    /// Along y in n intervals for any n; along x too when n = m·k.
+    #[test]
+    fn multi_jitter_is_stratified_along_each_axis() {
+        for n in [64, 100, 37] {
+            let x = pattern(Pattern::MultiJitter, 3, n);
+            assert!(one_per_interval(&x, 3, 1, n));
+            assert!(one_per_interval(&x, 3, 2, n));
+            assert_eq!(one_per_interval(&x, 3, 0, n), n != 37);
+        }
+    }
+}
