@@ -24,6 +24,7 @@ use crate::parallel::Outputs;
 /// A row-major block of rows of `width` values, split between threads at
 /// row boundaries.
 struct Rows<'a, T> {
+    /// The rows' values, row after row.
     values: &'a mut [T],
     width: usize,
 }

@@ -5,8 +5,8 @@ use super::directions::{BITS, MAX_DIMENSIONS, columns};
 use super::{Rows, check_dims, check_range};
 use crate::error::Result;
 use crate::math::Real;
-use crate::parallel;
 use crate::rng::Rng;
+use crate::{parallel, simd};
 
 /// How [`Sobol`] randomises its points.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,11 +34,20 @@ pub enum Scramble {
 /// then scrambled as [`Scramble`] says. Indices run from 0 to `2^32 − 1`.
 #[derive(Clone, Debug)]
 pub struct Sobol {
-    columns: Vec<[u32; BITS]>,
+    /// Bit-major: `by_bit[b·d + j]` is column `b` of dimension `j`'s
+    /// matrix, so that a step of the Gray-code walk is one pass of XORs
+    /// over contiguous memory.
+    by_bit: Vec<u32>,
+    dims: usize,
     scramble: Scramble,
     /// Per dimension: the Owen seed, or the digital shift (0 for plain).
     keys: Vec<u32>,
 }
+
+/// Values per block of [`Sobol::fill`]: the walk writes a block's bits, and
+/// the scramble and the conversion to floats then run over it in one
+/// vectorised pass.
+const BLOCK_VALUES: usize = 4096;
 
 impl Sobol {
     /// The first `dims` dimensions of the sequence, scrambled by `scramble`
@@ -61,8 +70,12 @@ impl Sobol {
                 (0..dims).map(|_| rng.next_u32()).collect()
             }
         };
+        let by_bit = (0..BITS)
+            .flat_map(|b| columns.iter().map(move |v| v[b]))
+            .collect();
         Ok(Sobol {
-            columns,
+            by_bit,
+            dims,
             scramble,
             keys,
         })
@@ -70,12 +83,29 @@ impl Sobol {
 
     /// Number of dimensions.
     pub fn dims(&self) -> usize {
-        self.columns.len()
+        self.dims
+    }
+
+    /// Column `b` of every dimension's matrix.
+    fn column(&self, b: usize) -> &[u32] {
+        &self.by_bit[b * self.dims..(b + 1) * self.dims]
+    }
+
+    /// Coordinate `dim` of point `index`, before the scramble's last step.
+    fn unscrambled(&self, index: u32, dim: usize) -> u32 {
+        let gray = index ^ (index >> 1);
+        (0..BITS)
+            .filter(|&b| gray >> b & 1 == 1)
+            .fold(0, |acc, b| acc ^ self.column(b)[dim])
     }
 
     /// Coordinate `dim` of point `index`, as 32 bits (`x·2^32`).
     pub fn bits(&self, index: u32, dim: usize) -> u32 {
-        self.finish(unscrambled(&self.columns[dim], index), dim)
+        let x = self.unscrambled(index, dim);
+        match self.scramble {
+            Scramble::Owen => owen(x, self.keys[dim]),
+            Scramble::None | Scramble::LinearMatrix => x ^ self.keys[dim],
+        }
     }
 
     /// Points `first ..` into `out` (row-major, `dims` values a row, as many
@@ -85,44 +115,59 @@ impl Sobol {
     /// [`Error::Integer`] if the points would pass index `2^32 − 1`, or
     /// if `out` does not hold whole rows.
     pub fn fill<F: Real>(&self, first: u64, out: &mut [F]) -> Result<()> {
-        let d = self.dims();
+        let d = self.dims;
         let n = check_range(out.len(), d, first, 1 << BITS)?;
+        let block_rows = (BLOCK_VALUES / d).max(1);
+        // The keys of a block's values, row after row.
+        let keys: Vec<u32> = self
+            .keys
+            .iter()
+            .copied()
+            .cycle()
+            .take(block_rows * d)
+            .collect();
         parallel::for_each_chunk(n, Rows::new(out, d), |range, rows| {
             let start = (first + range.start as u64) as u32;
-            let mut x: Vec<u32> = self.columns.iter().map(|v| unscrambled(v, start)).collect();
-            for (r, row) in rows.chunks_mut().enumerate() {
-                if r > 0 {
-                    // g(i) ⊕ g(i − 1) is the lowest set bit of i.
-                    let bit = (start + r as u32).trailing_zeros() as usize;
-                    for (x, v) in x.iter_mut().zip(&self.columns) {
-                        *x ^= v[bit];
+            let mut x: Vec<u32> = (0..d).map(|j| self.unscrambled(start, j)).collect();
+            let mut bits = vec![0u32; block_rows * d];
+            for (b, block) in rows.values.chunks_mut(block_rows * d).enumerate() {
+                let bits = &mut bits[..block.len()];
+                for (r, row_bits) in bits.chunks_exact_mut(d).enumerate() {
+                    let r = (b * block_rows + r) as u32;
+                    if r > 0 {
+                        // g(i) ⊕ g(i − 1) is the lowest set bit of i.
+                        let bit = (start + r).trailing_zeros() as usize;
+                        for (x, v) in x.iter_mut().zip(self.column(bit)) {
+                            *x ^= v;
+                        }
                     }
+                    row_bits.copy_from_slice(&x);
                 }
-                for (j, (value, &x)) in row.iter_mut().zip(&x).enumerate() {
-                    *value = F::from_random_bits(self.finish(x, j));
+                match self.scramble {
+                    Scramble::Owen => finish(block, bits, &keys, owen),
+                    Scramble::None | Scramble::LinearMatrix => {
+                        finish(block, bits, &keys, |x, key| x ^ key)
+                    }
                 }
             }
             true
         })
         .map(|_| ())
     }
-
-    /// The scramble's last step on coordinate `dim`'s bits `x`.
-    #[inline(always)]
-    fn finish(&self, x: u32, dim: usize) -> u32 {
-        match self.scramble {
-            Scramble::Owen => owen(x, self.keys[dim]),
-            Scramble::None | Scramble::LinearMatrix => x ^ self.keys[dim],
-        }
-    }
 }
 
-/// Point `index` of one dimension with columns `v`, before any shift.
-fn unscrambled(v: &[u32; BITS], index: u32) -> u32 {
-    let gray = index ^ (index >> 1);
-    (0..BITS)
-        .filter(|&b| gray >> b & 1 == 1)
-        .fold(0, |acc, b| acc ^ v[b])
+/// `out[k] = step(bits[k], keys[k])` as a float in `[0, 1)`, in a loop
+/// compiled for the widest vector unit.
+#[inline(always)]
+fn finish<F: Real>(out: &mut [F], bits: &[u32], keys: &[u32], step: impl Fn(u32, u32) -> u32) {
+    simd::dispatch(
+        #[inline(always)]
+        |_| {
+            for ((value, &x), &key) in out.iter_mut().zip(bits).zip(keys) {
+                *value = F::from_random_bits(step(x, key));
+            }
+        },
+    );
 }
 
 /// Owen's nested uniform scramble of `x` by a hash: reversed, its bits
