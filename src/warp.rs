@@ -1,5 +1,5 @@
 //! Warps from the unit square (or interval) to disks, spheres, hemispheres,
-//! lobes and triangles: `square_to_X(u, ..)`, its density `square_to_X_pdf(x, ..)`
+//! lobes, triangles, tents and linear ramps: `square_to_X(u, ..)`, its density `square_to_X_pdf(x, ..)`
 //! and its inverse `X_to_square(x, ..)`, with the names and point
 //! conventions of Mitsuba 3's `mi.warp` (same `u` → same point).
 //!
@@ -138,6 +138,37 @@ pub fn uniform_disk_to_square_concentric<F: Real>(p: P2<F>) -> P2<F> {
         clamp01((a + F::one()) * half),
         clamp01((b + F::one()) * half),
     ]
+}
+
+/// The concentric map's polar coordinates as a point of the square, as
+/// Mitsuba's `square_to_uniform_square_concentric`: with `(r, φ)` the
+/// radius and the angle (a fraction of a turn) of
+/// [`square_to_uniform_disk_concentric`]`(u)`, the point `(φ, r²)`: a
+/// measure-preserving map of the square onto itself that keeps
+/// neighbourhoods together within each octant. Density per unit area.
+///
+/// # Density
+/// `p = 1` on `[0, 1]²`. The centre (`r = 0`, where Mitsuba's angle is
+/// 0/0) gives `(0, 0)`.
+#[inline(always)]
+pub fn square_to_uniform_square_concentric<F: Real>(u: P2<F>) -> P2<F> {
+    let two = F::c(2.0);
+    let (x, y) = (two * u[0] - F::one(), two * u[1] - F::one());
+    let vertical = x.abs() < y.abs();
+    let (r, other) = if vertical { (y, x) } else { (x, y) };
+    let eighth = if r == F::zero() {
+        F::zero()
+    } else {
+        other / r * F::c(0.125)
+    };
+    let phi = if vertical {
+        F::c(0.25) - eighth
+    } else {
+        eighth
+    };
+    let phi = if r < F::zero() { phi + F::c(0.5) } else { phi };
+    let phi = if phi < F::zero() { phi + F::one() } else { phi };
+    [phi, r * r]
 }
 
 #[inline(always)]
@@ -396,6 +427,13 @@ pub fn interval_to_power_pdf<F: Real>(x: F, exponent: F) -> F {
 pub fn power_to_interval<F: Real>(x: F, exponent: F) -> F {
     F::pow_positive(clamp01(x), exponent + F::one())
 }
+
+mod ramps;
+
+pub use ramps::{
+    interval_to_linear, interval_to_nonuniform_tent, interval_to_tent, linear_to_interval,
+    square_to_tent, square_to_tent_pdf, tent_to_interval, tent_to_square,
+};
 
 #[cfg(test)]
 mod tests;

@@ -1,5 +1,6 @@
-"""Warps from the unit square to disks, spheres, hemispheres, lobes and
-triangles, each with its density (``*_pdf``) and inverse (``*_to_square``).
+"""Warps from the unit square to disks, spheres, hemispheres, lobes,
+triangles, tents and linear ramps, each with its density (``*_pdf``) and
+inverse (``*_to_square``) where Mitsuba has them.
 
 Names, argument order and point conventions follow Mitsuba 3's ``mi.warp``:
 the same ``u`` gives the same point. Densities are per unit area on planar
@@ -9,13 +10,19 @@ domains and per steradian on directions, and 0 off the support.
 from ._core.warp import (
     cosine_hemisphere_to_square,
     cosine_power_hemisphere_to_square,
+    interval_to_linear,
+    interval_to_nonuniform_tent,
     interval_to_power,
     interval_to_power_pdf,
+    interval_to_tent,
+    linear_to_interval,
     power_to_interval,
     square_to_cosine_hemisphere,
     square_to_cosine_hemisphere_pdf,
     square_to_cosine_power_hemisphere,
     square_to_cosine_power_hemisphere_pdf,
+    square_to_tent,
+    square_to_tent_pdf,
     square_to_uniform_cone,
     square_to_uniform_cone_pdf,
     square_to_uniform_disk,
@@ -26,8 +33,11 @@ from ._core.warp import (
     square_to_uniform_hemisphere_pdf,
     square_to_uniform_sphere,
     square_to_uniform_sphere_pdf,
+    square_to_uniform_square_concentric,
     square_to_uniform_triangle,
     square_to_uniform_triangle_pdf,
+    tent_to_interval,
+    tent_to_square,
     uniform_cone_to_square,
     uniform_disk_to_square,
     uniform_disk_to_square_concentric,
@@ -39,13 +49,19 @@ from ._core.warp import (
 __all__ = [
     "cosine_hemisphere_to_square",
     "cosine_power_hemisphere_to_square",
+    "interval_to_linear",
+    "interval_to_nonuniform_tent",
     "interval_to_power",
     "interval_to_power_pdf",
+    "interval_to_tent",
+    "linear_to_interval",
     "power_to_interval",
     "square_to_cosine_hemisphere",
     "square_to_cosine_hemisphere_pdf",
     "square_to_cosine_power_hemisphere",
     "square_to_cosine_power_hemisphere_pdf",
+    "square_to_tent",
+    "square_to_tent_pdf",
     "square_to_uniform_cone",
     "square_to_uniform_cone_pdf",
     "square_to_uniform_disk",
@@ -56,8 +72,11 @@ __all__ = [
     "square_to_uniform_hemisphere_pdf",
     "square_to_uniform_sphere",
     "square_to_uniform_sphere_pdf",
+    "square_to_uniform_square_concentric",
     "square_to_uniform_triangle",
     "square_to_uniform_triangle_pdf",
+    "tent_to_interval",
+    "tent_to_square",
     "uniform_cone_to_square",
     "uniform_disk_to_square",
     "uniform_disk_to_square_concentric",

@@ -18,24 +18,28 @@ use pyo3::prelude::*;
 /// `$kernel` (built with the precision alias `$F` in scope; `?` may be used
 /// to validate parameters). The docstring is the entry's summary followed
 /// by Parameters and Returns sections made from the shapes and the
-/// phrases given (`$k` and `$m` are checked against the kernel's). Every
-/// function also takes a keyword `out`: an array to write into, as numpy's
-/// ufuncs do.
+/// phrases given (`$k` and `$m` are checked against the kernel's).
+/// Parameters in braces before the points come first in the signature (as
+/// Mitsuba orders `interval_to_linear(v0, v1, sample)`). Every function
+/// also takes a keyword `out`: an array to write into, as numpy's ufuncs
+/// do.
 macro_rules! warps {
     ($(
         $(#[doc = $summary:literal])*
         fn $name:ident(
+            $({ $($q:ident: $qty:ty = $q_doc:literal),* })?
             $x:ident: [$k:tt; $check:ident] $x_doc:literal
             $(, $p:ident: $pty:ty = $p_doc:literal)*
         ) -> [$m:tt] $result_doc:literal
         = |$F:ident| $kernel:expr;
     )*) => {$(
         #[pyfunction]
-        #[pyo3(signature = ($x $(, $p)*, *, out = None))]
+        #[pyo3(signature = ($($($q,)*)? $x $(, $p)*, *, out = None))]
         $(#[doc = $summary])*
         #[doc = ""]
         #[doc = "Parameters"]
         #[doc = "----------"]
+        $($(#[doc = concat!(stringify!($q), " : ", $q_doc)])*)?
         #[doc = concat!(stringify!($x), " : ", points_doc!($k), ", ", $x_doc)]
         $(#[doc = concat!(stringify!($p), " : ", $p_doc)])*
         #[doc = "out : ndarray, optional, keyword only"]
@@ -46,6 +50,7 @@ macro_rules! warps {
         #[doc = concat!(result_doc!($m), ", ", $result_doc, ".")]
         pub fn $name<'py>(
             py: Python<'py>,
+            $($($q: $qty,)*)?
             $x: &Obj<'py>
             $(, $p: $pty)*,
             out: Out<'_, 'py>,
@@ -110,6 +115,58 @@ fn cos_cutoff_arg<F: Real>(cos_cutoff: f64) -> PyResult<F> {
         }
         .into())
     }
+}
+
+/// `(a, b, c)` of the nonuniform tent, checked: finite, `a ≤ b ≤ c`, `a < c`.
+fn tent_args<F: Real>(a: f64, b: f64, c: f64) -> PyResult<(F, F, F)> {
+    for (arg, value) in [("a", a), ("b", b), ("c", c)] {
+        if !value.is_finite() {
+            return Err(Error::Parameter {
+                arg,
+                value,
+                requirement: "must be finite",
+            }
+            .into());
+        }
+    }
+    let bad = |arg, value, requirement| {
+        Err(Error::Parameter {
+            arg,
+            value,
+            requirement,
+        }
+        .into())
+    };
+    if c <= a {
+        return bad("c", c, "must be greater than a");
+    }
+    if !(a..=c).contains(&b) {
+        return bad("b", b, "must lie in [a, c]");
+    }
+    Ok((F::c(a), F::c(b), F::c(c)))
+}
+
+/// `(v0, v1)` of the linear warps, checked: finite, `>= 0`, not both 0.
+fn linear_args<F: Real>(v0: f64, v1: f64) -> PyResult<(F, F)> {
+    for (arg, value) in [("v0", v0), ("v1", v1)] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(Error::Parameter {
+                arg,
+                value,
+                requirement: "must be finite and >= 0",
+            }
+            .into());
+        }
+    }
+    if v0 + v1 == 0.0 {
+        return Err(Error::Parameter {
+            arg: "v1",
+            value: v1,
+            requirement: "v0 and v1 must not both be 0",
+        }
+        .into());
+    }
+    Ok((F::c(v0), F::c(v1)))
 }
 
 /// `method` of the cosine-hemisphere warps: true for "polar", false for
@@ -304,6 +361,82 @@ warps! {
             #[inline(always)]
             move |x: [F; 1]| [warp::power_to_interval(x[0], n)]
         };
+
+    /// The tent 1 - |x| on [-1, 1] by inversion (Mitsuba's
+    /// ``interval_to_tent``): s = u - 1/2, x = sign(s) (1 - sqrt(1 - 2|s|)).
+    fn interval_to_tent(sample: [1; Unit] "values in [0, 1]")
+        -> [1] "in [-1, 1]; density 1 - |x| per unit length"
+        = |F| |u: [F; 1]| [warp::interval_to_tent(u[0])];
+
+    /// Inverse of ``interval_to_tent``: u = (x (2 - |x|) + 1) / 2.
+    fn tent_to_interval(value: [1; Finite] "values in [-1, 1]")
+        -> [1] "in [0, 1]"
+        = |F| |x: [F; 1]| [warp::tent_to_interval(x[0])];
+
+    /// ``interval_to_tent`` in each coordinate: the tent
+    /// (1 - |x|)(1 - |y|) on [-1, 1]^2.
+    fn square_to_tent(sample: [2; Unit] "values in [0, 1]")
+        -> [2] "in [-1, 1]^2; density (1 - |x|)(1 - |y|) per unit area"
+        = |F| warp::square_to_tent::<F>;
+
+    /// Inverse of ``square_to_tent``.
+    fn tent_to_square(value: [2; Finite] "points of [-1, 1]^2")
+        -> [2] "in [0, 1]^2"
+        = |F| warp::tent_to_square::<F>;
+
+    /// Density of ``square_to_tent``: (1 - |x|)(1 - |y|) on [-1, 1]^2,
+    /// else 0.
+    fn square_to_tent_pdf(v: [2; Finite] "points of the plane")
+        -> [1] "per unit area"
+        = |F| |p| [warp::square_to_tent_pdf::<F>(p)];
+
+    /// The tent on [a, c] with its peak at b (Mitsuba's
+    /// ``interval_to_nonuniform_tent``; the falling side runs from c down
+    /// to b as u grows): density 2(x - a)/((c - a)(b - a)) below b and
+    /// 2(c - x)/((c - a)(c - b)) above.
+    fn interval_to_nonuniform_tent(
+        { a: f64 = "float, the left end", b: f64 = "float in [a, c], the peak",
+          c: f64 = "float > a, the right end" }
+        d: [1; Unit] "values in [0, 1] (the sample)"
+    ) -> [1] "in [a, c]"
+        = |F| {
+            let (a, b, c) = tent_args::<F>(a, b, c)?;
+            #[inline(always)]
+            move |u: [F; 1]| [warp::interval_to_nonuniform_tent(a, b, c, u[0])]
+        };
+
+    /// The linear density on [0, 1] from v0 at 0 to v1 at 1 by inversion:
+    /// x = (v0 - sqrt((1 - u) v0^2 + u v1^2)) / (v0 - v1) (x = u when the
+    /// ends agree to 1e-4, as Mitsuba).
+    fn interval_to_linear(
+        { v0: f64 = "float >= 0, the density's value at 0",
+          v1: f64 = "float >= 0, its value at 1 (not both 0)" }
+        sample: [1; Unit] "values in [0, 1]"
+    ) -> [1] "in [0, 1]; density 2((1 - x) v0 + x v1)/(v0 + v1) per unit length"
+        = |F| {
+            let (v0, v1) = linear_args::<F>(v0, v1)?;
+            #[inline(always)]
+            move |u: [F; 1]| [warp::interval_to_linear(v0, v1, u[0])]
+        };
+
+    /// Inverse of ``interval_to_linear``: u = x (x v1 + (2 - x) v0)/(v0 + v1).
+    fn linear_to_interval(
+        { v0: f64 = "float >= 0", v1: f64 = "float >= 0 (not both 0)" }
+        sample: [1; Finite] "values in [0, 1]"
+    ) -> [1] "in [0, 1]"
+        = |F| {
+            let (v0, v1) = linear_args::<F>(v0, v1)?;
+            #[inline(always)]
+            move |x: [F; 1]| [warp::linear_to_interval(v0, v1, x[0])]
+        };
+
+    /// The concentric map's polar coordinates as a point of the square
+    /// (Mitsuba's ``square_to_uniform_square_concentric``): (phi / 2 pi,
+    /// r^2) of ``square_to_uniform_disk_concentric(sample)``, a
+    /// measure-preserving map of the square onto itself.
+    fn square_to_uniform_square_concentric(sample: [2; Unit] "values in [0, 1]")
+        -> [2] "in [0, 1]^2; density 1; the centre gives (0, 0)"
+        = |F| warp::square_to_uniform_square_concentric::<F>;
 }
 
 /// Cosine-weighted directions on the +z hemisphere (Malley's method).
@@ -424,6 +557,15 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
         interval_to_power,
         interval_to_power_pdf,
         power_to_interval,
+        interval_to_tent,
+        tent_to_interval,
+        square_to_tent,
+        tent_to_square,
+        square_to_tent_pdf,
+        interval_to_nonuniform_tent,
+        interval_to_linear,
+        linear_to_interval,
+        square_to_uniform_square_concentric,
     );
     Ok(())
 }

@@ -54,7 +54,7 @@ impl Sobol {
     /// with random bits from `seed`.
     ///
     /// # Errors
-    /// [`Error::Integer`] unless `1 ≤ dims ≤` [`MAX_DIMENSIONS`].
+    /// [`crate::Error::Integer`] unless `1 ≤ dims ≤` [`MAX_DIMENSIONS`].
     pub fn new(dims: usize, scramble: Scramble, seed: u64) -> Result<Self> {
         check_dims(dims, MAX_DIMENSIONS)?;
         let mut columns = columns(dims);
@@ -112,7 +112,7 @@ impl Sobol {
     /// rows as fit), on all cores; the same bits at any thread count.
     ///
     /// # Errors
-    /// [`Error::Integer`] if the points would pass index `2^32 − 1`, or
+    /// [`crate::Error::Integer`] if the points would pass index `2^32 − 1`, or
     /// if `out` does not hold whole rows.
     pub fn fill<F: Real>(&self, first: u64, out: &mut [F]) -> Result<()> {
         let d = self.dims;

@@ -340,3 +340,40 @@ fn samples_have_the_moments_of_their_density() {
         }
     }
 }
+
+/// The concentric square map keeps the square's measure: on a fine grid of
+/// `u`, its points have the uniform square's moments, they stay in the
+/// square, and the eight octants keep their order around the centre.
+#[test]
+fn square_concentric_preserves_the_measure() {
+    let n = 1000;
+    let (mut m, mut all_inside) = ([0.0; 4], true);
+    for i in 0..n {
+        for j in 0..n {
+            let u = [(i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64];
+            let [phi, r2] = square_to_uniform_square_concentric(u);
+            all_inside &= (0.0..=1.0).contains(&phi) && (0.0..=1.0).contains(&r2);
+            for (acc, v) in m.iter_mut().zip([phi, r2, phi * phi, phi * r2]) {
+                *acc += v / (n * n) as f64;
+            }
+        }
+    }
+    assert!(all_inside);
+    for (got, want) in m.iter().zip([0.5, 0.5, 1.0 / 3.0, 0.25]) {
+        assert!((got - want).abs() < 1e-5, "{m:?}");
+    }
+    assert_eq!(
+        square_to_uniform_square_concentric([0.5f64, 0.5]),
+        [0.0, 0.0]
+    );
+    // Right of the centre: angle 0 (a turn's start), radius² 1 at the edge.
+    assert_eq!(
+        square_to_uniform_square_concentric([1.0f64, 0.5]),
+        [0.0, 1.0]
+    );
+    // Above: a quarter turn.
+    assert_eq!(
+        square_to_uniform_square_concentric([0.5f64, 1.0]),
+        [0.25, 1.0]
+    );
+}
