@@ -77,6 +77,11 @@ pub struct PhongSamples<'a, F, C> {
     pub component: &'a mut [C],
 }
 
+/// The largest lobe exponent: `f_r`'s constants `ρs·(n + 2)/2π` stay
+/// finite in `f32`, so a masked `f_r` is 0, never `∞·0`. (Far past any
+/// lobe a float can resolve: `cosⁿ` of the nearest angle below 1 is 0.)
+pub const MAX_EXPONENT: f64 = 1e30;
+
 /// Rows per block of [`PhongView::sample_rows`]: its numbers and samples
 /// stay in the L1 cache.
 const SAMPLE_BLOCK: usize = 256;
@@ -88,7 +93,8 @@ impl Phong {
     /// # Errors
     /// [`Error::Element`] for a reflectance that is negative or not finite,
     /// [`Error::NotEnergyConserving`] if `ρd + ρs > 1` in a channel, and
-    /// [`Error::Parameter`] for an exponent below 0 or not finite.
+    /// [`Error::Parameter`] for an exponent outside `[0,`
+    /// [`MAX_EXPONENT`]`]`.
     pub fn new(
         diffuse: [f64; 3],
         specular: [f64; 3],
@@ -111,11 +117,11 @@ impl Phong {
                 sum: diffuse[k] + specular[k],
             });
         }
-        if !(exponent >= 0.0 && exponent.is_finite()) {
+        if !(0.0..=MAX_EXPONENT).contains(&exponent) {
             return Err(Error::Parameter {
                 arg: "exponent",
                 value: exponent,
-                requirement: "must be finite and >= 0",
+                requirement: "must be in [0, 1e30]",
             });
         }
         let (d, s) = match selection {

@@ -117,11 +117,14 @@ def test_points_do_not_depend_on_the_thread_count(make):
     try:
         mcs.set_num_threads(1)
         one = make(6, 3).random(200_000)
+        later_one = make(6, 3).fast_forward(123_457).random(100_000)
         mcs.set_num_threads(4)
         four = make(6, 3).random(200_000)
+        later_four = make(6, 3).fast_forward(123_457).random(100_000)
     finally:
         mcs.set_num_threads(before)
     assert np.array_equal(one, four)
+    assert np.array_equal(later_one, later_four)
 
 
 @pytest.mark.parametrize("make", SCRAMBLED, ids=SCRAMBLED_IDS)
@@ -142,7 +145,7 @@ def test_engine_interface(make):
     assert ((f32 >= 0) & (f32 < 1)).all()
     # scipy's helpers take the engine.
     ints = e.reset().integers([0, 0, 0], u_bounds=[4, 5, 6], n=100)
-    assert ints.shape == (100, 3) and ints.max() < 6
+    assert ints.shape == (100, 3) and (ints >= 0).all() and (ints < [4, 5, 6]).all()
     assert 0 < scipy_qmc.discrepancy(e.reset().random(256)) < 0.01
 
 
@@ -195,6 +198,17 @@ def test_bad_input():
         qmc.MultiJitter(0)
     with pytest.raises(ValueError, match="n = 1073741825"):
         qmc.Stratified(1).random(2**30 + 1)
+    # Refused before anything is allocated.
+    with pytest.raises(ValueError, match="below index 9007199254740992"):
+        qmc.Halton(1, scramble=False).random(2**53 + 1)
+    with pytest.raises(ValueError, match="n·d"):
+        qmc.Sobol(21201).random(2**32)
+    with pytest.raises(ValueError, match="m = 33"):
+        qmc.Sobol(1).random_base2(33)
+    with pytest.raises(ValueError, match="scrambled Halton sequence in 5000 dimensions"):
+        qmc.Halton(5000)
+    assert qmc.Halton(5000, scramble=False).random(2).shape == (2, 5000)
+    assert qmc.Sobol(2, scramble=np.False_).random(2)[0].tolist() == [0.0, 0.0]
     with pytest.raises(ValueError, match="n = -3"):
         qmc.Sobol(2).fast_forward(-3)
     with pytest.raises(ValueError, match="n = -1"):

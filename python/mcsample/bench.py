@@ -534,9 +534,9 @@ def suite_convergence(n: int, repeat: int, mi, target: float = 0.01, spp: int = 
 
 
 def suite_qmc(n: int, repeat: int, mi) -> list[Timing]:
-    """QMC engines drawing 2^20 points (values counted: points × d),
-    beside scipy.stats.qmc's engines of the same kind, from a reset engine
-    each time."""
+    """QMC engines drawing 2^20 points whatever ``n`` (the size the issue's
+    figures are for; values counted: points × d), beside scipy.stats.qmc's
+    engines of the same kind, from a reset engine each time."""
     from scipy.stats import qmc as scipy_qmc
 
     points = 2**20

@@ -102,7 +102,9 @@ class _Engine(_scipy_qmc.QMCEngine):
         return sample
 
     def fast_forward(self, n: int) -> _Engine:
-        """Skips ``n`` points (n >= 0) in O(1); returns the engine."""
+        """Skips ``n`` points (n >= 0) in O(1); returns the engine. (For the
+        patterns, which are drawn whole, it changes which pattern comes
+        next.)"""
         self.num_generated += _count(n, "n")
         return self
 
@@ -143,10 +145,8 @@ class Sobol(_Engine):
         self, d: int, *, scramble: bool | Literal["lms"] = True, seed: SeedLike = None
     ) -> None:
         kind: Literal["owen", "none", "lms"]
-        if scramble is True:
-            kind = "owen"
-        elif scramble is False:
-            kind = "none"
+        if isinstance(scramble, (bool, np.bool_)):
+            kind = "owen" if scramble else "none"
         elif scramble == "lms":
             kind = "lms"
         else:
@@ -163,6 +163,8 @@ class Sobol(_Engine):
         scipy does.
         """
         m = _count(m, "m")
+        if m > 32:
+            raise ValueError(f"m = {m}: must be at most 32 (2**32 points in all)")
         n = 2**m
         total = self.num_generated + n
         if total & (total - 1) != 0:

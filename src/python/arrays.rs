@@ -14,7 +14,7 @@ use super::args::type_name;
 use crate::error::{Error, shape_str};
 use crate::math::Real;
 use crate::python::{Obj, Out};
-use numpy::{AllowTypeChange, Element, PyArray, PyArrayDescrMethods, PyArrayDyn, PyArrayLikeDyn};
+use numpy::{AllowTypeChange, Element, PyArrayDescrMethods, PyArrayDyn, PyArrayLikeDyn};
 use numpy::{PyArrayMethods, PyReadwriteArrayDyn, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -263,10 +263,18 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
     }
 }
 
-/// A fresh zeroed numpy array of `shape` (allocated by numpy, so a failed
-/// allocation is a `MemoryError`, and untouched pages cost nothing).
-pub fn zeros<'py, F: Element>(py: Python<'py>, shape: &[usize]) -> Bound<'py, PyArrayDyn<F>> {
-    PyArray::zeros(py, shape, false)
+/// A fresh zeroed numpy array of `shape`, made by `numpy.zeros` (so that a
+/// request too big for memory is numpy's MemoryError, or its ValueError
+/// for a size beyond the address space, and untouched pages cost nothing).
+pub fn zeros<'py, F: Element>(
+    py: Python<'py>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyArrayDyn<F>>> {
+    let array = py
+        .import("numpy")?
+        .getattr("zeros")?
+        .call1((PyTuple::new(py, shape)?, numpy::dtype::<F>(py)))?;
+    Ok(array.cast_into::<PyArrayDyn<F>>()?)
 }
 
 /// `array` as returned to Python: a numpy scalar when it is 0-d.
@@ -288,7 +296,7 @@ pub fn output<'py, T: Element>(
     arg: &'static str,
 ) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     let Some(out) = out.filter(|o| !o.is_none()) else {
-        return Ok(zeros::<T>(py, shape));
+        return zeros::<T>(py, shape);
     };
     let array = out.cast::<PyUntypedArray>().map_err(|_| {
         PyTypeError::new_err(format!(

@@ -26,7 +26,7 @@ where
     F: PyFloat,
     T: Element + Copy + Default + Send,
 {
-    let out = zeros::<T>(py, &x.out_shape(M));
+    let out = zeros::<T>(py, &x.out_shape(M))?;
     {
         let mut guard = out.readwrite();
         let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
@@ -60,7 +60,7 @@ where
     F: PyFloat,
     T: Element + Copy + Default + Send,
 {
-    let out = zeros::<T>(py, &x.out_shape(1));
+    let out = zeros::<T>(py, &x.out_shape(1))?;
     {
         let mut guard = out.readwrite();
         let in_rows = x.rows();
@@ -164,7 +164,7 @@ where
     let ((a, check_a), (b, check_b)) = (a, b);
     let batch = pair_shape(a, b)?;
     let n = batch.iter().product();
-    let out = zeros::<T>(py, &result_shape(&batch, M));
+    let out = zeros::<T>(py, &result_shape(&batch, M))?;
     {
         let mut guard = out.readwrite();
         let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
@@ -229,8 +229,8 @@ where
     T: Element + Copy + Default + Send,
     S: Element + Copy + Default + Send,
 {
-    let first = zeros::<T>(py, &x.out_shape(M));
-    let second = zeros::<S>(py, &x.out_shape(L));
+    let first = zeros::<T>(py, &x.out_shape(M))?;
+    let second = zeros::<S>(py, &x.out_shape(L))?;
     {
         let (mut g1, mut g2) = (first.readwrite(), second.readwrite());
         let rows1 = g1.as_slice_mut()?.as_chunks_mut::<M>().0;
@@ -258,7 +258,7 @@ pub fn map_indices<'py, const K: usize>(
     indices: &Indices<K>,
     f: impl Fn([usize; K]) -> f64 + Sync + Send,
 ) -> PyResult<Obj<'py>> {
-    let out = zeros::<f64>(py, &indices.batch);
+    let out = zeros::<f64>(py, &indices.batch)?;
     {
         let mut guard = out.readwrite();
         let values = guard.as_slice_mut()?;

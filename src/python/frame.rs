@@ -62,7 +62,7 @@ impl PyFrame {
             })?;
         let n = batch.iter().product();
         let (step_f, step_v) = (usize::from(frames.len() != 1), usize::from(v.n != 1));
-        let out = zeros::<F>(py, &result_shape(&batch, 3));
+        let out = zeros::<F>(py, &result_shape(&batch, 3))?;
         {
             let mut guard = out.readwrite();
             let rows = guard.as_slice_mut()?.as_chunks_mut::<3>().0;
@@ -89,7 +89,7 @@ impl PyFrame {
     }
 
     fn axis<'py>(&self, py: Python<'py>, pick: fn(&Frame<f64>) -> [f64; 3]) -> PyResult<Obj<'py>> {
-        let out = zeros::<f64>(py, &self.shape());
+        let out = zeros::<f64>(py, &self.shape())?;
         {
             let mut guard = out.readwrite();
             let flat = guard.as_slice_mut()?;

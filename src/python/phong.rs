@@ -42,7 +42,7 @@ record! {
 /// ----------
 /// diffuse, specular : float or (3,) RGB
 ///     rho_d and rho_s, >= 0, with rho_d + rho_s <= 1 in every channel.
-/// exponent : float >= 0
+/// exponent : float in [0, 1e30]
 /// selection : "max" (default) or "luminance", keyword only
 ///     How the diffuse probability is chosen: max(rho_d) / (max(rho_d) +
 ///     max(rho_s)) over channels, or the same with Rec. 709 luminance
@@ -184,10 +184,10 @@ impl PyPhong {
         let batch = pair_shape(&wi, &u)?;
         let n = batch.iter().product();
         let (vec_shape, scalar_shape) = (result_shape(&batch, 3), result_shape(&batch, 1));
-        let wo = zeros::<F>(py, &vec_shape);
-        let pdf = zeros::<F>(py, &scalar_shape);
-        let weight = zeros::<F>(py, &vec_shape);
-        let component = zeros::<i64>(py, &scalar_shape);
+        let wo = zeros::<F>(py, &vec_shape)?;
+        let pdf = zeros::<F>(py, &scalar_shape)?;
+        let weight = zeros::<F>(py, &vec_shape)?;
+        let component = zeros::<i64>(py, &scalar_shape)?;
         {
             let (mut g_wo, mut g_pdf) = (wo.readwrite(), pdf.readwrite());
             let (mut g_w, mut g_c) = (weight.readwrite(), component.readwrite());

@@ -6,6 +6,7 @@ use super::args::{choice, index_arg, seed};
 use super::arrays::zeros;
 use super::parallel::detached;
 use super::rng::wants_float32;
+use crate::error::Error;
 use crate::math::Real;
 use crate::python::Obj;
 use crate::qmc::{
@@ -14,15 +15,34 @@ use crate::qmc::{
 use numpy::{Element, PyArrayDyn, PyArrayMethods};
 use pyo3::prelude::*;
 
+/// Values one call may ask for (`n·d`), as `mcsample.uniform`.
+const MAX_VALUES: u64 = 1 << 40;
+
 /// Points `first .. first + n` of `fill`'s sequence in `d` dimensions, as a
-/// fresh `(n, d)` array of `F`.
+/// fresh `(n, d)` array of `F`; checked before anything is allocated: the
+/// indices stay below `end`, and `n·d` ≤ [`MAX_VALUES`].
 fn points<'py, F: Element + Real>(
     py: Python<'py>,
-    d: usize,
-    n: usize,
+    (first, n, d, end): (u64, u64, usize, u64),
     fill: impl FnOnce(&mut [F]) -> crate::Result<()> + Send,
 ) -> PyResult<Obj<'py>> {
-    let out: Bound<'py, PyArrayDyn<F>> = zeros(py, &[n, d]);
+    let too_many = |requirement: String| -> PyResult<Obj<'py>> {
+        Err(Error::Integer {
+            arg: "n",
+            value: n.to_string(),
+            requirement,
+        }
+        .into())
+    };
+    if first.checked_add(n).is_none_or(|last| last > end) {
+        return too_many(format!(
+            "points {first} .. {first} + n must stay below index {end} (the sequence's end)"
+        ));
+    }
+    if n.saturating_mul(d as u64) > MAX_VALUES {
+        return too_many(format!("n·d = n·{d} must be at most {MAX_VALUES} values"));
+    }
+    let out: Bound<'py, PyArrayDyn<F>> = zeros(py, &[n as usize, d])?;
     {
         let mut guard = out.readwrite();
         let flat = guard.as_slice_mut()?;
@@ -85,12 +105,12 @@ impl PySobolPoints {
         dtype: Option<&Obj<'py>>,
     ) -> PyResult<Obj<'py>> {
         let first = index_arg(first, "first", 0, u64::MAX)?;
-        let n = index_arg(n, "n", 0, 1 << 32)? as usize;
-        let (sobol, d) = (&self.0, self.0.dims());
+        let n = index_arg(n, "n", 0, u64::MAX)?;
+        let (sobol, request) = (&self.0, (first, n, self.0.dims(), 1 << 32));
         if wants_float32(py, dtype)? {
-            points::<f32>(py, d, n, |out| sobol.fill(first, out))
+            points::<f32>(py, request, |out| sobol.fill(first, out))
         } else {
-            points::<f64>(py, d, n, |out| sobol.fill(first, out))
+            points::<f64>(py, request, |out| sobol.fill(first, out))
         }
     }
 
@@ -107,7 +127,8 @@ impl PySobolPoints {
 /// Parameters
 /// ----------
 /// d : int
-///     Dimensions, 1 to 65536.
+///     Dimensions, 1 to 65536 (scrambled: while the digit permutations fit
+///     in 2**26 entries: d <= 2191).
 /// scramble : bool
 ///     False: scipy's ``scramble=False`` points, bit for bit; True: a random
 ///     permutation of the digits per digit position and dimension.
@@ -144,12 +165,12 @@ impl PyHaltonPoints {
         dtype: Option<&Obj<'py>>,
     ) -> PyResult<Obj<'py>> {
         let first = index_arg(first, "first", 0, u64::MAX)?;
-        let n = index_arg(n, "n", 0, HALTON_MAX_INDEX)? as usize;
-        let (halton, d) = (&self.0, self.0.dims());
+        let n = index_arg(n, "n", 0, u64::MAX)?;
+        let (halton, request) = (&self.0, (first, n, self.0.dims(), HALTON_MAX_INDEX));
         if wants_float32(py, dtype)? {
-            points::<f32>(py, d, n, |out| halton.fill(first, out))
+            points::<f32>(py, request, |out| halton.fill(first, out))
         } else {
-            points::<f64>(py, d, n, |out| halton.fill(first, out))
+            points::<f64>(py, request, |out| halton.fill(first, out))
         }
     }
 
@@ -216,12 +237,13 @@ impl PyPatternPoints {
         dtype: Option<&Obj<'py>>,
     ) -> PyResult<Obj<'py>> {
         let draw = index_arg(draw, "draw", 0, u64::MAX)?;
-        let n = index_arg(n, "n", 0, PATTERN_MAX_POINTS)? as usize;
-        let (patterns, d) = (&self.0, self.0.dims());
+        let n = index_arg(n, "n", 0, PATTERN_MAX_POINTS)?;
+        // A pattern's points are numbered from 0.
+        let (patterns, request) = (&self.0, (0, n, self.0.dims(), PATTERN_MAX_POINTS));
         if wants_float32(py, dtype)? {
-            points::<f32>(py, d, n, |out| patterns.fill(draw, out))
+            points::<f32>(py, request, |out| patterns.fill(draw, out))
         } else {
-            points::<f64>(py, d, n, |out| patterns.fill(draw, out))
+            points::<f64>(py, request, |out| patterns.fill(draw, out))
         }
     }
 

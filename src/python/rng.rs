@@ -69,7 +69,7 @@ fn random_array<'py, F: Element + Real>(
     rng: &mut Rng,
     shape: &[usize],
 ) -> PyResult<Obj<'py>> {
-    let out: Bound<'py, PyArrayDyn<F>> = zeros(py, shape);
+    let out: Bound<'py, PyArrayDyn<F>> = zeros(py, shape)?;
     {
         let mut guard = out.readwrite();
         let flat = guard.as_slice_mut()?;
@@ -167,7 +167,7 @@ impl PyRng {
         shape: Option<&Obj<'py>>,
     ) -> PyResult<Obj<'py>> {
         let shape = parse_shape(shape)?;
-        let out: Bound<'py, PyArrayDyn<u32>> = zeros(py, &shape);
+        let out: Bound<'py, PyArrayDyn<u32>> = zeros(py, &shape)?;
         {
             let mut guard = out.readwrite();
             let flat = guard.as_slice_mut()?;

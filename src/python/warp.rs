@@ -117,18 +117,9 @@ fn cos_cutoff_arg<F: Real>(cos_cutoff: f64) -> PyResult<F> {
     }
 }
 
-/// `(a, b, c)` of the nonuniform tent, checked: finite, `a ≤ b ≤ c`, `a < c`.
+/// `(a, b, c)` of the nonuniform tent, checked: finite, `a ≤ b ≤ c`, `a < c`,
+/// and `c − a` finite in the kernel's precision.
 fn tent_args<F: Real>(a: f64, b: f64, c: f64) -> PyResult<(F, F, F)> {
-    for (arg, value) in [("a", a), ("b", b), ("c", c)] {
-        if !value.is_finite() {
-            return Err(Error::Parameter {
-                arg,
-                value,
-                requirement: "must be finite",
-            }
-            .into());
-        }
-    }
     let bad = |arg, value, requirement| {
         Err(Error::Parameter {
             arg,
@@ -137,16 +128,31 @@ fn tent_args<F: Real>(a: f64, b: f64, c: f64) -> PyResult<(F, F, F)> {
         }
         .into())
     };
+    for (arg, value) in [("a", a), ("b", b), ("c", c)] {
+        if !value.is_finite() {
+            return bad(arg, value, "must be finite");
+        }
+    }
     if c <= a {
         return bad("c", c, "must be greater than a");
     }
     if !(a..=c).contains(&b) {
         return bad("b", b, "must lie in [a, c]");
     }
-    Ok((F::c(a), F::c(b), F::c(c)))
+    let (a, b, c) = (F::c(a), F::c(b), F::c(c));
+    if !(c - a).is_finite() {
+        return bad(
+            "c",
+            c.f64(),
+            "c - a must be a finite number in the input's precision",
+        );
+    }
+    Ok((a, b, c))
 }
 
-/// `(v0, v1)` of the linear warps, checked: finite, `>= 0`, not both 0.
+/// `(v0, v1)` of the linear warps, checked (finite, `>= 0`, not both 0)
+/// and divided by the larger (the density depends only on their ratio, and
+/// their squares then cannot overflow).
 fn linear_args<F: Real>(v0: f64, v1: f64) -> PyResult<(F, F)> {
     for (arg, value) in [("v0", v0), ("v1", v1)] {
         if !(value.is_finite() && value >= 0.0) {
@@ -158,7 +164,8 @@ fn linear_args<F: Real>(v0: f64, v1: f64) -> PyResult<(F, F)> {
             .into());
         }
     }
-    if v0 + v1 == 0.0 {
+    let larger = v0.max(v1);
+    if larger == 0.0 {
         return Err(Error::Parameter {
             arg: "v1",
             value: v1,
@@ -166,7 +173,7 @@ fn linear_args<F: Real>(v0: f64, v1: f64) -> PyResult<(F, F)> {
         }
         .into());
     }
-    Ok((F::c(v0), F::c(v1)))
+    Ok((F::c(v0 / larger), F::c(v1 / larger)))
 }
 
 /// `method` of the cosine-hemisphere warps: true for "polar", false for

@@ -1,8 +1,8 @@
 //! [`Halton`]: the Halton sequence, plain (scipy's points) or with random
 //! digit permutations.
 
-use super::{Rows, check_dims, check_range};
-use crate::error::Result;
+use super::{Rows, below, check_dims, check_range, scramble_rng};
+use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::parallel;
 use crate::rng::Rng;
@@ -10,6 +10,11 @@ use crate::rng::Rng;
 /// Dimensions [`Halton`] accepts: the bases are the first primes, and a
 /// scramble holds `base` entries per digit and dimension.
 pub const MAX_DIMENSIONS: usize = 1 << 16;
+
+/// Entries a scrambled [`Halton`]'s permutation tables may hold in all
+/// (`2^26`, 256 MiB): `d ≤ 2191` dimensions (scipy builds the same
+/// tables, in 64-bit integers).
+pub const MAX_PERMUTATION_ENTRIES: usize = 1 << 26;
 
 /// Indices [`Halton`] accepts: below `2^53`, where every index is an exact
 /// float and scipy's integer arithmetic has not wrapped.
@@ -38,11 +43,25 @@ impl Halton {
     /// permutations from `seed`.
     ///
     /// # Errors
-    /// [`crate::Error::Integer`] unless `1 ≤ dims ≤` [`MAX_DIMENSIONS`].
+    /// [`crate::Error::Integer`] unless `1 ≤ dims ≤` [`MAX_DIMENSIONS`],
+    /// or, scrambled, if the permutations would pass
+    /// [`MAX_PERMUTATION_ENTRIES`].
     pub fn new(dims: usize, scramble: bool, seed: u64) -> Result<Self> {
         check_dims(dims, MAX_DIMENSIONS)?;
         let bases = primes(dims);
-        let mut rng = Rng::new(seed, 0);
+        let entries: usize = bases.iter().map(|&b| positions(b) * b as usize).sum();
+        if scramble && entries > MAX_PERMUTATION_ENTRIES {
+            return Err(Error::Integer {
+                arg: "d",
+                value: dims.to_string(),
+                requirement: format!(
+                    "a scrambled Halton sequence in {dims} dimensions needs {entries} digit \
+                     permutation entries, more than the {MAX_PERMUTATION_ENTRIES} allowed \
+                     (d <= 2191)"
+                ),
+            });
+        }
+        let mut rng = scramble_rng(seed);
         let permutations = if scramble {
             bases.iter().map(|&b| permutations(b, &mut rng)).collect()
         } else {
@@ -110,18 +129,23 @@ impl Halton {
     }
 }
 
-/// The digit permutations of one base: `⌈54 / log2 b⌉ − 1` positions (as
-/// scipy), each a uniform random permutation of `0 .. b` (Fisher–Yates).
+/// Digit positions a scramble permutes in base `b`: `⌈54 / log2 b⌉ − 1`
+/// (as scipy), enough for a double.
+fn positions(base: u32) -> usize {
+    (54.0 / f64::from(base).log2()).ceil() as usize - 1
+}
+
+/// The digit permutations of one base, one per position, each a uniform
+/// random permutation of `0 .. b` (Fisher–Yates).
 fn permutations(base: u32, rng: &mut Rng) -> Vec<u32> {
-    let positions = (54.0 / f64::from(base).log2()).ceil() as usize - 1;
+    let positions = positions(base);
     let mut table = Vec::with_capacity(positions * base as usize);
     for _ in 0..positions {
         let start = table.len();
         table.extend(0..base);
         let digits = &mut table[start..];
         for k in (1..digits.len()).rev() {
-            let pick = (u64::from(rng.next_u32()) * (k as u64 + 1)) >> 32;
-            digits.swap(k, pick as usize);
+            digits.swap(k, below(rng, k as u32 + 1) as usize);
         }
     }
     table

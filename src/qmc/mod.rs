@@ -12,7 +12,10 @@ mod patterns;
 mod sobol;
 
 pub use directions::MAX_DIMENSIONS as SOBOL_MAX_DIMENSIONS;
-pub use halton::{Halton, MAX_DIMENSIONS as HALTON_MAX_DIMENSIONS, MAX_INDEX as HALTON_MAX_INDEX};
+pub use halton::{
+    Halton, MAX_DIMENSIONS as HALTON_MAX_DIMENSIONS, MAX_INDEX as HALTON_MAX_INDEX,
+    MAX_PERMUTATION_ENTRIES as HALTON_MAX_PERMUTATION_ENTRIES,
+};
 pub use patterns::{
     MAX_DIMENSIONS as PATTERN_MAX_DIMENSIONS, MAX_POINTS as PATTERN_MAX_POINTS, Pattern, Patterns,
 };
@@ -20,6 +23,27 @@ pub use sobol::{Scramble, Sobol, owen};
 
 use crate::error::{Error, Result};
 use crate::parallel::Outputs;
+use crate::rng::Rng;
+
+/// The random bits of a scramble: PCG32 with the engine's seed on a stream
+/// of its own, so that they are not the first numbers of
+/// `uniform(seed = s)`.
+fn scramble_rng(seed: u64) -> Rng {
+    const SCRAMBLE_STREAM: u64 = 0x7163_6d63; // "qmc"
+    Rng::new(seed, SCRAMBLE_STREAM)
+}
+
+/// A uniform integer below `n ≥ 1` (Lemire's multiply-shift with
+/// rejection: no bias toward small values).
+fn below(rng: &mut Rng, n: u32) -> u32 {
+    let threshold = n.wrapping_neg() % n;
+    loop {
+        let m = u64::from(rng.next_u32()) * u64::from(n);
+        if (m as u32) >= threshold {
+            return (m >> 32) as u32;
+        }
+    }
+}
 
 /// A row-major block of rows of `width` values, split between threads at
 /// row boundaries.

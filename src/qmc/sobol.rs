@@ -2,7 +2,7 @@
 //! scrambled, or by a random linear matrix scramble and digital shift.
 
 use super::directions::{BITS, MAX_DIMENSIONS, columns};
-use super::{Rows, check_dims, check_range};
+use super::{Rows, check_dims, check_range, scramble_rng};
 use crate::error::Result;
 use crate::math::Real;
 use crate::rng::Rng;
@@ -58,7 +58,7 @@ impl Sobol {
     pub fn new(dims: usize, scramble: Scramble, seed: u64) -> Result<Self> {
         check_dims(dims, MAX_DIMENSIONS)?;
         let mut columns = columns(dims);
-        let mut rng = Rng::new(seed, 0);
+        let mut rng = scramble_rng(seed);
         let keys = match scramble {
             Scramble::None => vec![0; dims],
             Scramble::Owen => (0..dims).map(|_| rng.next_u32()).collect(),

@@ -82,8 +82,9 @@ pub fn interval_to_nonuniform_tent<F: Real>(a: F, b: F, c: F, u: F) -> F {
 }
 
 /// The linear density on `[0, 1]` from `v0` at 0 to `v1` at 1 (`v0, v1 ≥
-/// 0`, not both 0) by inversion: `x = (v0 − √((1 − u)·v0² + u·v1²))/(v0 −
-/// v1)`, or `x = u` when the ends agree to `10⁻⁴` (Mitsuba's test).
+/// 0`, not both 0) by inversion: `x = (v0 − √m)/(v0 − v1)` with
+/// `m = (1 − u)·v0² + u·v1²`, computed as `u·(v0 + v1)/(v0 + √m)`, or
+/// `x = u` when the ends agree to `10⁻⁴` (Mitsuba's test).
 /// Density per unit length.
 ///
 /// # Density
@@ -94,8 +95,15 @@ pub fn interval_to_nonuniform_tent<F: Real>(a: F, b: F, c: F, u: F) -> F {
 #[inline(always)]
 pub fn interval_to_linear<F: Real>(v0: F, v1: F, u: F) -> F {
     if (v0 - v1).abs() > F::c(1e-4) * (v0 + v1) {
+        // Mitsuba's quotient times (v0 + √m)/(v0 + √m): the same x without
+        // the cancellation of v0 − √m when the ends are close.
         let mix = v0 * v0 - v0 * v0 * u + v1 * v1 * u;
-        (v0 - safe_sqrt(mix)) / (v0 - v1)
+        let denominator = v0 + safe_sqrt(mix);
+        if denominator > F::zero() {
+            (u * (v0 + v1) / denominator).min(F::one())
+        } else {
+            F::zero()
+        }
     } else {
         u
     }
