@@ -222,7 +222,17 @@ class LatinHypercube(_Engine):
         super().__init__(_core.PatternPoints(kind, d, value), value)
 
 
-class Stratified(_Engine):
+class _Pattern(_Engine):
+    """An engine of patterns of one kind (``_kind``) and no options."""
+
+    _kind: Literal["stratified", "multijitter"]
+
+    def __init__(self, d: int, *, seed: SeedLike = None) -> None:
+        value = resolve_seed(seed)
+        super().__init__(_core.PatternPoints(self._kind, d, value), value)
+
+
+class Stratified(_Pattern):
     """Jittered strata, as Mitsuba's ``stratified`` sampler: each
     ``random(n)`` shuffles the strata of an r x r grid (r = ceil(sqrt(n)))
     per pair of dimensions and jitters each point in its stratum (a last odd
@@ -237,12 +247,10 @@ class Stratified(_Engine):
         None (default) draws fresh random bits.
     """
 
-    def __init__(self, d: int, *, seed: SeedLike = None) -> None:
-        value = resolve_seed(seed)
-        super().__init__(_core.PatternPoints("stratified", d, value), value)
+    _kind = "stratified"
 
 
-class MultiJitter(_Engine):
+class MultiJitter(_Pattern):
     """Kensler's correlated multi-jittered points (2013), as Mitsuba's
     ``multijitter`` sampler: per pair of dimensions, each ``random(n)`` is
     stratified in an m x k grid (m = floor(sqrt(n)), k = ceil(n/m)) and in
@@ -256,6 +264,4 @@ class MultiJitter(_Engine):
         None (default) draws fresh random bits.
     """
 
-    def __init__(self, d: int, *, seed: SeedLike = None) -> None:
-        value = resolve_seed(seed)
-        super().__init__(_core.PatternPoints("multijitter", d, value), value)
+    _kind = "multijitter"

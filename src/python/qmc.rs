@@ -18,14 +18,41 @@ use pyo3::prelude::*;
 /// Values one call may ask for (`n·d`), as `mcsample.uniform`.
 const MAX_VALUES: u64 = 1 << 40;
 
-/// Points `first .. first + n` of `fill`'s sequence in `d` dimensions, as a
-/// fresh `(n, d)` array of `F`; checked before anything is allocated: the
-/// indices stay below `end`, and `n·d` ≤ [`MAX_VALUES`].
-fn points<'py, F: Element + Real>(
+/// A core point generator: rows of `dims` values filled from `start` (an
+/// index, or a pattern's number).
+trait Fill: Sync {
+    fn dims(&self) -> usize;
+    fn fill<F: Real>(&self, start: u64, out: &mut [F]) -> crate::Result<()>;
+}
+
+macro_rules! fill_by_core {
+    ($($engine:ty),*) => {$(
+        impl Fill for $engine {
+            fn dims(&self) -> usize {
+                <$engine>::dims(self)
+            }
+            fn fill<F: Real>(&self, start: u64, out: &mut [F]) -> crate::Result<()> {
+                <$engine>::fill(self, start, out)
+            }
+        }
+    )*};
+}
+fill_by_core!(Sobol, Halton, Patterns);
+
+/// `n` points of `engine` from `start` (argument `n`, an int), as a fresh
+/// `(n, d)` array of the float type `dtype` asks for. Checked before
+/// anything is allocated: the points' indices `first .. first + n` stay
+/// below `end`, and `n·d` ≤ [`MAX_VALUES`].
+fn draw<'py>(
     py: Python<'py>,
-    (first, n, d, end): (u64, u64, usize, u64),
-    fill: impl FnOnce(&mut [F]) -> crate::Result<()> + Send,
+    engine: &impl Fill,
+    start: u64,
+    n: &Obj<'py>,
+    dtype: Option<&Obj<'py>>,
+    (first, end): (u64, u64),
 ) -> PyResult<Obj<'py>> {
+    let n = index_arg(n, "n", 0, u64::MAX)?;
+    let d = engine.dims();
     let too_many = |requirement: String| -> PyResult<Obj<'py>> {
         Err(Error::Integer {
             arg: "n",
@@ -42,11 +69,25 @@ fn points<'py, F: Element + Real>(
     if n.saturating_mul(d as u64) > MAX_VALUES {
         return too_many(format!("n·d = n·{d} must be at most {MAX_VALUES} values"));
     }
-    let out: Bound<'py, PyArrayDyn<F>> = zeros(py, &[n as usize, d])?;
+    if wants_float32(py, dtype)? {
+        filled::<f32>(py, engine, start, [n as usize, d])
+    } else {
+        filled::<f64>(py, engine, start, [n as usize, d])
+    }
+}
+
+/// A fresh array of `shape` filled by `engine` from `start`, GIL released.
+fn filled<'py, F: Element + Real>(
+    py: Python<'py>,
+    engine: &impl Fill,
+    start: u64,
+    shape: [usize; 2],
+) -> PyResult<Obj<'py>> {
+    let out: Bound<'py, PyArrayDyn<F>> = zeros(py, &shape)?;
     {
         let mut guard = out.readwrite();
         let flat = guard.as_slice_mut()?;
-        detached(py, || fill(flat))?;
+        detached(py, || engine.fill(start, flat))?;
     }
     Ok(out.into_any())
 }
@@ -105,13 +146,7 @@ impl PySobolPoints {
         dtype: Option<&Obj<'py>>,
     ) -> PyResult<Obj<'py>> {
         let first = index_arg(first, "first", 0, u64::MAX)?;
-        let n = index_arg(n, "n", 0, u64::MAX)?;
-        let (sobol, request) = (&self.0, (first, n, self.0.dims(), 1 << 32));
-        if wants_float32(py, dtype)? {
-            points::<f32>(py, request, |out| sobol.fill(first, out))
-        } else {
-            points::<f64>(py, request, |out| sobol.fill(first, out))
-        }
+        draw(py, &self.0, first, n, dtype, (first, 1 << 32))
     }
 
     /// The number of dimensions.
@@ -165,13 +200,7 @@ impl PyHaltonPoints {
         dtype: Option<&Obj<'py>>,
     ) -> PyResult<Obj<'py>> {
         let first = index_arg(first, "first", 0, u64::MAX)?;
-        let n = index_arg(n, "n", 0, u64::MAX)?;
-        let (halton, request) = (&self.0, (first, n, self.0.dims(), HALTON_MAX_INDEX));
-        if wants_float32(py, dtype)? {
-            points::<f32>(py, request, |out| halton.fill(first, out))
-        } else {
-            points::<f64>(py, request, |out| halton.fill(first, out))
-        }
+        draw(py, &self.0, first, n, dtype, (first, HALTON_MAX_INDEX))
     }
 
     /// The number of dimensions.
@@ -217,34 +246,28 @@ impl PyPatternPoints {
         Ok(Self(Patterns::new(kind, d, seed)?))
     }
 
-    /// The pattern numbered ``draw`` (the points drawn before it), of ``n``
+    /// The pattern numbered ``number`` (the points drawn before it), of ``n``
     /// points (at most 2**30).
     ///
     /// Parameters
     /// ----------
-    /// draw, n : int >= 0
+    /// number, n : int >= 0
     /// dtype : float64 (default) or float32
     ///
     /// Returns
     /// -------
     /// ndarray, shape (n, d), in [0, 1).
-    #[pyo3(signature = (draw, n, dtype = None))]
+    #[pyo3(signature = (number, n, dtype = None))]
     fn points<'py>(
         &self,
         py: Python<'py>,
-        draw: &Obj<'py>,
+        number: &Obj<'py>,
         n: &Obj<'py>,
         dtype: Option<&Obj<'py>>,
     ) -> PyResult<Obj<'py>> {
-        let draw = index_arg(draw, "draw", 0, u64::MAX)?;
-        let n = index_arg(n, "n", 0, PATTERN_MAX_POINTS)?;
+        let number = index_arg(number, "number", 0, u64::MAX)?;
         // A pattern's points are numbered from 0.
-        let (patterns, request) = (&self.0, (0, n, self.0.dims(), PATTERN_MAX_POINTS));
-        if wants_float32(py, dtype)? {
-            points::<f32>(py, request, |out| patterns.fill(draw, out))
-        } else {
-            points::<f64>(py, request, |out| patterns.fill(draw, out))
-        }
+        draw(py, &self.0, number, n, dtype, (0, PATTERN_MAX_POINTS))
     }
 
     /// The number of dimensions.

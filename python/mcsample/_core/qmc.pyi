@@ -42,7 +42,7 @@ class PatternPoints:
         d: int,
         seed: int | None | np.random.Generator = 0,
     ) -> PatternPoints: ...
-    def points(self, draw: int, n: int, dtype: DTypeLike | None = None) -> NDArray[Any]:
-        """The pattern numbered ``draw``, of ``n`` points, shape (n, d)."""
+    def points(self, number: int, n: int, dtype: DTypeLike | None = None) -> NDArray[Any]:
+        """The pattern numbered ``number``, of ``n`` points, shape (n, d)."""
     @property
     def d(self) -> int: ...
