@@ -2,10 +2,15 @@
 //! point: irradiance on a surface, and radiance reflected by a Phong
 //! surface, each by several sampling strategies and their MIS combination.
 //!
-//! An estimate averages `n` independent evaluations `f_i`; its standard
-//! error is `s/√n` with `s²` the sample variance. Sample `i` draws its
-//! uniform numbers from the PCG32 stream of `seed` advanced to
-//! `i · draws`, so the result is the same bits whatever the thread count.
+//! An estimate averages `n` evaluations `f_i`; its standard error is
+//! `s/√n` with `s²` the sample variance. Sample `i` takes its uniform
+//! numbers from dimensions `0, 1, 2, …` of sample `i` of one [`Stream`] of
+//! the plan's [`Sampler`], in the order the formulas below draw them (under
+//! the independent sampler: the PCG32 stream of `seed` advanced to
+//! `i · draws`), so the result is the same bits whatever the thread count.
+//! With a stratified or low-discrepancy sampler the `f_i` are no longer
+//! independent, and `s/√n` overstates the error (it is the error of
+//! independent sampling): compare seeds to measure it.
 //!
 //! # Irradiance `E = ∫ L(ω) max(0, n·ω) dω`
 //! - uniform: `ω` uniform on the hemisphere of `n`, `f = L cos θ · 2π`;
@@ -25,7 +30,10 @@ use crate::math::{V3, dot};
 use crate::mis::Heuristic;
 use crate::parallel;
 use crate::phong::Phong;
+use crate::qmc::patterns::mix64;
 use crate::rng::Rng;
+use crate::sampler::zorder::ZOrder;
+use crate::sampler::{Sampler, Stream};
 use crate::warp;
 use std::f64::consts::PI;
 use std::sync::Mutex;
@@ -62,7 +70,7 @@ impl Strategy {
 }
 
 /// How to estimate: `n` evaluations by `strategy` (MIS weights by
-/// `heuristic`), random numbers from the stream of `seed`.
+/// `heuristic`), random numbers from `sampler` seeded by `seed`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Plan {
     /// Number of evaluations, at least 1.
@@ -71,8 +79,10 @@ pub struct Plan {
     pub strategy: Strategy,
     /// The MIS heuristic (for [`Strategy::Mis`]).
     pub heuristic: Heuristic,
-    /// Seed of the PCG32 stream.
+    /// Seed of the PCG32 stream, or of the scrambles and patterns.
     pub seed: u64,
+    /// Where the numbers come from.
+    pub sampler: Sampler,
 }
 
 /// A Monte Carlo estimate of an RGB quantity.
@@ -125,13 +135,16 @@ impl Moments {
 }
 
 impl Plan {
-    /// The mean and standard error of `f(rng)` over `n` evaluations, each
-    /// with its own stretch of `draws` numbers of the stream of `seed`.
+    /// The mean and standard error of `f(stream)` over `n` evaluations, the
+    /// stream at sample `i` for evaluation `i` (which draws `draws`
+    /// independent numbers).
     ///
     /// # Errors
-    /// [`Error::Integer`] for `n = 0`.
-    fn estimate(self, draws: u64, f: impl Fn(&mut Rng) -> V3<f64> + Sync) -> Result<Estimate> {
+    /// [`Error::Integer`] for `n = 0`, or `n` above the sampler's
+    /// [`Sampler::max_count`].
+    fn estimate(self, draws: u64, f: impl Fn(&mut Stream) -> V3<f64> + Sync) -> Result<Estimate> {
         let Plan { n, seed, .. } = self;
+        self.sampler.check_count("n", n as u64)?;
         if n == 0 {
             return Err(Error::Integer {
                 arg: "n",
@@ -139,17 +152,24 @@ impl Plan {
                 requirement: "must be at least 1".into(),
             });
         }
-        let base = Rng::new(seed, 0);
+        let base = Stream::new(
+            self.sampler,
+            mix64(seed),
+            Rng::new(seed, 0),
+            n as u64,
+            ZOrder::new((0, 0), (1, 1), n as u64, seed),
+        );
         let parts = Mutex::new(Vec::new());
         parallel::for_each_chunk(n, (), |range, ()| {
             // One partial sum per block of CHUNK items, whatever the range a
             // thread is handed: the same sums in the same order on any pool.
             let mut local = Vec::new();
             for start in range.clone().step_by(parallel::CHUNK) {
-                let mut rng = base.jumped(start as u64 * draws);
+                let mut stream = base.jumped(start as u64 * draws);
                 let mut m = Moments::default();
-                for _ in start..(start + parallel::CHUNK).min(range.end) {
-                    m.push(f(&mut rng));
+                for i in start..(start + parallel::CHUNK).min(range.end) {
+                    stream.start(i as u32);
+                    m.push(f(&mut stream));
                 }
                 local.push((start, m));
             }
@@ -211,11 +231,6 @@ fn add(a: V3<f64>, b: V3<f64>) -> V3<f64> {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
-#[inline(always)]
-fn next2(rng: &mut Rng) -> [f64; 2] {
-    [rng.next_float(), rng.next_float()]
-}
-
 /// The irradiance at a surface of unit `normal` (world) lit by `env`.
 ///
 /// # Errors
@@ -226,21 +241,21 @@ pub fn irradiance(env: &EnvMap, normal: V3<f64>, plan: Plan) -> Result<Estimate>
     let frame = Frame::from_normal(normal);
     let cosine_pdf = |d: V3<f64>| dot(d, normal).max(0.0) / PI;
     match plan.strategy {
-        Strategy::Uniform => plan.estimate(2, |rng| {
-            let d = frame.to_world(warp::square_to_uniform_hemisphere(next2(rng)));
+        Strategy::Uniform => plan.estimate(2, |s| {
+            let d = frame.to_world(warp::square_to_uniform_hemisphere(s.get2(0)));
             scaled(env.eval(d), dot(d, normal).max(0.0) * 2.0 * PI)
         }),
-        Strategy::Cosine => plan.estimate(2, |rng| {
-            let local = warp::square_to_cosine_hemisphere(next2(rng));
+        Strategy::Cosine => plan.estimate(2, |s| {
+            let local = warp::square_to_cosine_hemisphere(s.get2(0));
             let f = if local[2] > 0.0 { PI } else { 0.0 };
             scaled(env.eval(frame.to_world(local)), f)
         }),
-        Strategy::Emitter => plan.estimate(2, |rng| {
-            let s = env.sample(next2(rng));
+        Strategy::Emitter => plan.estimate(2, |s| {
+            let s = env.sample(s.get2(0));
             scaled(s.weight, dot(s.direction, normal).max(0.0))
         }),
-        Strategy::Mis => plan.estimate(4, |rng| {
-            let d = frame.to_world(warp::square_to_cosine_hemisphere(next2(rng)));
+        Strategy::Mis => plan.estimate(4, |stream| {
+            let d = frame.to_world(warp::square_to_cosine_hemisphere(stream.get2(0)));
             let p = cosine_pdf(d);
             let from_cosine = if p > 0.0 {
                 let w = heuristic.weight(p, env.pdf(d));
@@ -248,7 +263,7 @@ pub fn irradiance(env: &EnvMap, normal: V3<f64>, plan: Plan) -> Result<Estimate>
             } else {
                 [0.0; 3]
             };
-            let s = env.sample(next2(rng));
+            let s = env.sample(stream.get2(2));
             let w = heuristic.weight(s.pdf, cosine_pdf(s.direction));
             add(
                 from_cosine,
@@ -285,25 +300,27 @@ pub fn reflected_radiance(
         let wo = frame.to_local(d);
         scaled(view.eval(wo), wo[2].max(0.0))
     };
-    let bsdf_sample = |rng: &mut Rng| {
-        let s = view.sample([rng.next_float(), rng.next_float(), rng.next_float()]);
+    let bsdf_sample = |stream: &mut Stream| {
+        let lobe = stream.get1(0);
+        let [u1, u2] = stream.get2(1);
+        let s = view.sample([lobe, u1, u2]);
         (frame.to_world(s.wo), s)
     };
     let times = |a: V3<f64>, b: V3<f64>| [a[0] * b[0], a[1] * b[1], a[2] * b[2]];
     match plan.strategy {
-        Strategy::Bsdf => plan.estimate(3, |rng| {
-            let (d, s) = bsdf_sample(rng);
+        Strategy::Bsdf => plan.estimate(3, |stream| {
+            let (d, s) = bsdf_sample(stream);
             times(s.weight, env.eval(d))
         }),
-        Strategy::Emitter => plan.estimate(2, |rng| {
-            let s = env.sample(next2(rng));
+        Strategy::Emitter => plan.estimate(2, |stream| {
+            let s = env.sample(stream.get2(0));
             times(s.weight, reflect(s.direction))
         }),
-        Strategy::Mis => plan.estimate(5, |rng| {
-            let (d, b) = bsdf_sample(rng);
+        Strategy::Mis => plan.estimate(5, |stream| {
+            let (d, b) = bsdf_sample(stream);
             let w = heuristic.weight(b.pdf, env.pdf(d));
             let from_bsdf = scaled(times(b.weight, env.eval(d)), w);
-            let s = env.sample(next2(rng));
+            let s = env.sample(stream.get2(3));
             let w = heuristic.weight(s.pdf, view.pdf(frame.to_local(s.direction)));
             add(from_bsdf, scaled(times(s.weight, reflect(s.direction)), w))
         }),
@@ -325,6 +342,7 @@ mod tests {
             strategy,
             heuristic: Heuristic::Power,
             seed,
+            sampler: Sampler::Independent,
         }
     }
 

@@ -53,6 +53,7 @@ pub mod qmc;
 mod quadrature;
 pub mod render;
 pub mod rng;
+pub mod sampler;
 pub mod simd;
 pub mod warp;
 

@@ -4,6 +4,9 @@ point, and their quadrature references.
 - :func:`irradiance` (strategies "uniform", "cosine", "emitter", "mis") and
   :func:`reflected_radiance` from a Phong surface ("bsdf", "emitter", "mis")
   run in Rust on all cores; same seed, same bits on any thread count.
+  ``sampler=`` picks where the uniform numbers come from: "independent"
+  (default), "stratified", "multijitter", "sobol" or "zsobol" (see
+  :mod:`mcsample.qmc` and :func:`mcsample.render`).
   "emitter" samples the environment map ("envmap" is accepted as the same);
   MIS weights by the power heuristic unless ``heuristic="balance"`` (the
   default of :func:`mcsample.render` too). Everything after ``n`` is
@@ -16,12 +19,97 @@ point, and their quadrature references.
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Any, Callable, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from ._core.estimators import Estimate, irradiance, reflected_radiance
+from ._core import EnvMap, Phong
+from ._core.estimators import Estimate, estimate as _estimate
+from .seeds import SeedLike
 from .stats import EnvMapDomain
+
+Sampler = Literal["independent", "stratified", "multijitter", "sobol", "zsobol"]
+
+_SAMPLERS_DOC = """sampler : "independent" (default), "stratified", "multijitter", "sobol" or "zsobol"
+        Where sample i's uniform numbers come from (dimensions 0, 1, ... in
+        the order the strategy draws them; see :func:`mcsample.render`).
+        Independent keeps the bits of every earlier release. Under the
+        others the n evaluations are stratified together: the estimate
+        converges faster, and ``.stderr`` (the error of independent
+        sampling) overstates its error; at most 2**32 evaluations
+        ("stratified", "multijitter": 2**30)."""
+
+
+def irradiance(env: EnvMap, normal: ArrayLike, n: int, *,
+               strategy: Literal["uniform", "cosine", "emitter", "envmap", "mis"] = "mis",
+               seed: SeedLike = 0, heuristic: Literal["balance", "power"] = "power",
+               sampler: Sampler = "independent") -> Estimate:
+    """The irradiance E = integral of L(w) max(0, n.w) dw at a surface of
+    normal ``normal`` under ``env``, by Monte Carlo.
+
+    Parameters
+    ----------
+    env : EnvMap
+    normal : (3,) array_like, world space (normalised here)
+    n : int >= 1
+        Evaluations (an "mis" evaluation uses one cosine and one emitter
+        sample).
+    strategy : "uniform", "cosine", "emitter" or "mis" (default)
+        "emitter" samples the map ("envmap" is the same).
+    seed : int, None or numpy.random.Generator
+        Seed of the samples (default 0); the result does not depend on the
+        thread count. None draws a fresh seed from the operating system, a
+        Generator draws one from itself.
+    heuristic : "power" (default) or "balance"
+    SAMPLER
+
+    Everything after ``n`` is keyword-only.
+
+    Returns
+    -------
+    Estimate
+        ``.value`` (3,) RGB, ``.stderr`` (3,), ``.n``, ``.strategy``.
+    """
+    return _estimate(env, normal, n, strategy=strategy, seed=seed, heuristic=heuristic,
+                     sampler=sampler)
+
+
+def reflected_radiance(env: EnvMap, phong: Phong, normal: ArrayLike, wi: ArrayLike, n: int, *,
+                       strategy: Literal["bsdf", "emitter", "envmap", "mis"] = "mis",
+                       seed: SeedLike = 0, heuristic: Literal["balance", "power"] = "power",
+                       sampler: Sampler = "independent") -> Estimate:
+    """The radiance L_r(wi) = integral of L(w) f_r(wi, w) max(0, n.w) dw that
+    a Phong surface of normal ``normal`` reflects toward ``wi`` under ``env``.
+
+    Parameters
+    ----------
+    env : EnvMap
+    phong : Phong
+    normal, wi : (3,) array_like, world space (normalised here); wi points
+        toward the viewer
+    n : int >= 1
+    strategy : "bsdf", "emitter" or "mis" (default)
+        "emitter" samples the map ("envmap" is the same).
+    seed : int, None or numpy.random.Generator
+        As for :func:`irradiance` (default 0).
+    heuristic : "power" (default) or "balance"
+    SAMPLER
+
+    Everything after ``n`` is keyword-only.
+
+    Returns
+    -------
+    Estimate
+    """
+    if not isinstance(phong, Phong):
+        raise TypeError(f"phong must be an mcsample.Phong, got {type(phong).__name__}")
+    return _estimate(env, normal, n, phong=phong, wi=wi, strategy=strategy, seed=seed,
+                     heuristic=heuristic, sampler=sampler)
+
+
+for _f in (irradiance, reflected_radiance):
+    _f.__doc__ = (_f.__doc__ or "").replace("SAMPLER", _SAMPLERS_DOC)
 
 __all__ = [
     "Estimate",

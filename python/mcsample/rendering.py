@@ -14,7 +14,9 @@ from typing import Any, Callable, Literal
 
 from ._core.render import render as _render
 from .results import RenderResult
+from .estimators import Sampler
 from .scene import Scene
+from .scene.parse import MITSUBA_SAMPLERS
 from .seeds import SeedLike, resolve_seed
 
 __all__ = ["RenderResult", "render"]
@@ -44,7 +46,7 @@ def render(scene: Scene, spp: int | None = None, *,
            strategy: Literal["bsdf", "emitter", "mis"] = "mis",
            heuristic: Literal["balance", "power"] = "power", max_depth: int | None = None,
            rr_depth: int | None = None, seed: SeedLike = 0, progress: bool = True,
-           hide_emitters: bool | None = None) -> RenderResult:
+           hide_emitters: bool | None = None, sampler: Sampler | None = None) -> RenderResult:
     """Renders ``scene`` with ``spp`` samples per pixel.
 
     Parameters
@@ -79,6 +81,21 @@ def render(scene: Scene, spp: int | None = None, *,
         Leave out emitters seen straight from the camera (area lights and
         the environment), as Mitsuba's ``hide_emitters``. Default: the
         scene dict's integrator, else False.
+    sampler : "independent", "stratified", "multijitter", "sobol" or "zsobol", optional
+        Where each pixel's uniform numbers come from. Default: the scene
+        dict's sensor sampler (Mitsuba's ``stratified``, ``multijitter``,
+        ``orthogonal`` (as "multijitter") and ``ldsampler`` (as "zsobol")),
+        else "independent", which keeps the bits of every earlier release.
+        "stratified" and "multijitter" jitter the strata of a grid (Mitsuba's
+        samplers of those names); "sobol" is the Owen-scrambled Sobol'
+        sequence seeded per pixel; "zsobol" is pbrt-v4's z-ordered Sobol'
+        (blue-noise error across the screen; best with power-of-two spp).
+        Every random decision has its own dimension, in this order: film
+        position (2), lens (2), time (1, reserved), then per shading point
+        BSDF lobe (1), BSDF direction (2), light choice (1), light position
+        (2), Russian roulette (1).
+        Under these samplers a pixel's samples are not independent, and
+        ``variance`` (that of independent samples) overstates the error.
 
     Everything after ``spp`` is keyword-only.
 
@@ -91,13 +108,16 @@ def render(scene: Scene, spp: int | None = None, *,
         raise TypeError(f"scene must be an mcsample.Scene, got {type(scene).__name__}")
     settings = scene.integrator_settings(integrator, max_depth, rr_depth, hide_emitters)
     spp = scene.camera.sample_count or 16 if spp is None else spp
+    if sampler is None:
+        sampler = MITSUBA_SAMPLERS[scene.camera.sampler][1]  # type: ignore[assignment]
     height, width = scene.shape
     callback, bar = _progress_bar(width * height * max(int(spp), 1), progress)
     start = time.perf_counter()
     try:
         image, variance, lum_var = _render(
             scene.compiled, spp, resolve_seed(seed), settings["integrator"], strategy, heuristic,
-            settings["max_depth"], settings["rr_depth"], settings["hide_emitters"], callback)
+            settings["max_depth"], settings["rr_depth"], settings["hide_emitters"], callback,
+            sampler)
     finally:
         if bar is not None:
             bar.close()

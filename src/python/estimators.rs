@@ -6,6 +6,7 @@ use super::envmap::PyEnvMap;
 use super::parallel::detached;
 use super::phong::PyPhong;
 use crate::estimators::{self, Estimate, Plan, Strategy};
+use crate::sampler::Sampler;
 use crate::python::Obj;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -56,7 +57,7 @@ impl PyEstimate {
     }
 }
 
-/// The strategies of [`irradiance`] (and their names).
+/// The strategies of the irradiance estimator (and their names).
 const IRRADIANCE: &[(&str, Strategy)] = &[
     ("uniform", Strategy::Uniform),
     ("cosine", Strategy::Cosine),
@@ -65,7 +66,7 @@ const IRRADIANCE: &[(&str, Strategy)] = &[
     ("mis", Strategy::Mis),
 ];
 
-/// The strategies of [`reflected_radiance`].
+/// The strategies of the reflected-radiance estimator.
 const REFLECTED: &[(&str, Strategy)] = &[
     ("bsdf", Strategy::Bsdf),
     ("emitter", Strategy::Emitter),
@@ -73,120 +74,60 @@ const REFLECTED: &[(&str, Strategy)] = &[
     ("mis", Strategy::Mis),
 ];
 
-/// The irradiance E = integral of L(w) max(0, n.w) dw at a surface of
-/// normal ``normal`` under ``env``, by Monte Carlo.
-///
-/// Parameters
-/// ----------
-/// env : EnvMap
-/// normal : (3,) array_like, world space (normalised here)
-/// n : int >= 1
-///     Evaluations (an "mis" evaluation uses one cosine and one emitter
-///     sample).
-/// strategy : "uniform", "cosine", "emitter" or "mis" (default)
-///     "emitter" samples the map ("envmap" is the same).
-/// seed : int, None or numpy.random.Generator
-///     Seed of the PCG32 stream (default 0); the result does not depend on
-///     the thread count. None draws a fresh seed from the operating system,
-///     a Generator draws one from itself.
-/// heuristic : "power" (default) or "balance"
-///
-/// Everything after ``n`` is keyword-only.
-///
-/// Returns
-/// -------
-/// Estimate
-///     ``.value`` (3,) RGB, ``.stderr`` (3,), ``.n``, ``.strategy``.
+/// One estimate: the irradiance at ``normal`` without ``phong``, the
+/// radiance ``phong`` reflects toward ``wi`` with it.
+/// ``mcsample.estimators.irradiance`` and ``reflected_radiance`` call it
+/// and document the arguments.
 #[pyfunction]
-#[pyo3(signature = (env, normal, n, *, strategy = "mis", seed = 0, heuristic = "power"))]
-pub fn irradiance(
+#[pyo3(signature = (env, normal, n, *, phong = None, wi = None, strategy, seed, heuristic, sampler))]
+#[allow(clippy::too_many_arguments)] // the Python signature
+pub fn estimate(
     py: Python<'_>,
     env: &Bound<'_, PyEnvMap>,
     normal: &Obj<'_>,
     n: &Obj<'_>,
+    phong: Option<&Bound<'_, PyPhong>>,
+    wi: Option<&Obj<'_>>,
     strategy: &str,
     #[pyo3(from_py_with = seed)] seed: u64,
     heuristic: &str,
+    sampler: &str,
 ) -> PyResult<PyEstimate> {
     let normal = three_floats(normal, "normal", false)?;
-    let plan = plan(
-        n,
-        seed,
-        choice("strategy", strategy, IRRADIANCE)?,
-        heuristic,
-    )?;
-    let env = env.get().inner();
-    let estimate = detached(py, || estimators::irradiance(env, normal, plan))?;
-    Ok(PyEstimate {
-        estimate,
-        strategy: plan.strategy,
-    })
-}
-
-/// The radiance L_r(wi) = integral of L(w) f_r(wi, w) max(0, n.w) dw that a
-/// Phong surface of normal ``normal`` reflects toward ``wi`` under ``env``.
-///
-/// Parameters
-/// ----------
-/// env : EnvMap
-/// phong : Phong
-/// normal, wi : (3,) array_like, world space (normalised here); wi points
-///     toward the viewer
-/// n : int >= 1
-/// strategy : "bsdf", "emitter" or "mis" (default)
-///     "emitter" samples the map ("envmap" is the same).
-/// seed : int, None or numpy.random.Generator
-///     As for ``irradiance`` (default 0).
-/// heuristic : "power" (default) or "balance"
-///
-/// Everything after ``n`` is keyword-only.
-///
-/// Returns
-/// -------
-/// Estimate
-#[pyfunction]
-#[pyo3(signature = (env, phong, normal, wi, n, *, strategy = "mis", seed = 0, heuristic = "power"))]
-#[allow(clippy::too_many_arguments)] // the Python signature
-pub fn reflected_radiance(
-    py: Python<'_>,
-    env: &Bound<'_, PyEnvMap>,
-    phong: &Bound<'_, PyPhong>,
-    normal: &Obj<'_>,
-    wi: &Obj<'_>,
-    n: &Obj<'_>,
-    strategy: &str,
-    #[pyo3(from_py_with = seed)] seed: u64,
-    heuristic: &str,
-) -> PyResult<PyEstimate> {
-    let (normal, wi) = (
-        three_floats(normal, "normal", false)?,
-        three_floats(wi, "wi", false)?,
-    );
-    let plan = plan(n, seed, choice("strategy", strategy, REFLECTED)?, heuristic)?;
-    let (env, phong) = (env.get().inner(), phong.get().inner());
-    let estimate = detached(py, || {
-        estimators::reflected_radiance(env, phong, normal, wi, plan)
-    })?;
-    Ok(PyEstimate {
-        estimate,
-        strategy: plan.strategy,
-    })
-}
-
-/// The checked arguments of an estimator.
-fn plan(n: &Obj<'_>, seed: u64, strategy: Strategy, heuristic: &str) -> PyResult<Plan> {
-    Ok(Plan {
+    let plan = Plan {
         n: index_arg(n, "n", 1, 1 << 40)? as usize,
-        strategy,
+        strategy: choice(
+            "strategy",
+            strategy,
+            if phong.is_some() { REFLECTED } else { IRRADIANCE },
+        )?,
         heuristic: heuristic_arg(heuristic)?,
         seed,
+        sampler: choice("sampler", sampler, Sampler::NAMES)?,
+    };
+    let env = env.get().inner();
+    let estimate = match phong {
+        None => detached(py, || estimators::irradiance(env, normal, plan))?,
+        Some(phong) => {
+            let wi = match wi {
+                Some(wi) => three_floats(wi, "wi", false)?,
+                None => return Err(pyo3::exceptions::PyTypeError::new_err("wi is required with phong")),
+            };
+            let phong = phong.get().inner();
+            detached(py, || {
+                estimators::reflected_radiance(env, phong, normal, wi, plan)
+            })?
+        }
+    };
+    Ok(PyEstimate {
+        estimate,
+        strategy: plan.strategy,
     })
 }
 
 /// Registers the estimators in module `m`.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyEstimate>()?;
-    m.add_function(wrap_pyfunction!(irradiance, m)?)?;
-    m.add_function(wrap_pyfunction!(reflected_radiance, m)?)?;
+    m.add_function(wrap_pyfunction!(estimate, m)?)?;
     Ok(())
 }

@@ -21,6 +21,7 @@ use crate::error::Error;
 use crate::render::camera::{Camera, FovAxis};
 use crate::render::scene::{Environment, Geometry, Material, Shape, affine};
 use crate::render::{Integrator, Progress, Scene, Settings, Strategy};
+use crate::sampler::Sampler;
 
 fn rows<'py, T: numpy::Element + Copy, const K: usize>(
     a: &PyReadonlyArray2<'py, T>,
@@ -295,7 +296,7 @@ impl PyScene {
 /// as Ctrl-C) stops the render and is raised once its threads have stopped.
 #[pyfunction]
 #[allow(clippy::type_complexity)]
-#[pyo3(signature = (scene, spp, seed, integrator, strategy, heuristic, max_depth, rr_depth, hide_emitters = false, callback = None))]
+#[pyo3(signature = (scene, spp, seed, integrator, strategy, heuristic, max_depth, rr_depth, hide_emitters = false, callback = None, sampler = "independent"))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -309,6 +310,7 @@ pub fn render<'py>(
     rr_depth: &Obj<'py>,
     hide_emitters: bool,
     callback: Option<Obj<'py>>,
+    sampler: &str,
 ) -> PyResult<(
     Bound<'py, PyArray1<f32>>,
     Bound<'py, PyArray1<f32>>,
@@ -336,6 +338,7 @@ pub fn render<'py>(
         max_depth: depth_arg(max_depth, "max_depth")?,
         rr_depth,
         hide_emitters,
+        sampler: choice("sampler", sampler, Sampler::NAMES)?,
     };
     let scene = Arc::clone(&scene.get().0);
     let progress = Arc::new(Progress::default());

@@ -6,10 +6,10 @@
 //! thread count; a point is computed from its index alone, so skipping
 //! ahead costs nothing.
 
-mod directions;
+pub(crate) mod directions;
 mod halton;
-mod patterns;
-mod sobol;
+pub(crate) mod patterns;
+pub(crate) mod sobol;
 
 pub use directions::MAX_DIMENSIONS as SOBOL_MAX_DIMENSIONS;
 pub use halton::{

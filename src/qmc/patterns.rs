@@ -131,7 +131,7 @@ impl Patterns {
 }
 
 /// Point `s` of `n` in a shuffled `r × r` grid of strata, `r = ⌈√n⌉`.
-fn stratified(s: u32, n: u32, p: u32) -> (f64, f64) {
+pub(crate) fn stratified(s: u32, n: u32, p: u32) -> (f64, f64) {
     let r = (f64::from(n).sqrt().ceil() as u32).max(1);
     let cell = permute(s, r * r, p);
     let r_f = f64::from(r);
@@ -142,7 +142,7 @@ fn stratified(s: u32, n: u32, p: u32) -> (f64, f64) {
 }
 
 /// Point `s` of `n` of Kensler's correlated multi-jittered pattern.
-fn multi_jitter(s: u32, n: u32, p: u32) -> (f64, f64) {
+pub(crate) fn multi_jitter(s: u32, n: u32, p: u32) -> (f64, f64) {
     let m = (f64::from(n).sqrt() as u32).max(1);
     let k = n.div_ceil(m);
     let s = permute(s, n, p.wrapping_mul(0x5163_3e2d));
@@ -164,7 +164,7 @@ fn multi_jitter(s: u32, n: u32, p: u32) -> (f64, f64) {
 /// invertible on those low bits (xor, multiplication by odd constants,
 /// xor-shifts), applied again while the result is `≥ len` (cycle
 /// walking), then rotated by `seed`. `i < len`.
-fn permute(mut i: u32, len: u32, seed: u32) -> u32 {
+pub(crate) fn permute(mut i: u32, len: u32, seed: u32) -> u32 {
     let w = u32::MAX >> (len.max(2) - 1).leading_zeros();
     loop {
         i ^= seed;
@@ -193,7 +193,7 @@ fn permute(mut i: u32, len: u32, seed: u32) -> u32 {
 
 /// A uniform jitter in `[0, 1)` for index `i` and seed `p`: 32 bits of
 /// Wellons' `lowbias32` hash, as a multiple of `2^−32`.
-fn jitter(i: u32, p: u32) -> f64 {
+pub(crate) fn jitter(i: u32, p: u32) -> f64 {
     f64::from(lowbias32(i ^ lowbias32(p))) * (1.0 / 4_294_967_296.0)
 }
 
@@ -207,7 +207,7 @@ fn lowbias32(mut x: u32) -> u32 {
 }
 
 /// SplitMix64's finaliser: a bijective 64-bit mix.
-fn mix64(mut z: u64) -> u64 {
+pub(crate) fn mix64(mut z: u64) -> u64 {
     z = z.wrapping_add(0x9e37_79b9_7f4a_7c15);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);

@@ -15,6 +15,10 @@
 //! `hide_emitters`.
 //! Path lengths follow Mitsuba's `max_depth`: 1 is emission only, 2 direct
 //! illumination, −1 unbounded.
+//!
+//! Every random decision of a sample has its own dimension of the pixel's
+//! [`Stream`] ([`dims`]): a stratified or low-discrepancy sampler then
+//! stratifies each decision across the pixel's samples.
 
 use glam::Vec3A;
 
@@ -22,7 +26,43 @@ use super::accel::Hit;
 use super::scene::{LightSample, Scene};
 use super::shape::Ray;
 use crate::frame::Frame;
-use crate::rng::Rng;
+use crate::sampler::{Sampler, Stream};
+
+/// The dimensions of a sample, in this order: the camera's, then
+/// [`dims::PER_BOUNCE`] for each shading point along the path
+/// ([`dims::bounce`]). 2D requests take two consecutive dimensions.
+pub mod dims {
+    /// The position on the film within the pixel (2D).
+    pub const FILM: u32 = 0;
+    /// The position on the lens (2D; drawn by pinhole cameras too).
+    pub const LENS: u32 = 2;
+    /// The time within the shutter interval (reserved: no motion yet).
+    pub const TIME: u32 = 4;
+    /// Dimensions of the camera sample.
+    pub const CAMERA: u32 = 5;
+    /// Which lobe of the BSDF is sampled.
+    pub const BSDF_COMPONENT: u32 = 0;
+    /// The direction the BSDF samples (2D).
+    pub const BSDF_DIRECTION: u32 = 1;
+    /// Which light is sampled.
+    pub const LIGHT_CHOICE: u32 = 3;
+    /// The position on the light (2D).
+    pub const LIGHT_POSITION: u32 = 4;
+    /// Russian roulette.
+    pub const ROULETTE: u32 = 6;
+    /// Dimensions of each shading point.
+    pub const PER_BOUNCE: u32 = 7;
+
+    /// Dimension `offset` (one of the constants above) of the shading
+    /// point at path depth `depth` (0: where the camera ray lands):
+    /// `CAMERA + PER_BOUNCE·depth + offset`.
+    #[inline(always)]
+    pub fn bounce(depth: u32, offset: u32) -> u32 {
+        CAMERA
+            .saturating_add(PER_BOUNCE.saturating_mul(depth))
+            .saturating_add(offset)
+    }
+}
 
 /// Which light transport to compute.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -64,6 +104,8 @@ pub struct Settings {
     /// Mitsuba's `hide_emitters`: camera rays pass through area lights
     /// ([`skip_emitters`]) and see no environment.
     pub hide_emitters: bool,
+    /// Where each pixel's random numbers come from.
+    pub sampler: Sampler,
 }
 
 impl Settings {
@@ -215,7 +257,8 @@ pub fn skip_emitters(scene: &Scene, ray: &mut Ray, mut hit: Option<Hit>) -> Opti
 
 /// The radiance arriving at the camera along `ray`, whose first hit
 /// ([`super::accel::Accel::intersect`]) is `hit`: one sample of the
-/// estimator above, drawing its random numbers from `rng`. Light from the
+/// estimator above, drawing its random numbers from `stream` (at the
+/// current sample). Light from the
 /// environment is not included: rays that escape are added to `escaped`
 /// under `slot`, and [`add_escaped`] adds their light.
 #[inline]
@@ -223,7 +266,7 @@ pub fn radiance(
     scene: &Scene,
     ray: Ray,
     hit: Option<Hit>,
-    rng: &mut Rng,
+    stream: &mut Stream,
     settings: &Settings,
     escaped: &mut Escaped,
     slot: u32,
@@ -232,7 +275,7 @@ pub fn radiance(
         return [0.0; 3];
     }
     match hit {
-        Some(hit) => path(scene, ray, hit, rng, settings, escaped, slot),
+        Some(hit) => path(scene, ray, hit, stream, settings, escaped, slot),
         None => {
             if scene.environment().is_some() && !settings.hide_emitters {
                 escaped.push(slot, ray.d, [1.0; 3], None);
@@ -249,7 +292,7 @@ fn path(
     scene: &Scene,
     mut ray: Ray,
     mut hit: Hit,
-    rng: &mut Rng,
+    stream: &mut Stream,
     settings: &Settings,
     escaped: &mut Escaped,
     slot: u32,
@@ -286,8 +329,13 @@ fn path(
         let view = material.bsdf.view(frame.to_local(wi.to_array()));
 
         if settings.strategy != Strategy::Bsdf {
-            let u = [rng.next_float(), rng.next_float(), rng.next_float()];
-            if let Some(ls) = scene.sample_light(sp.p, u, Some(|| rng.next_u64())) {
+            let choice = stream.get1(dims::bounce(depth, dims::LIGHT_CHOICE));
+            let [u1, u2] = stream.get2(dims::bounce(depth, dims::LIGHT_POSITION));
+            // The independent sampler picks environment cells from extra
+            // random bits (an alias table); the others by inversion, which
+            // keeps their stratification.
+            let bits = stream.independent().map(|rng| move || rng.next_u64());
+            if let Some(ls) = scene.sample_light(sp.p, [choice, u1, u2], bits) {
                 let wo = frame.to_local(ls.d.to_array());
                 let (f, pdf_wo) = view.eval_pdf_one(wo);
                 if f.iter().any(|&v| v > 0.0)
@@ -309,8 +357,9 @@ fn path(
             }
         }
 
-        let u = [rng.next_float(), rng.next_float(), rng.next_float()];
-        let s = view.sample_one(u);
+        let component = stream.get1(dims::bounce(depth, dims::BSDF_COMPONENT));
+        let [u1, u2] = stream.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
+        let s = view.sample_one([component, u1, u2]);
         if s.weight.iter().all(|&v| v <= 0.0) {
             break;
         }
@@ -326,7 +375,7 @@ fn path(
         depth += 1;
         if settings.integrator == Integrator::Path && depth >= settings.rr_depth {
             let q = beta.iter().copied().fold(0.0f32, f32::max).min(0.95);
-            if rng.next_float::<f32>() >= q {
+            if stream.get1::<f32>(dims::bounce(depth - 1, dims::ROULETTE)) >= q {
                 break;
             }
             beta = beta.map(|b| b / q);

@@ -6,9 +6,11 @@
 //! Pixel `(x, y)` is the mean of `spp` samples at uniform positions inside
 //! it (a box filter of radius ½, as Mitsuba's `box`); its variance is that of
 //! the mean, `s² / spp` with `s²` the unbiased sample variance. Each pixel
-//! draws from its own PCG32 stream (seeded from `seed` and the pixel index),
-//! so the image does not depend on the thread count or on the order in which
-//! rows are rendered.
+//! draws from its own [`Stream`] of the settings' [`Sampler`] (keyed by
+//! `seed` and the pixel index; the independent sampler's PCG32 stream is
+//! seeded the same way), so the image does not depend on the thread count
+//! or on the order in which rows are rendered. The dimensions each random
+//! decision takes are listed in [`integrator::dims`].
 //!
 //! Samples are rendered in batches of about `BATCH` (whole pixels of one
 //! row): each pixel's film and lens positions are drawn first, the camera
@@ -36,13 +38,15 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use rayon::prelude::*;
 
-pub use integrator::{Heuristic, Integrator, Settings, Strategy};
+pub use integrator::{Heuristic, Integrator, Settings, Strategy, dims};
 pub use scene::Scene;
 
 use crate::error::Result;
 use crate::math::luminance;
 use crate::parallel;
 use crate::rng::Rng;
+use crate::sampler::zorder::ZOrder;
+use crate::sampler::{Sampler, Stream};
 use accel::Hit;
 use integrator::Escaped;
 use shape::Ray;
@@ -113,17 +117,26 @@ impl Batch {
         self.escaped.clear();
         self.radiance.clear();
         self.camera_u.clear();
-        let mut rngs = Vec::with_capacity(pixels.len());
+        let mut streams = Vec::with_capacity(pixels.len());
         for x in pixels {
             let pixel = (y * width + x) as u64;
-            let mut rng = Rng::new(mix(seed, pixel), pixel);
-            for _ in 0..spp {
-                let film_x = (x as f32 + rng.next_float::<f32>()) * inv_width;
-                let film_y = (y as f32 + rng.next_float::<f32>()) * inv_height;
-                let lens = [rng.next_float(), rng.next_float()];
+            let key = mix(seed, pixel);
+            let mut stream = Stream::new(
+                settings.sampler,
+                key,
+                Rng::new(key, pixel),
+                u64::from(spp),
+                ZOrder::new((x, y), (width, height), u64::from(spp), seed),
+            );
+            for i in 0..spp {
+                stream.start(i);
+                let film = stream.get2::<f32>(dims::FILM);
+                let lens = stream.get2(dims::LENS);
+                let film_x = (x as f32 + film[0]) * inv_width;
+                let film_y = (y as f32 + film[1]) * inv_height;
                 self.camera_u.push([film_x, film_y, lens[0], lens[1]]);
             }
-            rngs.push(rng);
+            streams.push(stream);
         }
         self.rays.resize(self.camera_u.len(), Ray::default());
         scene.camera().rays_into(&self.camera_u, &mut self.rays);
@@ -138,14 +151,15 @@ impl Batch {
         }));
         let spp = spp.max(1) as usize;
         let per_pixel = self.rays.chunks(spp).zip(self.hits.chunks(spp));
-        for (mut rng, (rays, hits)) in rngs.into_iter().zip(per_pixel) {
-            for (ray, hit) in rays.iter().zip(hits) {
+        for (mut stream, (rays, hits)) in streams.into_iter().zip(per_pixel) {
+            for (i, (ray, hit)) in (0..).zip(rays.iter().zip(hits)) {
+                stream.start(i);
                 let slot = self.radiance.len() as u32;
                 let l = integrator::radiance(
                     scene,
                     *ray,
                     *hit,
-                    &mut rng,
+                    &mut stream,
                     settings,
                     &mut self.escaped,
                     slot,
@@ -212,7 +226,9 @@ fn mix(seed: u64, pixel: u64) -> u64 {
 /// polled for cancellation once per pixel.
 ///
 /// # Errors
-/// Only when the thread pool cannot start.
+/// [`crate::Error::Integer`] naming `spp` when the sampler cannot make that
+/// many samples per pixel ([`Sampler::max_count`], [`ZOrder::check`]), and
+/// when the thread pool cannot start.
 pub fn render(
     scene: &Scene,
     spp: u32,
@@ -221,6 +237,10 @@ pub fn render(
     progress: &Progress,
 ) -> Result<Image> {
     let (width, height) = scene.film();
+    settings.sampler.check_count("spp", u64::from(spp))?;
+    if settings.sampler == Sampler::ZSobol {
+        ZOrder::check((width, height), u64::from(spp))?;
+    }
     let mut mean = vec![0.0f32; width * height * 3];
     let mut variance = vec![0.0f32; width * height * 3];
     let mut luminance_variance = vec![0.0f32; width * height];

@@ -13,6 +13,8 @@ use super::shape::Ray;
 use super::{Heuristic, Integrator, Scene, Settings, Strategy};
 use crate::phong::{Phong, Selection};
 use crate::rng::Rng;
+use crate::sampler::zorder::ZOrder;
+use crate::sampler::{Sampler, Stream};
 
 fn diffuse(rho: f64) -> Material {
     Material {
@@ -116,7 +118,17 @@ fn settings(integrator: Integrator, strategy: Strategy) -> Settings {
         max_depth: None,
         rr_depth: 5,
         hide_emitters: false,
+        sampler: Sampler::Independent,
     }
+}
+
+/// Every strategy with every sampler. (Under a stratified sampler the
+/// samples are not independent and the standard error of independent
+/// samples overstates the error: the tests' bounds stay valid.)
+fn strategies_and_samplers() -> impl Iterator<Item = (Strategy, Sampler)> {
+    [Strategy::Emitter, Strategy::Bsdf, Strategy::Mis]
+        .into_iter()
+        .flat_map(|t| Sampler::NAMES.iter().map(move |&(_, s)| (t, s)))
 }
 
 /// The mean and standard error of `n` samples of the (first channel of
@@ -128,14 +140,17 @@ fn estimate(scene: &Scene, from: Vec3A, target: Vec3A, s: &Settings, n: usize) -
         tmax: f32::INFINITY,
     };
     let hit = scene.accel().intersect(&ray);
-    let mut rng = Rng::new(17, 5);
+    let count = n as u64;
+    let zorder = ZOrder::new((0, 0), (1, 1), count, 17);
+    let mut stream = Stream::new(s.sampler, 17, Rng::new(17, 5), count, zorder);
     let mut escaped = Escaped::default();
     let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
     let mut l = vec![[0.0f32; 3]; 256];
-    for _ in 0..n / 256 {
+    for block in 0..n / 256 {
         escaped.clear();
         for (slot, out) in l.iter_mut().enumerate() {
-            *out = integrator::radiance(scene, ray, hit, &mut rng, s, &mut escaped, slot as u32);
+            stream.start((block * 256 + slot) as u32);
+            *out = integrator::radiance(scene, ray, hit, &mut stream, s, &mut escaped, slot as u32);
         }
         integrator::add_escaped(scene, s, &mut escaped, &mut l);
         for v in &l {
@@ -285,17 +300,20 @@ fn direct_light_from_every_shape_matches_its_irradiance() {
         for (shape, geometry, e) in lights_at(m) {
             let scene = floor_scene(rho, vec![light(geometry, 1.0)]);
             let expected = rho / std::f64::consts::PI * e;
-            for strategy in [Strategy::Emitter, Strategy::Bsdf, Strategy::Mis] {
+            for (strategy, sampler) in strategies_and_samplers() {
                 let n = if strategy == Strategy::Bsdf && place != "near" {
                     1 << 21
                 } else {
                     1 << 17
                 };
-                let s = settings(Integrator::Direct, strategy);
+                let s = Settings {
+                    sampler,
+                    ..settings(Integrator::Direct, strategy)
+                };
                 let (mean, se) = estimate(&scene, from, Vec3A::ZERO, &s, n);
                 assert!(
                     (mean - expected).abs() < 5.0 * se + 2e-3 * expected,
-                    "{shape} {place} {strategy:?}: {mean} ± {se}, expected {expected}"
+                    "{shape} {place} {strategy:?} {sampler:?}: {mean} ± {se}, expected {expected}"
                 );
                 assert!(
                     se < 0.05 * expected,
@@ -356,7 +374,7 @@ fn glowing_room_sums_its_bounces() {
     let (rho, l) = (0.6, 0.5);
     let scene = glowing_room(rho, l);
     let from = Vec3A::new(0.1, 0.2, -0.3);
-    for strategy in [Strategy::Emitter, Strategy::Bsdf, Strategy::Mis] {
+    for (strategy, sampler) in strategies_and_samplers() {
         for (max_depth, expected) in [
             (Some(1), l),
             (Some(2), l * (1.0 + rho)),
@@ -366,12 +384,13 @@ fn glowing_room_sums_its_bounces() {
             let s = Settings {
                 max_depth,
                 rr_depth: 2,
+                sampler,
                 ..settings(Integrator::Path, strategy)
             };
             let (mean, se) = estimate(&scene, from, Vec3A::new(1.0, 0.5, 0.2), &s, 1 << 16);
             assert!(
                 (mean - expected).abs() < 5.0 * se + 1e-4 * expected,
-                "{strategy:?} max_depth {max_depth:?}: {mean} ± {se}, expected {expected}"
+                "{strategy:?} {sampler:?} max_depth {max_depth:?}: {mean} ± {se}, expected {expected}"
             );
         }
     }

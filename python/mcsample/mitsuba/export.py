@@ -76,7 +76,7 @@ def scene_dict(scene: "Scene", spp: int | None = None,
         "far_clip": c.far_clip, "to_world": mi.ScalarTransform4f(c.to_world.tolist()),
         "film": {"type": "hdrfilm", "width": c.width, "height": c.height,
                  "rfilter": {"type": "box"}, "pixel_format": "rgb"},
-        "sampler": {"type": "independent", "sample_count": int(spp or c.sample_count or 4)},
+        "sampler": {"type": c.sampler, "sample_count": int(spp or c.sample_count or 4)},
     }
     if c.aperture_radius > 0:
         sensor.update(aperture_radius=c.aperture_radius, focus_distance=c.focus_distance)

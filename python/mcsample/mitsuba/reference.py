@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from ..results import RenderResult
+from ..scene.parse import MITSUBA_SAMPLERS
 from ..seeds import SeedLike, resolve_seed
 from .export import scene_dict
 from .variant import variant_set
@@ -20,7 +21,8 @@ def render_reference(scene: "Scene", spp: int, *, seed: SeedLike = 0,
                      integrator: Literal["direct", "path"] | None = None,
                      max_depth: int | None = None, rr_depth: int | None = None,
                      variant: str | None = None,
-                     hide_emitters: bool | None = None) -> RenderResult:
+                     hide_emitters: bool | None = None,
+                     sampler: str | None = None) -> RenderResult:
     """Renders ``scene`` in Mitsuba 3 (``variant``: default
     :func:`choose_variant`; the caller's variant is set again afterwards)
     with its ``path`` or ``direct`` integrator
@@ -28,8 +30,10 @@ def render_reference(scene: "Scene", spp: int, *, seed: SeedLike = 0,
     luminance. The film uses a box filter, as mcsample's. ``integrator``,
     ``max_depth``, ``rr_depth`` and ``hide_emitters`` default to the scene
     dict's integrator, as in :func:`mcsample.render`; ``seed`` is taken as
-    there (and reduced to Mitsuba's 32 bits). Everything after ``spp`` is
-    keyword-only.
+    there (and reduced to Mitsuba's 32 bits). ``sampler`` is Mitsuba's
+    sampler plugin ("independent", "stratified", "multijitter",
+    "orthogonal", "ldsampler"; default: the scene dict's, else
+    "independent"). Everything after ``spp`` is keyword-only.
 
     Returns a :class:`mcsample.RenderResult` whose ``variance`` is None
     (Mitsuba reports moments in XYZ, from which per-RGB-channel variances
@@ -47,6 +51,11 @@ def render_reference(scene: "Scene", spp: int, *, seed: SeedLike = 0,
             nested["max_depth"] = int(settings["max_depth"])
             nested["rr_depth"] = int(settings["rr_depth"])
         d = scene_dict(scene, spp=spp)
+        if sampler is not None:
+            if sampler not in MITSUBA_SAMPLERS:
+                raise ValueError(f"sampler = {sampler!r}: must be one of "
+                                 f"{', '.join(map(repr, MITSUBA_SAMPLERS))}")
+            d["sensor"]["sampler"]["type"] = sampler
         d["integrator"] = {"type": "moment", "nested": nested}
         mi_scene = mi.load_dict(d)
         start = time.perf_counter()

@@ -20,8 +20,11 @@ The subset (anything else raises ValueError naming the key):
   given directly as the value, in any mapping) and ``constant`` (radiance).
 - sensors: ``perspective`` (fov, fov_axis, near_clip, far_clip, to_world)
   and ``thinlens`` (also aperture_radius, focus_distance), with an
-  ``hdrfilm`` (width, height, box ``rfilter``) and an ``independent``
-  sampler (sample_count: the default spp).
+  ``hdrfilm`` (width, height, box ``rfilter``) and a sampler:
+  ``independent``, ``stratified``, ``multijitter``, ``orthogonal`` or
+  ``ldsampler`` (sample_count: the default spp; the type: the default
+  ``sampler=`` of :func:`mcsample.render`, see ``MITSUBA_SAMPLERS`` in
+  :mod:`mcsample.scene.parse`).
 - ``integrator``: ``path`` or ``direct`` (max_depth, rr_depth, hide_emitters): the
   defaults of :func:`mcsample.render`.
 

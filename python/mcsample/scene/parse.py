@@ -140,6 +140,21 @@ class Camera:
     aperture_radius: float = 0.0
     focus_distance: float = 0.0
     sample_count: int | None = None
+    #: The sensor's sampler, by its Mitsuba name.
+    sampler: str = "independent"
+
+
+#: Mitsuba's samplers, the keys each takes, and the mcsample sampler that
+#: does the same (``orthogonal``'s orthogonal arrays stratify each 1D and 2D
+#: projection, as the multi-jittered pattern does; ``ldsampler``'s padded
+#: (0, 2)-sequences are what "zsobol" draws, in z-order).
+MITSUBA_SAMPLERS: dict[str, tuple[set[str], str]] = {
+    "independent": ({"sample_count", "seed"}, "independent"),
+    "stratified": ({"sample_count", "seed", "jitter"}, "stratified"),
+    "multijitter": ({"sample_count", "seed", "jitter"}, "multijitter"),
+    "orthogonal": ({"sample_count", "seed", "jitter", "strength"}, "multijitter"),
+    "ldsampler": ({"sample_count", "seed"}, "zsobol"),
+}
 
 
 def _material(d: Any, key: str, refs: Mapping[str, Material]) -> Material:
@@ -320,9 +335,17 @@ def _camera(d: Mapping[str, Any], key: str) -> Camera:
         raise ValueError(f"{key}.film.pixel_format must be 'rgb' or 'rgba'")
     sampler = d.get("sampler")
     if sampler is not None:
-        if sampler.get("type") != "independent":
-            raise ValueError(f"{key}.sampler.type must be 'independent'")
-        _check_keys(sampler, {"sample_count", "seed"}, f"{key}.sampler")
+        kind = sampler.get("type")
+        if kind not in MITSUBA_SAMPLERS:
+            raise ValueError(f"{key}.sampler.type = {kind!r}: must be one of "
+                             f"{', '.join(map(repr, MITSUBA_SAMPLERS))}")
+        _check_keys(sampler, MITSUBA_SAMPLERS[kind][0], f"{key}.sampler")
+        if not sampler.get("jitter", True):
+            raise ValueError(f"{key}.sampler.jitter = False is not supported (strata are "
+                             "always jittered)")
+        if int(sampler.get("strength", 2)) != 2:
+            raise ValueError(f"{key}.sampler.strength must be 2")
+        cam.sampler = kind
         cam.sample_count = int(sampler.get("sample_count", 4))
     return cam
 

@@ -1,0 +1,257 @@
+//! Sample generators for the estimators and the renderer: where the uniform
+//! numbers of each sample come from.
+//!
+//! A [`Stream`] holds the samples `0 .. count` of one pixel (or of one
+//! estimate); sample `i`'s coordinate `dim` is asked for by
+//! [`Stream::get1`] and [`Stream::get2`] after [`Stream::start`]`(i)`. The
+//! callers give every random decision a fixed dimension (the renderer's
+//! order is in [`crate::render::integrator`]), so that a stratified or
+//! low-discrepancy sampler stratifies each decision across the samples:
+//!
+//! - [`Sampler::Independent`]: PCG32 numbers in the order they are asked
+//!   for, dimensions ignored (the bits of every earlier release);
+//! - [`Sampler::Stratified`] and [`Sampler::MultiJitter`]: each 1D request a
+//!   jittered stratum of `1/count`, each 2D request a point of a jittered
+//!   grid or of Kensler's correlated multi-jittered pattern
+//!   ([`crate::qmc::Pattern`]), a pattern of its own (hashed from the
+//!   stream's key and the dimension) per request, as Mitsuba's samplers;
+//! - [`Sampler::Sobol`]: the Sobol' sequence (Joe–Kuo directions, natural
+//!   order) in dimensions `dim` and `dim + 1`, Owen-scrambled per pixel and
+//!   dimension (Burley 2020's hash), past [`SOBOL_DIMENSIONS`] hashed
+//!   independent numbers;
+//! - [`Sampler::ZSobol`]: Ahmed and Wronski's (2020) z-ordered Sobol', as
+//!   pbrt-v4's `ZSobolSampler` ([`zorder`]): every request the first two
+//!   Sobol' dimensions at the pixel's Morton index, shuffled by base-4
+//!   digit permutations per dimension, Owen-scrambled per dimension, so that
+//!   the error is spread as blue noise across the screen.
+//!
+//! Every value is uniform on `[0, 1)` over the seed (a scrambled net is
+//! uniform point by point), so every estimator stays unbiased whatever the
+//! sampler.
+
+pub mod zorder;
+
+use std::sync::OnceLock;
+
+use crate::error::{Error, Result};
+use crate::math::Real;
+use crate::qmc::directions::{self, BITS};
+use crate::qmc::patterns::{jitter, mix64, multi_jitter, permute, stratified};
+use crate::qmc::sobol::owen;
+use crate::rng::Rng;
+use zorder::ZOrder;
+
+/// Dimensions of the Sobol' sequence [`Sampler::Sobol`] uses: a path of 145
+/// bounces (7 dimensions each past the camera's 5).
+pub const SOBOL_DIMENSIONS: u32 = 1024;
+
+/// The generator matrices of the first [`SOBOL_DIMENSIONS`] dimensions.
+fn sobol_columns() -> &'static [[u32; BITS]] {
+    static COLUMNS: OnceLock<Vec<[u32; BITS]>> = OnceLock::new();
+    COLUMNS.get_or_init(|| directions::columns(SOBOL_DIMENSIONS as usize))
+}
+
+/// Which generator a [`Stream`] draws from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sampler {
+    /// Independent uniform numbers (PCG32).
+    Independent,
+    /// Jittered strata per request (Mitsuba's `stratified`).
+    Stratified,
+    /// Correlated multi-jittered patterns per request (Mitsuba's
+    /// `multijitter`).
+    MultiJitter,
+    /// Owen-scrambled Sobol', seeded per pixel.
+    Sobol,
+    /// Z-ordered, Owen-scrambled Sobol' (pbrt-v4's `ZSobolSampler`).
+    ZSobol,
+}
+
+impl Sampler {
+    /// Every sampler with its Python name.
+    pub const NAMES: &'static [(&'static str, Sampler)] = &[
+        ("independent", Sampler::Independent),
+        ("stratified", Sampler::Stratified),
+        ("multijitter", Sampler::MultiJitter),
+        ("sobol", Sampler::Sobol),
+        ("zsobol", Sampler::ZSobol),
+    ];
+
+    /// The most samples one stream may hold: Sobol' indices have 32 bits,
+    /// and a stratified grid's `⌈√n⌉²` strata are counted in 32 bits.
+    pub fn max_count(self) -> u64 {
+        match self {
+            Sampler::Independent => u64::MAX,
+            Sampler::Stratified | Sampler::MultiJitter => crate::qmc::PATTERN_MAX_POINTS as u64,
+            Sampler::Sobol | Sampler::ZSobol => 1 << 32,
+        }
+    }
+
+    /// Checks that a stream of `count` samples fits (argument `arg`).
+    ///
+    /// # Errors
+    /// [`Error::Integer`] naming `arg` when `count` exceeds [`Sampler::max_count`].
+    pub fn check_count(self, arg: &'static str, count: u64) -> Result<()> {
+        if count <= self.max_count() {
+            return Ok(());
+        }
+        let name = Sampler::NAMES
+            .iter()
+            .find(|(_, s)| *s == self)
+            .map_or("?", |(n, _)| n);
+        Err(Error::Integer {
+            arg,
+            value: count.to_string(),
+            requirement: format!(
+                "must be at most {} with sampler=\"{name}\"",
+                self.max_count()
+            ),
+        })
+    }
+}
+
+/// The samples `0 .. count` of one pixel or one estimate.
+#[derive(Clone, Debug)]
+pub struct Stream {
+    sampler: Sampler,
+    /// The independent numbers (also the source of
+    /// [`Sampler::Independent`]'s draws).
+    rng: Rng,
+    /// Seeds the scrambles and patterns of this stream.
+    key: u64,
+    count: u32,
+    index: u32,
+    zorder: ZOrder,
+}
+
+impl Stream {
+    /// A stream of `count` samples (`1 ≤ count ≤` [`Sampler::max_count`],
+    /// which the caller checks) keyed by `key`; `rng` feeds
+    /// [`Sampler::Independent`]. `zorder` places the stream's samples in
+    /// the z-ordered sequence of [`Sampler::ZSobol`].
+    pub fn new(sampler: Sampler, key: u64, rng: Rng, count: u64, zorder: ZOrder) -> Self {
+        Stream {
+            sampler,
+            rng,
+            key,
+            count: count.clamp(1, u64::from(u32::MAX)) as u32,
+            index: 0,
+            zorder,
+        }
+    }
+
+    /// This stream with its independent numbers advanced by `draws` (where
+    /// a thread's share of an estimate starts).
+    pub fn jumped(&self, draws: u64) -> Self {
+        Stream {
+            rng: self.rng.jumped(draws),
+            ..self.clone()
+        }
+    }
+
+    /// The sampler.
+    pub fn sampler(&self) -> Sampler {
+        self.sampler
+    }
+
+    /// Moves to sample `index` (`< count`).
+    #[inline(always)]
+    pub fn start(&mut self, index: u32) {
+        self.index = index;
+    }
+
+    /// The independent generator, for [`Sampler::Independent`] only: its
+    /// callers may draw extra bits (an alias table's) that a stratified
+    /// sampler would waste.
+    #[inline(always)]
+    pub fn independent(&mut self) -> Option<&mut Rng> {
+        (self.sampler == Sampler::Independent).then_some(&mut self.rng)
+    }
+
+    /// A 32-bit seed for dimension `dim` of this stream.
+    #[inline(always)]
+    fn seed(&self, dim: u32) -> u64 {
+        mix64(self.key ^ mix64(u64::from(dim)))
+    }
+
+    /// Coordinate `dim` of the current sample, in `[0, 1)`.
+    #[inline]
+    pub fn get1<F: Real>(&mut self, dim: u32) -> F {
+        let (s, n) = (self.index, self.count);
+        let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
+        match self.sampler {
+            Sampler::Independent => self.rng.next_float(),
+            Sampler::Stratified | Sampler::MultiJitter => {
+                let p = (self.seed(dim) >> 32) as u32;
+                unit((f64::from(permute(s, n, p)) + jitter(s, p)) / f64::from(n))
+            }
+            Sampler::Sobol => F::from_random_bits(self.sobol(dim)),
+            Sampler::ZSobol => {
+                let h = self.zorder_seed(dim);
+                let i = self.zorder.sample_index(s, h);
+                F::from_random_bits(owen(zorder::sobol0(i), h as u32))
+            }
+        }
+    }
+
+    /// Coordinates `dim` and `dim + 1` of the current sample, stratified
+    /// together.
+    #[inline]
+    pub fn get2<F: Real>(&mut self, dim: u32) -> [F; 2] {
+        let (s, n) = (self.index, self.count);
+        let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
+        match self.sampler {
+            Sampler::Independent => [self.rng.next_float(), self.rng.next_float()],
+            Sampler::Stratified | Sampler::MultiJitter => {
+                let p = (self.seed(dim) >> 32) as u32;
+                let (x, y) = if self.sampler == Sampler::Stratified {
+                    stratified(s, n, p)
+                } else {
+                    multi_jitter(s, n, p)
+                };
+                [unit(x), unit(y)]
+            }
+            Sampler::Sobol => [
+                F::from_random_bits(self.sobol(dim)),
+                F::from_random_bits(self.sobol(dim + 1)),
+            ],
+            Sampler::ZSobol => {
+                let h = self.zorder_seed(dim);
+                let i = self.zorder.sample_index(s, h);
+                let (x, y) = zorder::sobol01(i);
+                [
+                    F::from_random_bits(owen(x, h as u32)),
+                    F::from_random_bits(owen(y, (h >> 32) as u32)),
+                ]
+            }
+        }
+    }
+
+    /// Coordinate `dim` of the current sample of [`Sampler::Sobol`], as 32
+    /// bits: `owen(⊕_{b : bit b of i} v_dim,b, seed(pixel, dim))`.
+    #[inline]
+    fn sobol(&self, dim: u32) -> u32 {
+        let seed = self.seed(dim);
+        let Some(columns) = sobol_columns().get(dim as usize) else {
+            // Past the table: a hashed independent number.
+            return (mix64(seed ^ u64::from(self.index)) >> 32) as u32;
+        };
+        let mut x = 0;
+        let mut bits = self.index;
+        while bits != 0 {
+            x ^= columns[bits.trailing_zeros() as usize];
+            bits &= bits - 1;
+        }
+        owen(x, (seed >> 32) as u32)
+    }
+
+    /// [`Sampler::ZSobol`]'s seed of dimension `dim`: the same for every
+    /// pixel (the z-order decorrelates them).
+    #[inline(always)]
+    fn zorder_seed(&self, dim: u32) -> u64 {
+        mix64(self.zorder.seed() ^ mix64(u64::from(dim)))
+    }
+}
+
+#[cfg(test)]
+mod tests;
