@@ -6,8 +6,8 @@ use super::envmap::PyEnvMap;
 use super::parallel::detached;
 use super::phong::PyPhong;
 use crate::estimators::{self, Estimate, Plan, Strategy};
-use crate::sampler::Sampler;
 use crate::python::Obj;
+use crate::sampler::Sampler;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 
@@ -99,7 +99,11 @@ pub fn estimate(
         strategy: choice(
             "strategy",
             strategy,
-            if phong.is_some() { REFLECTED } else { IRRADIANCE },
+            if phong.is_some() {
+                REFLECTED
+            } else {
+                IRRADIANCE
+            },
         )?,
         heuristic: heuristic_arg(heuristic)?,
         seed,
@@ -111,7 +115,11 @@ pub fn estimate(
         Some(phong) => {
             let wi = match wi {
                 Some(wi) => three_floats(wi, "wi", false)?,
-                None => return Err(pyo3::exceptions::PyTypeError::new_err("wi is required with phong")),
+                None => {
+                    return Err(pyo3::exceptions::PyTypeError::new_err(
+                        "wi is required with phong",
+                    ));
+                }
             };
             let phong = phong.get().inner();
             detached(py, || {

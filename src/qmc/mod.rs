@@ -19,7 +19,7 @@ pub use halton::{
 pub use patterns::{
     MAX_DIMENSIONS as PATTERN_MAX_DIMENSIONS, MAX_POINTS as PATTERN_MAX_POINTS, Pattern, Patterns,
 };
-pub use sobol::{Scramble, Sobol, owen};
+pub use sobol::{Scramble, Sobol, owen, owen_reversed};
 
 use crate::error::{Error, Result};
 use crate::parallel::Outputs;

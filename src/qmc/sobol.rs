@@ -175,10 +175,17 @@ fn finish<F: Real>(out: &mut [F], bits: &[u32], keys: &[u32], step: impl Fn(u32,
 /// Laine–Karras permutation (additions and multiplications by even
 /// constants, each changing only bits above those it reads) flips each bit
 /// by a function of the bits before it and `seed` (Burley 2020's
-/// constants).
+/// constants); see [`owen_reversed`].
 #[inline(always)]
 pub fn owen(x: u32, seed: u32) -> u32 {
-    let mut v = x.reverse_bits().wrapping_add(seed);
+    owen_reversed(x.reverse_bits(), seed)
+}
+
+/// [`owen`] of the value whose bits reversed are `r` (a caller that builds
+/// its values from reversed generator matrices saves one reversal).
+#[inline(always)]
+pub fn owen_reversed(r: u32, seed: u32) -> u32 {
+    let mut v = r.wrapping_add(seed);
     v ^= v.wrapping_mul(0x6c50_b47c);
     v ^= v.wrapping_mul(0xb82f_1e52);
     v ^= v.wrapping_mul(0xc7af_e638);

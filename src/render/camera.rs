@@ -122,6 +122,12 @@ impl Camera {
         })
     }
 
+    /// Whether rays start across a lens (a thin lens) rather than at a
+    /// pinhole, which ignores the lens sample.
+    pub fn has_lens(&self) -> bool {
+        self.aperture_radius > 0.0
+    }
+
     /// The ray through the film position `film ∈ [0, 1]²` (x right, y down),
     /// through the lens point `lens ∈ [0, 1]²` (concentric disk) for a thin
     /// lens. In camera space the pinhole ray's direction is

@@ -128,10 +128,17 @@ impl Batch {
                 u64::from(spp),
                 ZOrder::new((x, y), (width, height), u64::from(spp), seed),
             );
+            // A pinhole ignores the lens: only the independent sampler,
+            // whose draws come in order, must draw it.
+            let lens_drawn = scene.camera().has_lens() || stream.independent().is_some();
             for i in 0..spp {
                 stream.start(i);
                 let film = stream.get2::<f32>(dims::FILM);
-                let lens = stream.get2(dims::LENS);
+                let lens = if lens_drawn {
+                    stream.get2(dims::LENS)
+                } else {
+                    [0.5; 2]
+                };
                 let film_x = (x as f32 + film[0]) * inv_width;
                 let film_y = (y as f32 + film[1]) * inv_height;
                 self.camera_u.push([film_x, film_y, lens[0], lens[1]]);

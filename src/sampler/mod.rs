@@ -37,7 +37,7 @@ use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::qmc::directions::{self, BITS};
 use crate::qmc::patterns::{jitter, mix64, multi_jitter, permute, stratified};
-use crate::qmc::sobol::owen;
+use crate::qmc::sobol::owen_reversed;
 use crate::rng::Rng;
 use zorder::ZOrder;
 
@@ -45,10 +45,16 @@ use zorder::ZOrder;
 /// bounces (7 dimensions each past the camera's 5).
 pub const SOBOL_DIMENSIONS: u32 = 1024;
 
-/// The generator matrices of the first [`SOBOL_DIMENSIONS`] dimensions.
+/// The generator matrices of the first [`SOBOL_DIMENSIONS`] dimensions,
+/// their columns bit-reversed (for [`owen_reversed`]).
 fn sobol_columns() -> &'static [[u32; BITS]] {
     static COLUMNS: OnceLock<Vec<[u32; BITS]>> = OnceLock::new();
-    COLUMNS.get_or_init(|| directions::columns(SOBOL_DIMENSIONS as usize))
+    COLUMNS.get_or_init(|| {
+        directions::columns(SOBOL_DIMENSIONS as usize)
+            .into_iter()
+            .map(|v| v.map(u32::reverse_bits))
+            .collect()
+    })
 }
 
 /// Which generator a [`Stream`] draws from.
@@ -110,6 +116,20 @@ impl Sampler {
     }
 }
 
+/// Dimensions whose [`DimKey`] a stream keeps once computed (a direct-
+/// lighting sample uses 19).
+const CACHED: usize = 32;
+
+/// What a dimension's values need besides the sample index.
+#[derive(Clone, Copy, Debug, Default)]
+struct DimKey {
+    /// The 64-bit seed of the dimension's scrambles or pattern.
+    seed: u64,
+    /// [`Sampler::ZSobol`]: the shuffled digits above the pixel's samples
+    /// ([`ZOrder::block`]).
+    block: u64,
+}
+
 /// The samples `0 .. count` of one pixel or one estimate.
 #[derive(Clone, Debug)]
 pub struct Stream {
@@ -122,6 +142,12 @@ pub struct Stream {
     count: u32,
     index: u32,
     zorder: ZOrder,
+    /// [`Sampler::Sobol`]'s generator matrices (empty for the others).
+    columns: &'static [[u32; BITS]],
+    /// The keys of dimensions below [`CACHED`], where bit `dim` of
+    /// `cached` is set.
+    keys: [DimKey; CACHED],
+    cached: u32,
 }
 
 impl Stream {
@@ -137,6 +163,13 @@ impl Stream {
             count: count.clamp(1, u64::from(u32::MAX)) as u32,
             index: 0,
             zorder,
+            columns: if sampler == Sampler::Sobol {
+                sobol_columns()
+            } else {
+                &[]
+            },
+            keys: [DimKey::default(); CACHED],
+            cached: 0,
         }
     }
 
@@ -168,42 +201,87 @@ impl Stream {
         (self.sampler == Sampler::Independent).then_some(&mut self.rng)
     }
 
-    /// A 32-bit seed for dimension `dim` of this stream.
+    /// The key of dimension `dim`: its seed is a hash of the stream's key
+    /// and `dim` ([`Sampler::ZSobol`]: of the sampler's seed and `dim`, the
+    /// same for every pixel, as the z-order decorrelates them).
     #[inline(always)]
-    fn seed(&self, dim: u32) -> u64 {
-        mix64(self.key ^ mix64(u64::from(dim)))
+    fn key(&mut self, dim: u32) -> DimKey {
+        let Some(slot) = self.keys.get(dim as usize) else {
+            return self.make_key(dim);
+        };
+        if self.cached >> dim & 1 == 1 {
+            return *slot;
+        }
+        let key = self.make_key(dim);
+        self.keys[dim as usize] = key;
+        self.cached |= 1 << dim;
+        key
+    }
+
+    fn make_key(&self, dim: u32) -> DimKey {
+        let dim = mix64(u64::from(dim));
+        if self.sampler == Sampler::ZSobol {
+            let seed = mix64(self.zorder.seed() ^ dim);
+            DimKey {
+                seed,
+                block: self.zorder.block(seed),
+            }
+        } else {
+            DimKey {
+                seed: mix64(self.key ^ dim),
+                block: 0,
+            }
+        }
     }
 
     /// Coordinate `dim` of the current sample, in `[0, 1)`.
-    #[inline]
+    #[inline(always)]
     pub fn get1<F: Real>(&mut self, dim: u32) -> F {
-        let (s, n) = (self.index, self.count);
-        let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
-        match self.sampler {
-            Sampler::Independent => self.rng.next_float(),
-            Sampler::Stratified | Sampler::MultiJitter => {
-                let p = (self.seed(dim) >> 32) as u32;
-                unit((f64::from(permute(s, n, p)) + jitter(s, p)) / f64::from(n))
-            }
-            Sampler::Sobol => F::from_random_bits(self.sobol(dim)),
-            Sampler::ZSobol => {
-                let h = self.zorder_seed(dim);
-                let i = self.zorder.sample_index(s, h);
-                F::from_random_bits(owen(zorder::sobol0(i), h as u32))
-            }
+        if self.sampler == Sampler::Independent {
+            self.rng.next_float()
+        } else {
+            self.stratified1(dim)
         }
     }
 
     /// Coordinates `dim` and `dim + 1` of the current sample, stratified
     /// together.
-    #[inline]
+    #[inline(always)]
     pub fn get2<F: Real>(&mut self, dim: u32) -> [F; 2] {
+        if self.sampler == Sampler::Independent {
+            [self.rng.next_float(), self.rng.next_float()]
+        } else {
+            self.stratified2(dim)
+        }
+    }
+
+    /// [`Stream::get1`] of the samplers other than the independent one.
+    fn stratified1<F: Real>(&mut self, dim: u32) -> F {
+        let (s, n) = (self.index, self.count);
+        let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
+        match self.sampler {
+            Sampler::Independent => self.rng.next_float(),
+            Sampler::Stratified | Sampler::MultiJitter => {
+                let p = (self.key(dim).seed >> 32) as u32;
+                unit((f64::from(permute(s, n, p)) + jitter(s, p)) / f64::from(n))
+            }
+            Sampler::Sobol => F::from_random_bits(self.sobol(dim)),
+            Sampler::ZSobol => {
+                let k = self.key(dim);
+                let i = k.block | self.zorder.within(s, k.seed);
+                F::from_random_bits(owen_reversed(zorder::sobol0_reversed(i), k.seed as u32))
+            }
+        }
+    }
+
+    /// [`Stream::get2`] of the samplers other than the independent one.
+    fn stratified2<F: Real>(&mut self, dim: u32) -> [F; 2] {
         let (s, n) = (self.index, self.count);
         let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
         match self.sampler {
             Sampler::Independent => [self.rng.next_float(), self.rng.next_float()],
             Sampler::Stratified | Sampler::MultiJitter => {
-                let p = (self.seed(dim) >> 32) as u32;
+                let p = (self.key(dim).seed >> 32) as u32;
                 let (x, y) = if self.sampler == Sampler::Stratified {
                     stratified(s, n, p)
                 } else {
@@ -216,23 +294,24 @@ impl Stream {
                 F::from_random_bits(self.sobol(dim + 1)),
             ],
             Sampler::ZSobol => {
-                let h = self.zorder_seed(dim);
-                let i = self.zorder.sample_index(s, h);
-                let (x, y) = zorder::sobol01(i);
+                let k = self.key(dim);
+                let i = k.block | self.zorder.within(s, k.seed);
+                let (x, y) = zorder::sobol01_reversed(i);
                 [
-                    F::from_random_bits(owen(x, h as u32)),
-                    F::from_random_bits(owen(y, (h >> 32) as u32)),
+                    F::from_random_bits(owen_reversed(x, k.seed as u32)),
+                    F::from_random_bits(owen_reversed(y, (k.seed >> 32) as u32)),
                 ]
             }
         }
     }
 
     /// Coordinate `dim` of the current sample of [`Sampler::Sobol`], as 32
-    /// bits: `owen(⊕_{b : bit b of i} v_dim,b, seed(pixel, dim))`.
+    /// bits: `owen(⊕_{b : bit b of i} v_dim,b, seed(pixel, dim))` (built
+    /// reversed).
     #[inline]
-    fn sobol(&self, dim: u32) -> u32 {
-        let seed = self.seed(dim);
-        let Some(columns) = sobol_columns().get(dim as usize) else {
+    fn sobol(&mut self, dim: u32) -> u32 {
+        let seed = self.key(dim).seed;
+        let Some(columns) = self.columns.get(dim as usize) else {
             // Past the table: a hashed independent number.
             return (mix64(seed ^ u64::from(self.index)) >> 32) as u32;
         };
@@ -242,14 +321,7 @@ impl Stream {
             x ^= columns[bits.trailing_zeros() as usize];
             bits &= bits - 1;
         }
-        owen(x, (seed >> 32) as u32)
-    }
-
-    /// [`Sampler::ZSobol`]'s seed of dimension `dim`: the same for every
-    /// pixel (the z-order decorrelates them).
-    #[inline(always)]
-    fn zorder_seed(&self, dim: u32) -> u64 {
-        mix64(self.zorder.seed() ^ mix64(u64::from(dim)))
+        owen_reversed(x, (seed >> 32) as u32)
     }
 }
 

@@ -70,7 +70,12 @@ fn is_net(p: &[[f64; 2]]) -> bool {
     (0..=m).all(|a| {
         let mut cells: Vec<(u64, u64)> = p
             .iter()
-            .map(|q| ((q[0] * (1u64 << a) as f64) as u64, (q[1] * (1u64 << (m - a)) as f64) as u64))
+            .map(|q| {
+                (
+                    (q[0] * (1u64 << a) as f64) as u64,
+                    (q[1] * (1u64 << (m - a)) as f64) as u64,
+                )
+            })
             .collect();
         cells.sort();
         cells.dedup();
@@ -146,6 +151,10 @@ fn counts_are_checked() {
     assert!(Sampler::Sobol.check_count("n", 1 << 32).is_ok());
     let e = Sampler::Sobol.check_count("n", (1 << 32) + 1).unwrap_err();
     assert!(e.to_string().contains("sampler=\"sobol\""));
-    assert!(Sampler::Stratified.check_count("spp", (1 << 30) + 1).is_err());
+    assert!(
+        Sampler::Stratified
+            .check_count("spp", (1 << 30) + 1)
+            .is_err()
+    );
     assert!(Sampler::Independent.check_count("n", u64::MAX).is_ok());
 }

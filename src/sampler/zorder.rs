@@ -39,17 +39,17 @@ const fn permutations() -> [[u8; 4]; 24] {
 
 /// Column `b` of the second Sobol' dimension's generator matrix (Pascal's
 /// triangle mod 2, `binom(b, r)` odd iff `r & !b = 0` by Lucas), for indices
-/// of up to 64 bits: bit `31 − r` of column `b` is row `r`.
-const PASCAL: [u32; 64] = pascal();
+/// of up to 64 bits, bit-reversed: bit `r` of column `b` is row `r`.
+const PASCAL_REVERSED: [u32; 64] = pascal_reversed();
 
-const fn pascal() -> [u32; 64] {
+const fn pascal_reversed() -> [u32; 64] {
     let mut out = [0u32; 64];
     let mut b = 0;
     while b < 64 {
         let mut r = 0;
         while r < 32 {
             if r & !b == 0 {
-                out[b] |= 1 << (31 - r);
+                out[b] |= 1 << r;
             }
             r += 1;
         }
@@ -58,23 +58,24 @@ const fn pascal() -> [u32; 64] {
     out
 }
 
-/// The first Sobol' dimension (van der Corput's) of index `i`, as 32 bits.
+/// The first Sobol' dimension (van der Corput's) of index `i`, as 32
+/// bits reversed (which are the index's low 32 bits).
 #[inline(always)]
-pub fn sobol0(i: u64) -> u32 {
-    (i as u32).reverse_bits()
+pub fn sobol0_reversed(i: u64) -> u32 {
+    i as u32
 }
 
 /// The first two Sobol' dimensions of index `i` (natural order), as 32
-/// bits each.
+/// bits each, reversed.
 #[inline]
-pub fn sobol01(i: u64) -> (u32, u32) {
+pub fn sobol01_reversed(i: u64) -> (u32, u32) {
     let mut y = 0;
     let mut bits = i;
     while bits != 0 {
-        y ^= PASCAL[bits.trailing_zeros() as usize];
+        y ^= PASCAL_REVERSED[bits.trailing_zeros() as usize];
         bits &= bits - 1;
     }
-    (sobol0(i), y)
+    (sobol0_reversed(i), y)
 }
 
 /// The z-order of one pixel's samples (the default: a single pixel).
@@ -148,21 +149,44 @@ impl ZOrder {
     }
 
     /// The shuffled global index of sample `s` for the dimension whose
-    /// hashed seed is `h`.
+    /// hashed seed is `h`: [`ZOrder::block`] `|` [`ZOrder::within`].
     #[inline]
     pub fn sample_index(&self, s: u32, h: u64) -> u64 {
+        self.block(h) | self.within(s, h)
+    }
+
+    /// The shuffled digits above the pixel's samples (the same for all of
+    /// them): where the pixel's block of `2^k` indices went.
+    pub fn block(&self, h: u64) -> u64 {
+        let first = self.log2_count.div_ceil(2);
+        self.shuffle(self.base, h, first..self.digits)
+    }
+
+    /// The shuffled digits of sample `s` within its pixel's block.
+    #[inline]
+    pub fn within(&self, s: u32, h: u64) -> u64 {
         let m = self.base | u64::from(s);
         let odd = self.log2_count & 1;
+        let mut out = self.shuffle(m, h, odd..self.log2_count.div_ceil(2));
+        if odd == 1 {
+            out |= (m & 1) ^ (mix64((m >> 1) ^ h) & 1);
+        }
+        out
+    }
+
+    /// The base-4 digits `digits` of `m` (digit `i` at bit `2i − (k mod
+    /// 2)`), each replaced by its image under the permutation that a hash
+    /// of the digits above it and `h` picks.
+    #[inline]
+    fn shuffle(&self, m: u64, h: u64, digits: std::ops::Range<u32>) -> u64 {
+        let odd = self.log2_count & 1;
         let mut out = 0u64;
-        for i in (odd..self.digits).rev() {
+        for i in digits.rev() {
             let shift = 2 * i - odd;
             let digit = ((m >> shift) & 3) as usize;
             let higher = m.checked_shr(shift + 2).unwrap_or(0);
             let p = ((mix64(higher ^ h) >> 32) % 24) as usize;
             out |= u64::from(PERMUTATIONS[p][digit]) << shift;
-        }
-        if odd == 1 {
-            out |= (m & 1) ^ (mix64((m >> 1) ^ h) & 1);
         }
         out
     }
@@ -175,8 +199,8 @@ mod tests {
 
     #[test]
     fn pascal_is_the_second_sobol_dimension() {
-        let v = columns(2)[1];
-        assert_eq!(&PASCAL[..32], &v[..]);
+        let v = columns(2)[1].map(u32::reverse_bits);
+        assert_eq!(&PASCAL_REVERSED[..32], &v[..]);
     }
 
     #[test]
