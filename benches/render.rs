@@ -1,9 +1,9 @@
 //! The renderer in the core, on all cores: camera samples per second on the
 //! two scenes of `python -m mcsample bench --only render` (a diffuse sphere
 //! under the packaged sky; the same sphere on a plane with a rectangular
-//! area light), 256 × 256, 64 spp, MIS, direct and path:
+//! area light), 256 × 256, 64 spp, MIS, direct and path, with each sampler:
 //! `cargo bench --bench render [-- FILTER]`, FILTER a part of a case's name
-//! (e.g. `plane`, `Path`).
+//! (e.g. `plane`, `Path`, `sobol`).
 
 use std::path::Path;
 use std::time::Instant;
@@ -14,6 +14,7 @@ use mcsample::phong::{Phong, Selection};
 use mcsample::render::camera::{Camera, FovAxis};
 use mcsample::render::scene::{Environment, Geometry, Material, Shape};
 use mcsample::render::{Heuristic, Integrator, Progress, Scene, Settings, Strategy, render};
+use mcsample::sampler::Sampler;
 
 const SIZE: usize = 256;
 const SPP: u32 = 64;
@@ -91,8 +92,15 @@ fn main() {
     let samples = (SIZE * SIZE) as f64 * f64::from(SPP);
     for (name, with_plane) in [("sphere under sky", false), ("sphere on plane", true)] {
         let scene = scene(with_plane);
-        for integrator in [Integrator::Direct, Integrator::Path] {
-            let case = format!("{name}, {integrator:?}");
+        let cases = [Integrator::Direct, Integrator::Path]
+            .into_iter()
+            .flat_map(|i| {
+                Sampler::NAMES
+                    .iter()
+                    .map(move |&(s, sampler)| (i, s, sampler))
+            });
+        for (integrator, sampler_name, sampler) in cases {
+            let case = format!("{name}, {integrator:?}, {sampler_name}");
             if filter.as_ref().is_some_and(|f| !case.contains(f.as_str())) {
                 continue;
             }
@@ -103,6 +111,7 @@ fn main() {
                 max_depth: None,
                 rr_depth: 5,
                 hide_emitters: false,
+                sampler,
             };
             let mut times: Vec<f64> = (0..5)
                 .map(|seed| {
@@ -113,7 +122,7 @@ fn main() {
                 .collect();
             times.sort_by(f64::total_cmp);
             println!(
-                "{case:>24}: min {:7.1} ms, median {:7.1} ms, {:5.2} M samples/s",
+                "{case:>38}: min {:7.1} ms, median {:7.1} ms, {:5.2} M samples/s",
                 times[0] * 1e3,
                 times[2] * 1e3,
                 samples / times[0] / 1e6

@@ -88,7 +88,7 @@ impl Sampler {
     pub fn max_count(self) -> u64 {
         match self {
             Sampler::Independent => u64::MAX,
-            Sampler::Stratified | Sampler::MultiJitter => crate::qmc::PATTERN_MAX_POINTS as u64,
+            Sampler::Stratified | Sampler::MultiJitter => crate::qmc::PATTERN_MAX_POINTS,
             Sampler::Sobol | Sampler::ZSobol => 1 << 32,
         }
     }
