@@ -18,9 +18,10 @@ class Estimate:
     n: Final[int]
     strategy: Final[str]
 
-def irradiance(env: EnvMap, normal: ArrayLike, n: int, *, strategy: _Strategy = "mis",
-               seed: int | np.random.Generator | None = 0,
-               heuristic: Literal["balance", "power"] = "power") -> Estimate: ...
-def reflected_radiance(env: EnvMap, phong: Phong, normal: ArrayLike, wi: ArrayLike, n: int, *,
-                       strategy: _Strategy = "mis", seed: int | np.random.Generator | None = 0,
-                       heuristic: Literal["balance", "power"] = "power") -> Estimate: ...
+def estimate(env: EnvMap, normal: ArrayLike, n: int, *, phong: Phong | None = None,
+             wi: ArrayLike | None = None, strategy: _Strategy,
+             seed: int | np.random.Generator | None, heuristic: Literal["balance", "power"],
+             sampler: Literal["independent", "stratified", "multijitter", "sobol", "zsobol"]
+             ) -> Estimate:
+    """The irradiance (without phong) or the reflected radiance (with phong
+    and wi): see mcsample.estimators."""

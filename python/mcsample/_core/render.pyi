@@ -40,4 +40,5 @@ def render(
     heuristic: Literal["balance", "power"],
     max_depth: int, rr_depth: int, hide_emitters: bool = False,
     callback: Callable[[int], object] | None = None,
+    sampler: Literal["independent", "stratified", "multijitter", "sobol", "zsobol"] = "independent",
 ) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32]]: ...
