@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import mcsample as mcs
-from mcsample import bench
+from mcsample.bench import kernels as bench
 
 CASES = [
     ("square_to_uniform_disk", bench._numpy_uniform_disk, ()),

@@ -43,9 +43,10 @@ import numpy as np
 
 from .._core.render import CompiledScene, SceneBuilder
 from ..results import EmitterSample
+from .meshes import icosphere
 from .parse import Camera, ShapeRecord, look_at, parse_scene
 
-__all__ = ["EmitterSample", "Scene", "look_at"]
+__all__ = ["EmitterSample", "Scene", "icosphere", "look_at"]
 
 
 @dataclass

@@ -1,95 +1,15 @@
-"""``python -m mcsample bench``: throughput of mcsample's kernels side by
-side with a vectorised numpy implementation and, when it runs here, Mitsuba
-3's llvm_ad_rgb variant, in one run.
-
-Each case is timed as the median of ``repeat`` runs after ``warmup`` runs
-(which also exclude Mitsuba's JIT compilation), and reported in millions of
-samples per second. Later issues add their cases to :data:`SUITES`.
-"""
+"""Kernel suites: random numbers, warps, discrete tables, Phong, envmap
+sampling and the QMC engines, beside numpy, scipy and Mitsuba."""
 
 from __future__ import annotations
 
-import statistics
-import time
-from typing import Callable, NamedTuple
+from typing import Callable
 
 import numpy as np
 
 import mcsample as mcs
 
-
-class Timing(NamedTuple):
-    case: str
-    implementation: str
-    dtype: str
-    n: int
-    seconds: float
-
-    @property
-    def msamples_per_s(self) -> float:
-        return self.n / self.seconds / 1e6
-
-
-def measure(fn: Callable[[], object], repeat: int = 7, warmup: int = 2) -> float:
-    """Median wall time of ``fn()`` in seconds over ``repeat`` runs, after
-    ``warmup`` runs."""
-    for _ in range(warmup):
-        fn()
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
-
-
-#: Seconds to wait before each timed run of a comparison, so that the other
-#: runtime's worker threads have gone idle. Dr.Jit's keep a core busy for
-#: some 10-50 ms after its last call: measured here, mcsample's first
-#: triangle warp right after Mitsuba's took 10.6 ms, the third 4.1 ms, and
-#: after a 50 ms pause 3.7-4.4 ms. Every side gets the same pause.
-IDLE_PAUSE = 0.1
-
-
-def measure_side_by_side(fns: list[Callable[[], object]], repeat: int = 7,
-                         warmup: int = 2) -> list[float]:
-    """Median wall time of each of ``fns`` in seconds, run in turn (one run
-    of each per round, ``repeat`` rounds after ``warmup``, each timed run
-    after a pause of ``IDLE_PAUSE``), so that a slow spell of a shared
-    machine weighs on all of them alike."""
-    for _ in range(warmup):
-        for fn in fns:
-            fn()
-    times: list[list[float]] = [[] for _ in fns]
-    for _ in range(repeat):
-        for fn, t in zip(fns, times):
-            time.sleep(IDLE_PAUSE)
-            start = time.perf_counter()
-            fn()
-            t.append(time.perf_counter() - start)
-    return [statistics.median(t) for t in times]
-
-
-def measure_alternating(fns: list[Callable[[], object]], repeat: int = 7,
-                        rounds: int = 3) -> list[float]:
-    """Median wall time of each of ``fns`` in seconds, timed in blocks that
-    alternate: each round runs every function after a pause of
-    ``IDLE_PAUSE`` (so that the other runtime's worker threads have gone
-    idle), once untimed and then ``repeat`` times, for ``rounds`` rounds;
-    the median is over every timed run. For calls of a few milliseconds,
-    where one call right after another runtime's is slowed by its spinning
-    threads, yet a single block each would leave the comparison to whichever
-    ran in a quiet spell."""
-    times: list[list[float]] = [[] for _ in fns]
-    for _ in range(rounds):
-        for fn, t in zip(fns, times):
-            time.sleep(IDLE_PAUSE)
-            fn()
-            for _ in range(repeat):
-                start = time.perf_counter()
-                fn()
-                t.append(time.perf_counter() - start)
-    return [statistics.median(t) for t in times]
+from .timing import Timing, measure, measure_side_by_side
 
 
 def _numpy_concentric_disk(u: np.ndarray) -> np.ndarray:
@@ -136,14 +56,6 @@ def _numpy_uniform_sphere(u: np.ndarray) -> np.ndarray:
     r = np.sqrt(np.maximum(0, 1 - z * z))
     phi = 2 * np.pi * u[:, 0]
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
-
-
-def _mitsuba():
-    from . import mitsuba as mcs_mitsuba
-
-    if not mcs_mitsuba.available() or mcs_mitsuba.choose_variant() != "llvm_ad_rgb":
-        return None
-    return mcs_mitsuba.load("llvm_ad_rgb")
 
 
 def suite_rng(n: int, repeat: int, mi) -> list[Timing]:
@@ -288,7 +200,7 @@ def suite_distr(n: int, repeat: int, mi) -> list[Timing]:
         from scipy.stats.sampling import DiscreteAliasUrn
 
         # UNU.RAN warns about round-off for 10^6 entries; it still samples.
-        warnings.filterwarnings("ignore", category=RuntimeWarning, module="mcsample.bench")
+        warnings.filterwarnings("ignore", category=RuntimeWarning, module="mcsample.bench.kernels")
 
         out.append(Timing("build 10^6 (entries/s)", "scipy DiscreteAliasUrn", "float64", size,
                           measure(lambda: DiscreteAliasUrn(weights, random_state=1), 3, 1)))
@@ -439,100 +351,6 @@ def suite_envmap(n: int, repeat: int, mi) -> list[Timing]:
     return out
 
 
-def _render_scenes(size: int = 256) -> dict[str, dict]:
-    """The issue's two speed scenes: a diffuse sphere under the packaged sky,
-    and a sphere on a plane lit by the sky and a rectangular area light."""
-    sensor = {"type": "perspective", "fov": 35,
-              "to_world": mcs.look_at([0, 1.2, 4.5], [0, 0.6, 0], [0, 1, 0]),
-              "film": {"type": "hdrfilm", "width": size, "height": size,
-                       "rfilter": {"type": "box"}}}
-    ball = {"type": "sphere", "center": [0, 0.6, 0], "radius": 0.6,
-            "bsdf": {"type": "diffuse", "reflectance": [0.7, 0.6, 0.5]}}
-    floor = {"type": "rectangle", "bsdf": {"type": "diffuse", "reflectance": 0.5},
-             "to_world": np.array([[4.0, 0, 0, 0], [0, 0, 4.0, 0], [0, -4.0, 0, 0], [0, 0, 0, 1]])}
-    light = {"type": "rectangle", "emitter": {"type": "area", "radiance": [12.0, 11.0, 9.0]},
-             "to_world": np.array([[0.4, 0, 0, 1.0], [0, 0, 1, 2.0], [0, -0.4, 0, 0.8],
-                                   [0, 0, 0, 1]])}
-    sky = mcs.EnvMap()
-    return {
-        "sphere under sky": {"type": "scene", "sensor": sensor, "sky": sky, "ball": ball},
-        "sphere on plane": {"type": "scene", "sensor": sensor, "sky": sky, "ball": ball,
-                            "floor": floor, "light": light},
-    }
-
-
-def suite_render(n: int, repeat: int, mi, spp: int = 64) -> list[Timing]:
-    """Samples (camera paths) per second at 256 x 256, 64 spp, MIS, direct and
-    path; Mitsuba's time excludes its JIT compilation (warm-up renders)."""
-    out = []
-    repeat = min(repeat, 3)
-    for name, d in _render_scenes().items():
-        scene = mcs.Scene.from_mitsuba(d)
-        h, w = scene.shape
-        samples = w * h * spp
-        mi_scene = None
-        if mi is not None:
-            mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp))
-        for integrator in ("direct", "path"):
-            case = f"render {name}, {integrator}"
-            runs = [("mcsample", lambda: mcs.render(scene, spp, integrator=integrator,
-                                                    progress=False))]
-            if mi_scene is not None:
-                mi_int = mi.load_dict({"type": integrator})
-
-                def run_mitsuba():
-                    img = mi.render(mi_scene, integrator=mi_int, spp=spp)
-                    np.asarray(img)
-                runs.append(("mitsuba llvm_ad_rgb", run_mitsuba))
-            # Side by side, after two warm-up renders of each (Mitsuba's JIT).
-            seconds = measure_side_by_side([r[1] for r in runs], repeat, 2)
-            out += [Timing(case, impl, "float32", samples, t)
-                    for (impl, _), t in zip(runs, seconds)]
-    return out
-
-
-def suite_convergence(n: int, repeat: int, mi, target: float = 0.01, spp: int = 16,
-                      ref_spp: int = 512) -> list[Timing]:
-    """Time to reach relMSE ``target`` on the demo scene (Phong spheres of
-    exponent 1 to 1000 under the packaged sky, 240 x 90, direct lighting),
-    by each strategy and by Mitsuba's MIS.
-
-    relMSE falls as C / spp for an unbiased renderer, so C is measured at
-    ``spp`` against a ``ref_spp`` MIS reference (less the reference's own
-    share, measured between two independent references), and the time to
-    the target is (C / target) spp at the measured seconds per spp. The
-    "samples" column is the pixel samples that takes."""
-    from .demo import demo_scene
-
-    scene = mcs.Scene.from_mitsuba(demo_scene(240, 90))
-    h, w = scene.shape
-
-    def render(strategy: str, count: int, seed: int):
-        return mcs.render(scene, count, integrator="direct", strategy=strategy, seed=seed,
-                          progress=False)
-
-    ref_a, ref_b = render("mis", ref_spp, 1), render("mis", ref_spp, 2)
-    floor = mcs.stats.relmse(ref_a.image, ref_b.image) / 2
-    runs: dict[str, tuple[np.ndarray, float]] = {}
-    for strategy in ("bsdf", "emitter", "mis"):
-        seconds = measure(lambda strategy=strategy: render(strategy, spp, 3), repeat, 1)
-        runs[f"mcsample {strategy}"] = (render(strategy, spp, 4).image, seconds)
-    if mi is not None:
-        mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp))
-        mi_int = mi.load_dict({"type": "direct"})
-        seconds = measure(lambda: np.asarray(mi.render(mi_scene, integrator=mi_int, spp=spp)),
-                          repeat, 2)
-        image = np.asarray(mi.render(mi_scene, integrator=mi_int, spp=spp, seed=5))
-        runs["Mitsuba 3 llvm (MIS)"] = (image[..., :3], seconds)
-    out = []
-    for name, (image, seconds) in runs.items():
-        c = max(mcs.stats.relmse(image, ref_a.image) - floor, 1e-12) * spp
-        needed = c / target
-        out.append(Timing(f"time to relMSE {target:g}, demo", name, "float32",
-                          int(needed * w * h), needed * seconds / spp))
-    return out
-
-
 def suite_qmc(n: int, repeat: int, mi) -> list[Timing]:
     """QMC engines drawing 2^20 points whatever ``n`` (the size the issue's
     figures are for; values counted: points × d), beside scipy.stats.qmc's
@@ -565,38 +383,3 @@ def suite_qmc(n: int, repeat: int, mi) -> list[Timing]:
         seconds = measure_side_by_side([f for _, f in runs], repeat=repeat, warmup=1)
         out += [Timing(case, impl, "float64", points * d, t) for (impl, _), t in zip(runs, seconds)]
     return out
-
-
-SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
-    "rng": suite_rng,
-    "warps": suite_warps,
-    "distr": suite_distr,
-    "phong": suite_phong,
-    "envmap": suite_envmap,
-    "render": suite_render,
-    "convergence": suite_convergence,
-    "qmc": suite_qmc,
-}
-
-
-def main(n: int = 10_000_000, repeat: int = 7, only: list[str] | None = None) -> list[Timing]:
-    """Runs the suites (all, or those named in ``only``) and prints a table."""
-    mi = _mitsuba()
-    if mi is not None:
-        import drjit as dr
-
-        # The versions, since Mitsuba's speed changes from release to release.
-        other = f"Mitsuba {mi.__version__} (Dr.Jit {dr.__version__}) llvm_ad_rgb"
-    else:
-        other = "Mitsuba: not available (llvm variant)"
-    print(f"mcsample {mcs.__version__}, {mcs.get_num_threads()} threads, n = {n:,}; {other}")
-    timings: list[Timing] = []
-    for name, suite in SUITES.items():
-        if only and name not in only:
-            continue
-        timings.extend(suite(n, repeat, mi))
-    print(f"{'case':32s} {'implementation':22s} {'dtype':8s} {'median ms':>10s} {'M/s':>9s}")
-    for t in timings:
-        print(f"{t.case:32s} {t.implementation:22s} {t.dtype:8s} "
-              f"{t.seconds * 1e3:10.2f} {t.msamples_per_s:9.1f}")
-    return timings

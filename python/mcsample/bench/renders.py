@@ -1,0 +1,180 @@
+"""Render suites: samples per second, time to a given error, and the
+samplers (speed, and relMSE at equal spp beside Mitsuba's samplers)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+import mcsample as mcs
+
+from .timing import Timing, measure, measure_side_by_side
+
+
+def _render_scenes(size: int = 256) -> dict[str, dict]:
+    """The issue's two speed scenes: a diffuse sphere under the packaged sky,
+    and a sphere on a plane lit by the sky and a rectangular area light."""
+    sensor = {"type": "perspective", "fov": 35,
+              "to_world": mcs.look_at([0, 1.2, 4.5], [0, 0.6, 0], [0, 1, 0]),
+              "film": {"type": "hdrfilm", "width": size, "height": size,
+                       "rfilter": {"type": "box"}}}
+    ball = {"type": "sphere", "center": [0, 0.6, 0], "radius": 0.6,
+            "bsdf": {"type": "diffuse", "reflectance": [0.7, 0.6, 0.5]}}
+    floor = {"type": "rectangle", "bsdf": {"type": "diffuse", "reflectance": 0.5},
+             "to_world": np.array([[4.0, 0, 0, 0], [0, 0, 4.0, 0], [0, -4.0, 0, 0], [0, 0, 0, 1]])}
+    light = {"type": "rectangle", "emitter": {"type": "area", "radiance": [12.0, 11.0, 9.0]},
+             "to_world": np.array([[0.4, 0, 0, 1.0], [0, 0, 1, 2.0], [0, -0.4, 0, 0.8],
+                                   [0, 0, 0, 1]])}
+    sky = mcs.EnvMap()
+    return {
+        "sphere under sky": {"type": "scene", "sensor": sensor, "sky": sky, "ball": ball},
+        "sphere on plane": {"type": "scene", "sensor": sensor, "sky": sky, "ball": ball,
+                            "floor": floor, "light": light},
+    }
+
+
+def suite_render(n: int, repeat: int, mi, spp: int = 64) -> list[Timing]:
+    """Samples (camera paths) per second at 256 x 256, 64 spp, MIS, direct and
+    path; Mitsuba's time excludes its JIT compilation (warm-up renders)."""
+    out = []
+    repeat = min(repeat, 3)
+    for name, d in _render_scenes().items():
+        scene = mcs.Scene.from_mitsuba(d)
+        h, w = scene.shape
+        samples = w * h * spp
+        mi_scene = None
+        if mi is not None:
+            mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp))
+        for integrator in ("direct", "path"):
+            case = f"render {name}, {integrator}"
+            runs = [("mcsample", lambda: mcs.render(scene, spp, integrator=integrator,
+                                                    progress=False))]
+            if mi_scene is not None:
+                mi_int = mi.load_dict({"type": integrator})
+
+                def run_mitsuba():
+                    img = mi.render(mi_scene, integrator=mi_int, spp=spp)
+                    np.asarray(img)
+                runs.append(("mitsuba llvm_ad_rgb", run_mitsuba))
+            # Side by side, after two warm-up renders of each (Mitsuba's JIT).
+            seconds = measure_side_by_side([r[1] for r in runs], repeat, 2)
+            out += [Timing(case, impl, "float32", samples, t)
+                    for (impl, _), t in zip(runs, seconds)]
+    return out
+
+
+def suite_convergence(n: int, repeat: int, mi, target: float = 0.01, spp: int = 16,
+                      ref_spp: int = 512) -> list[Timing]:
+    """Time to reach relMSE ``target`` on the demo scene (Phong spheres of
+    exponent 1 to 1000 under the packaged sky, 240 x 90, direct lighting),
+    by each strategy and by Mitsuba's MIS.
+
+    relMSE falls as C / spp for an unbiased renderer, so C is measured at
+    ``spp`` against a ``ref_spp`` MIS reference (less the reference's own
+    share, measured between two independent references), and the time to
+    the target is (C / target) spp at the measured seconds per spp. The
+    "samples" column is the pixel samples that takes."""
+    from ..demo import demo_scene
+
+    scene = mcs.Scene.from_mitsuba(demo_scene(240, 90))
+    h, w = scene.shape
+
+    def render(strategy: str, count: int, seed: int):
+        return mcs.render(scene, count, integrator="direct", strategy=strategy, seed=seed,
+                          progress=False)
+
+    ref_a, ref_b = render("mis", ref_spp, 1), render("mis", ref_spp, 2)
+    floor = mcs.stats.relmse(ref_a.image, ref_b.image) / 2
+    runs: dict[str, tuple[np.ndarray, float]] = {}
+    for strategy in ("bsdf", "emitter", "mis"):
+        seconds = measure(lambda strategy=strategy: render(strategy, spp, 3), repeat, 1)
+        runs[f"mcsample {strategy}"] = (render(strategy, spp, 4).image, seconds)
+    if mi is not None:
+        mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp))
+        mi_int = mi.load_dict({"type": "direct"})
+        seconds = measure(lambda: np.asarray(mi.render(mi_scene, integrator=mi_int, spp=spp)),
+                          repeat, 2)
+        image = np.asarray(mi.render(mi_scene, integrator=mi_int, spp=spp, seed=5))
+        runs["Mitsuba 3 llvm (MIS)"] = (image[..., :3], seconds)
+    out = []
+    for name, (image, seconds) in runs.items():
+        c = max(mcs.stats.relmse(image, ref_a.image) - floor, 1e-12) * spp
+        needed = c / target
+        out.append(Timing(f"time to relMSE {target:g}, demo", name, "float32",
+                          int(needed * w * h), needed * seconds / spp))
+    return out
+
+
+SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "zsobol")
+#: Mitsuba's samplers beside mcsample's equivalents.
+MITSUBA_SAMPLERS = {"independent": "independent", "stratified": "stratified",
+                    "multijitter": "multijitter", "ldsampler": "zsobol"}
+
+
+def sampler_relmse(mi, spp_list=(16, 64), seeds: int = 4, ref_spp: int = 4096,
+                   size: tuple[int, int] = (60, 160)) -> list[tuple[int, str, float, float | None]]:
+    """relMSE of the demo scene (direct, MIS) at equal spp by each of
+    mcsample's samplers and Mitsuba's equivalent, each against a
+    ``ref_spp`` render of its own renderer (mean over ``seeds``). The sky
+    is sampled by Mitsuba's density (``EnvMap(sampling="mitsuba")``) on
+    both sides, so that the integrands are the same and only the samplers
+    differ. Rows: (spp, sampler, mcsample relMSE, Mitsuba's or None)."""
+    from ..demo import demo_scene
+
+    d = demo_scene(size[1], size[0])
+    d["sky"] = mcs.EnvMap(sampling="mitsuba")
+    scene = mcs.Scene.from_mitsuba(d)
+    ours_ref = mcs.render(scene, ref_spp, integrator="direct", seed=12345, progress=False).image
+    mi_ref = None
+    if mi is not None:
+        mi_ref = mcs.mitsuba.render_reference(scene, ref_spp, seed=12345,
+                                              integrator="direct").image
+    theirs = {v: k for k, v in MITSUBA_SAMPLERS.items()}
+    rows = []
+    for spp in spp_list:
+        for sampler in SAMPLERS:
+            ours = np.mean([mcs.stats.relmse(mcs.render(
+                scene, spp, integrator="direct", sampler=sampler, seed=k, progress=False).image,
+                ours_ref) for k in range(seeds)])
+            other = None
+            if mi_ref is not None and sampler in theirs:
+                other = float(np.mean([mcs.stats.relmse(mcs.mitsuba.render_reference(
+                    scene, spp, seed=k, integrator="direct", sampler=theirs[sampler]).image,
+                    mi_ref) for k in range(seeds)]))
+            rows.append((spp, sampler, float(ours), other))
+    return rows
+
+
+def suite_samplers(n: int, repeat: int, mi) -> list[Timing]:
+    """Render time per sample with each sampler (demo scene and a triangle
+    mesh under the sky, 256 x 96, 64 spp, direct and path), and a table of
+    the relMSE each reaches at equal spp beside Mitsuba's samplers
+    (:func:`sampler_relmse`)."""
+    from ..demo import demo_scene
+    from ..scene import icosphere
+
+    mesh = demo_scene(256, 96)
+    v, f = icosphere(3)
+    for key in [k for k in mesh if k.startswith("sphere_n")][:2]:
+        sphere = mesh.pop(key)
+        mesh[key.replace("sphere", "mesh")] = {
+            "type": "mesh", "vertices": v * 0.5 + sphere["center"], "faces": f,
+            "bsdf": sphere["bsdf"]}
+    out = []
+    for name, d in (("demo", demo_scene(256, 96)), ("demo with meshes", mesh)):
+        scene = mcs.Scene.from_mitsuba(d)
+        h, w = scene.shape
+        for integrator in ("direct", "path"):
+            runs = [lambda s=s: mcs.render(scene, 64, integrator=integrator, sampler=s,
+                                           progress=False) for s in SAMPLERS]
+            seconds = measure_side_by_side(runs, min(repeat, 3), 1)
+            out += [Timing(f"render {name}, {integrator}", f"mcsample {s}", "float32",
+                           w * h * 64, t) for s, t in zip(SAMPLERS, seconds)]
+    rows = sampler_relmse(mi)
+    print("relMSE at equal spp, demo scene (direct, MIS), mean of 4 seeds, each renderer "
+          "against its own 4096-spp render:")
+    print(f"{'spp':>5s} {'mcsample':12s} {'relMSE':>9s}   {'Mitsuba':12s} {'relMSE':>9s}")
+    theirs = {v: k for k, v in MITSUBA_SAMPLERS.items()}
+    for spp, sampler, ours, other in rows:
+        print(f"{spp:5d} {sampler:12s} {ours:9.5f}   {theirs.get(sampler, '-'):12s} "
+              + (f"{other:9.5f}" if other is not None else f"{'-':>9s}"))
+    return out
