@@ -84,7 +84,7 @@ def test_every_sampler_is_unbiased_and_the_stratified_ones_lower_the_error():
     seeds is within 4 standard errors (of the seeds' spread) of an
     independent render at 1024 spp; the mean squared error per pixel
     against that render is below 0.8x the independent sampler's (measured:
-    0.38-0.58x)."""
+    0.38-0.60x)."""
     scene = mcs.Scene.from_mitsuba(demo_scene(120, 45))
     ref = mcs.render(scene, 1024, seed=99, progress=False)
     ref_mean = float(ref.image.mean())

@@ -87,9 +87,12 @@ def render(scene: Scene, spp: int | None = None, *,
         ``orthogonal`` (as "multijitter") and ``ldsampler`` (as "zsobol")),
         else "independent", which keeps the bits of every earlier release.
         "stratified" and "multijitter" jitter the strata of a grid (Mitsuba's
-        samplers of those names); "sobol" is the Owen-scrambled Sobol'
-        sequence seeded per pixel; "zsobol" is pbrt-v4's z-ordered Sobol'
-        (blue-noise error across the screen; best with power-of-two spp).
+        samplers of those names); "sobol" is padded Owen-scrambled Sobol'
+        (pbrt-v4's PaddedSobolSampler: each request a (0, m, 2)-net of the
+        first two Sobol' dimensions, its index shuffled, scrambled per pixel
+        and dimension); "zsobol" is pbrt-v4's z-ordered Sobol' (the same
+        nets, ordered along a Morton curve over the screen: blue-noise
+        error; best with power-of-two spp).
         Every random decision has its own dimension, in this order: film
         position (2), lens (2), time (1, reserved), then per shading point
         BSDF lobe (1), BSDF direction (2), light choice (1), light position

@@ -15,10 +15,12 @@
 //!   grid or of Kensler's correlated multi-jittered pattern
 //!   ([`crate::qmc::Pattern`]), a pattern of its own (hashed from the
 //!   stream's key and the dimension) per request, as Mitsuba's samplers;
-//! - [`Sampler::Sobol`]: the Sobol' sequence (Joe–Kuo directions, natural
-//!   order) in dimensions `dim` and `dim + 1`, Owen-scrambled per pixel and
-//!   dimension (Burley 2020's hash), past [`SOBOL_DIMENSIONS`] hashed
-//!   independent numbers;
+//! - [`Sampler::Sobol`]: padded Owen-scrambled Sobol' (pbrt-v4's
+//!   `PaddedSobolSampler`): every request the first one or two Sobol'
+//!   dimensions (a (0, m, 2)-net for every power-of-two prefix, which
+//!   consecutive higher dimensions are not) at the sample's index shuffled
+//!   by a permutation of `0 .. count`, Owen-scrambled (Burley 2020's hash),
+//!   each with its own seeds per pixel and dimension;
 //! - [`Sampler::ZSobol`]: Ahmed and Wronski's (2020) z-ordered Sobol', as
 //!   pbrt-v4's `ZSobolSampler` ([`zorder`]): every request the first two
 //!   Sobol' dimensions at the pixel's Morton index, shuffled by base-4
@@ -31,31 +33,12 @@
 
 pub mod zorder;
 
-use std::sync::OnceLock;
-
 use crate::error::{Error, Result};
 use crate::math::Real;
-use crate::qmc::directions::{self, BITS};
 use crate::qmc::patterns::{jitter, mix64, multi_jitter, permute, stratified};
 use crate::qmc::sobol::owen_reversed;
 use crate::rng::Rng;
 use zorder::ZOrder;
-
-/// Dimensions of the Sobol' sequence [`Sampler::Sobol`] uses: a path of 145
-/// bounces (7 dimensions each past the camera's 5).
-pub const SOBOL_DIMENSIONS: u32 = 1024;
-
-/// The generator matrices of the first [`SOBOL_DIMENSIONS`] dimensions,
-/// their columns bit-reversed (for [`owen_reversed`]).
-fn sobol_columns() -> &'static [[u32; BITS]] {
-    static COLUMNS: OnceLock<Vec<[u32; BITS]>> = OnceLock::new();
-    COLUMNS.get_or_init(|| {
-        directions::columns(SOBOL_DIMENSIONS as usize)
-            .into_iter()
-            .map(|v| v.map(u32::reverse_bits))
-            .collect()
-    })
-}
 
 /// Which generator a [`Stream`] draws from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -67,7 +50,7 @@ pub enum Sampler {
     /// Correlated multi-jittered patterns per request (Mitsuba's
     /// `multijitter`).
     MultiJitter,
-    /// Owen-scrambled Sobol', seeded per pixel.
+    /// Padded Owen-scrambled Sobol', seeded per pixel.
     Sobol,
     /// Z-ordered, Owen-scrambled Sobol' (pbrt-v4's `ZSobolSampler`).
     ZSobol,
@@ -126,7 +109,8 @@ struct DimKey {
     /// The 64-bit seed of the dimension's scrambles or pattern.
     seed: u64,
     /// [`Sampler::ZSobol`]: the shuffled digits above the pixel's samples
-    /// ([`ZOrder::block`]).
+    /// ([`ZOrder::block`]); [`Sampler::Sobol`]: the seed of the index
+    /// permutation.
     block: u64,
 }
 
@@ -142,8 +126,6 @@ pub struct Stream {
     count: u32,
     index: u32,
     zorder: ZOrder,
-    /// [`Sampler::Sobol`]'s generator matrices (empty for the others).
-    columns: &'static [[u32; BITS]],
     /// The keys of dimensions below [`CACHED`], where bit `dim` of
     /// `cached` is set.
     keys: [DimKey; CACHED],
@@ -163,11 +145,6 @@ impl Stream {
             count: count.clamp(1, u64::from(u32::MAX)) as u32,
             index: 0,
             zorder,
-            columns: if sampler == Sampler::Sobol {
-                sobol_columns()
-            } else {
-                &[]
-            },
             keys: [DimKey::default(); CACHED],
             cached: 0,
         }
@@ -227,9 +204,10 @@ impl Stream {
                 block: self.zorder.block(seed),
             }
         } else {
+            let seed = mix64(self.key ^ dim);
             DimKey {
-                seed: mix64(self.key ^ dim),
-                block: 0,
+                seed,
+                block: mix64(seed),
             }
         }
     }
@@ -265,10 +243,8 @@ impl Stream {
                 let p = (self.key(dim).seed >> 32) as u32;
                 unit((f64::from(permute(s, n, p)) + jitter(s, p)) / f64::from(n))
             }
-            Sampler::Sobol => F::from_random_bits(self.sobol(dim)),
-            Sampler::ZSobol => {
-                let k = self.key(dim);
-                let i = k.block | self.zorder.within(s, k.seed);
+            Sampler::Sobol | Sampler::ZSobol => {
+                let (i, k) = self.sobol_index(dim);
                 F::from_random_bits(owen_reversed(zorder::sobol0_reversed(i), k.seed as u32))
             }
         }
@@ -289,13 +265,8 @@ impl Stream {
                 };
                 [unit(x), unit(y)]
             }
-            Sampler::Sobol => [
-                F::from_random_bits(self.sobol(dim)),
-                F::from_random_bits(self.sobol(dim + 1)),
-            ],
-            Sampler::ZSobol => {
-                let k = self.key(dim);
-                let i = k.block | self.zorder.within(s, k.seed);
+            Sampler::Sobol | Sampler::ZSobol => {
+                let (i, k) = self.sobol_index(dim);
                 let (x, y) = zorder::sobol01_reversed(i);
                 [
                     F::from_random_bits(owen_reversed(x, k.seed as u32)),
@@ -305,23 +276,18 @@ impl Stream {
         }
     }
 
-    /// Coordinate `dim` of the current sample of [`Sampler::Sobol`], as 32
-    /// bits: `owen(⊕_{b : bit b of i} v_dim,b, seed(pixel, dim))` (built
-    /// reversed).
+    /// The Sobol' index of the current sample for dimension `dim`, and
+    /// the dimension's key: shuffled by a permutation of `0 .. count`
+    /// ([`Sampler::Sobol`]) or z-ordered ([`Sampler::ZSobol`]).
     #[inline]
-    fn sobol(&mut self, dim: u32) -> u32 {
-        let seed = self.key(dim).seed;
-        let Some(columns) = self.columns.get(dim as usize) else {
-            // Past the table: a hashed independent number.
-            return (mix64(seed ^ u64::from(self.index)) >> 32) as u32;
+    fn sobol_index(&mut self, dim: u32) -> (u64, DimKey) {
+        let k = self.key(dim);
+        let i = if self.sampler == Sampler::ZSobol {
+            k.block | self.zorder.within(self.index, k.seed)
+        } else {
+            u64::from(permute(self.index, self.count, k.block as u32))
         };
-        let mut x = 0;
-        let mut bits = self.index;
-        while bits != 0 {
-            x ^= columns[bits.trailing_zeros() as usize];
-            bits &= bits - 1;
-        }
-        owen_reversed(x, (seed >> 32) as u32)
+        (i, k)
     }
 }
 
