@@ -31,14 +31,23 @@ from .stats import EnvMapDomain
 
 Sampler = Literal["independent", "stratified", "multijitter", "sobol", "zsobol"]
 
-_SAMPLERS_DOC = """sampler : "independent" (default), "stratified", "multijitter", "sobol" or "zsobol"
+#: The end of both estimators' docstrings.
+_COMMON_DOC = """heuristic : "power" (default) or "balance"
+    sampler : "independent" (default), "stratified", "multijitter", "sobol" or "zsobol"
         Where sample i's uniform numbers come from (dimensions 0, 1, ... in
         the order the strategy draws them; see :func:`mcsample.render`).
         Independent keeps the bits of every earlier release. Under the
         others the n evaluations are stratified together: the estimate
         converges faster, and ``.stderr`` (the error of independent
         sampling) overstates its error; at most 2**32 evaluations
-        ("stratified", "multijitter": 2**30)."""
+        ("stratified", "multijitter": 2**30).
+
+    Everything after ``n`` is keyword-only.
+
+    Returns
+    -------
+    Estimate
+        ``.value`` (3,) RGB, ``.stderr`` (3,), ``.n``, ``.strategy``."""
 
 
 def irradiance(env: EnvMap, normal: ArrayLike, n: int, *,
@@ -61,15 +70,7 @@ def irradiance(env: EnvMap, normal: ArrayLike, n: int, *,
         Seed of the samples (default 0); the result does not depend on the
         thread count. None draws a fresh seed from the operating system, a
         Generator draws one from itself.
-    heuristic : "power" (default) or "balance"
-    SAMPLER
-
-    Everything after ``n`` is keyword-only.
-
-    Returns
-    -------
-    Estimate
-        ``.value`` (3,) RGB, ``.stderr`` (3,), ``.n``, ``.strategy``.
+    COMMON
     """
     return _estimate(env, normal, n, strategy=strategy, seed=seed, heuristic=heuristic,
                      sampler=sampler)
@@ -93,14 +94,7 @@ def reflected_radiance(env: EnvMap, phong: Phong, normal: ArrayLike, wi: ArrayLi
         "emitter" samples the map ("envmap" is the same).
     seed : int, None or numpy.random.Generator
         As for :func:`irradiance` (default 0).
-    heuristic : "power" (default) or "balance"
-    SAMPLER
-
-    Everything after ``n`` is keyword-only.
-
-    Returns
-    -------
-    Estimate
+    COMMON
     """
     if not isinstance(phong, Phong):
         raise TypeError(f"phong must be an mcsample.Phong, got {type(phong).__name__}")
@@ -109,7 +103,7 @@ def reflected_radiance(env: EnvMap, phong: Phong, normal: ArrayLike, wi: ArrayLi
 
 
 for _f in (irradiance, reflected_radiance):
-    _f.__doc__ = (_f.__doc__ or "").replace("SAMPLER", _SAMPLERS_DOC)
+    _f.__doc__ = (_f.__doc__ or "").replace("COMMON", _COMMON_DOC)
 
 __all__ = [
     "Estimate",
