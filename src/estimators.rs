@@ -9,7 +9,7 @@
 //! the independent sampler: the PCG32 stream of `seed` advanced to
 //! `i · draws`), so the result is the same bits whatever the thread count.
 //! With a stratified or low-discrepancy sampler the `f_i` are no longer
-//! independent, and `s/√n` overstates the error (it is the error of
+//! independent, and `s/√n` usually overstates the error (it is the error of
 //! independent sampling): compare seeds to measure it.
 //!
 //! # Irradiance `E = ∫ L(ω) max(0, n·ω) dω`

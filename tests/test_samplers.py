@@ -27,7 +27,8 @@ PINNED = {("direct", "bsdf"): 6446.348149069585, ("direct", "emitter"): 9056.479
           ("direct", "mis"): 9130.542206714075, ("path", "bsdf"): 8494.993941167602,
           ("path", "emitter"): 12215.975318473764, ("path", "mis"): 10742.18765714392}
 #: irradiance and reflected_radiance under the packaged sky, seed 3, n =
-#: 10^4, power heuristic, by that release.
+#: 10^4, power heuristic, by that release (exact: the estimators are scalar
+#: float64 code, the same on every vector unit).
 PINNED_ESTIMATES = ([4.990705549641566, 5.459578096514679, 6.688927341608828],
                     [0.3794538833085688, 0.45701644881402514, 0.6663743859026758])
 
@@ -137,7 +138,7 @@ def _slope(ns, errors) -> float:
 def test_estimators_converge_faster_with_every_stratified_sampler():
     """Irradiance under the packaged sky (MIS), 16 seeds, n = 2^6 .. 2^16:
     the RMSE against an unbiased reference (the mean of 16 Sobol'
-    estimates at n = 2^20) falls as n^-0.48 independently and n^-0.78 to
+    estimates at n = 2^20, seeds other than the tested ones) falls as n^-0.48 independently and n^-0.78 to
     n^-0.84 with the stratified samplers (the integrand has edges: -0.75 is
     the theory for a 2D discontinuity); every sampler is unbiased at n =
     2^10 (mean over the seeds within 4 standard errors)."""
@@ -147,7 +148,8 @@ def test_estimators_converge_faster_with_every_stratified_sampler():
         return np.array([mcs.estimators.irradiance(env, normal, n, sampler=sampler, seed=k).value
                          for k in range(16)])
 
-    ref = estimates("sobol", 2**20).mean(axis=0)
+    ref = np.mean([mcs.estimators.irradiance(env, normal, 2**20, sampler="sobol", seed=1000 + k)
+                   .value for k in range(16)], axis=0)
     ns = 2 ** np.arange(6, 17, 2)
     slopes = {}
     for sampler in SAMPLERS:
@@ -217,15 +219,15 @@ def test_bad_sampler_arguments():
         mcs.render(scene, 1, sampler="halton", progress=False)
     with pytest.raises(ValueError, match="sampler"):
         mcs.estimators.irradiance(mcs.EnvMap(), [0, 0, 1], 10, sampler="ldsampler")
-    with pytest.raises(ValueError, match=r"n = 8589934592.*sampler=\"sobol\""):
-        mcs.estimators.irradiance(mcs.EnvMap(), [0, 0, 1], 2**33, sampler="sobol")
+    with pytest.raises(ValueError, match=r"n = 4294967296.*sampler=\"sobol\""):
+        mcs.estimators.irradiance(mcs.EnvMap(), [0, 0, 1], 2**32, sampler="sobol")
     with pytest.raises(ValueError, match=r"spp = 1073741825.*stratified"):
         mcs.render(scene, 2**30 + 1, sampler="stratified", progress=False)
 
 
 MITSUBA_TYPES = {"independent": "independent", "stratified": "stratified",
                  "multijitter": "multijitter", "orthogonal": "multijitter",
-                 "ldsampler": "zsobol"}
+                 "ldsampler": "sobol"}
 
 
 @pytest.mark.parametrize("kind", list(MITSUBA_TYPES))

@@ -9,7 +9,7 @@ is below 0.4 %, and the same render made 2 % brighter fails.
 Every comparison runs with each of mcsample's samplers (``SAMPLERS``)
 against one Mitsuba render with its independent sampler. Under a
 stratified sampler a pixel's variance estimate (that of independent
-samples) overstates its error, so the test stays valid and keeps the
+samples) usually overstates its error, so the test stays valid and keeps the
 power its relative standard error states."""
 
 from __future__ import annotations

@@ -39,8 +39,8 @@ _COMMON_DOC = """heuristic : "power" (default) or "balance"
         Independent keeps the bits of every earlier release. Under the
         others the n evaluations are stratified together: the estimate
         converges faster, and ``.stderr`` (the error of independent
-        sampling) overstates its error; at most 2**32 evaluations
-        ("stratified", "multijitter": 2**30).
+        sampling) usually overstates its error; at most 2**32 - 1
+        evaluations ("stratified", "multijitter": 2**30).
 
     Everything after ``n`` is keyword-only.
 

@@ -84,7 +84,7 @@ def render(scene: Scene, spp: int | None = None, *,
     sampler : "independent", "stratified", "multijitter", "sobol" or "zsobol", optional
         Where each pixel's uniform numbers come from. Default: the scene
         dict's sensor sampler (Mitsuba's ``stratified``, ``multijitter``,
-        ``orthogonal`` (as "multijitter") and ``ldsampler`` (as "zsobol")),
+        ``orthogonal`` (as "multijitter") and ``ldsampler`` (as "sobol")),
         else "independent", which keeps the bits of every earlier release.
         "stratified" and "multijitter" jitter the strata of a grid (Mitsuba's
         samplers of those names); "sobol" is padded Owen-scrambled Sobol'
@@ -98,7 +98,8 @@ def render(scene: Scene, spp: int | None = None, *,
         BSDF lobe (1), BSDF direction (2), light choice (1), light position
         (2), Russian roulette (1).
         Under these samplers a pixel's samples are not independent, and
-        ``variance`` (that of independent samples) overstates the error.
+        ``variance`` (that of independent samples) usually overstates the
+        error. The nets and blocks above are whole for power-of-two spp.
 
     Everything after ``spp`` is keyword-only.
 

@@ -34,7 +34,8 @@ use crate::sampler::{Sampler, Stream};
 pub mod dims {
     /// The position on the film within the pixel (2D).
     pub const FILM: u32 = 0;
-    /// The position on the lens (2D; drawn by pinhole cameras too).
+    /// The position on the lens (2D; for a pinhole camera only the
+    /// independent sampler draws it, to keep its order of draws).
     pub const LENS: u32 = 2;
     /// The time within the shutter interval (reserved: no motion yet).
     pub const TIME: u32 = 4;

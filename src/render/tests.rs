@@ -124,7 +124,7 @@ fn settings(integrator: Integrator, strategy: Strategy) -> Settings {
 
 /// Every strategy with every sampler. (Under a stratified sampler the
 /// samples are not independent and the standard error of independent
-/// samples overstates the error: the tests' bounds stay valid.)
+/// samples usually overstates the error: the tests' bounds stay valid.)
 fn strategies_and_samplers() -> impl Iterator<Item = (Strategy, Sampler)> {
     [Strategy::Emitter, Strategy::Bsdf, Strategy::Mis]
         .into_iter()

@@ -107,7 +107,7 @@ def suite_convergence(n: int, repeat: int, mi, target: float = 0.01, spp: int = 
 SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "zsobol")
 #: Mitsuba's samplers beside mcsample's equivalents.
 MITSUBA_SAMPLERS = {"independent": "independent", "stratified": "stratified",
-                    "multijitter": "multijitter", "ldsampler": "zsobol"}
+                    "multijitter": "multijitter", "ldsampler": "sobol"}
 
 
 def sampler_relmse(mi, spp_list=(16, 64), seeds: int = 4, ref_spp: int = 4096,

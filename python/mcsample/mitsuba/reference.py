@@ -33,7 +33,9 @@ def render_reference(scene: "Scene", spp: int, *, seed: SeedLike = 0,
     there (and reduced to Mitsuba's 32 bits). ``sampler`` is Mitsuba's
     sampler plugin ("independent", "stratified", "multijitter",
     "orthogonal", "ldsampler"; default: the scene dict's, else
-    "independent"). Everything after ``spp`` is keyword-only.
+    "independent"); the samples per pixel are the count Mitsuba's sampler
+    makes of ``spp`` (some round it up), reported as ``.spp``. Everything
+    after ``spp`` is keyword-only.
 
     Returns a :class:`mcsample.RenderResult` whose ``variance`` is None
     (Mitsuba reports moments in XYZ, from which per-RGB-channel variances
@@ -58,6 +60,9 @@ def render_reference(scene: "Scene", spp: int, *, seed: SeedLike = 0,
             d["sensor"]["sampler"]["type"] = sampler
         d["integrator"] = {"type": "moment", "nested": nested}
         mi_scene = mi.load_dict(d)
+        # Mitsuba rounds some samplers' counts up (stratified: to a square,
+        # orthogonal: to a prime squared, ldsampler: to a power of two).
+        spp = int(mi_scene.sensors()[0].sampler().sample_count())
         start = time.perf_counter()
         out = np.asarray(mi.render(mi_scene, spp=spp, seed=resolve_seed(seed) % 2**32),
                          dtype=np.float64)

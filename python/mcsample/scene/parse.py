@@ -147,13 +147,13 @@ class Camera:
 #: Mitsuba's samplers, the keys each takes, and the mcsample sampler that
 #: does the same (``orthogonal``'s orthogonal arrays stratify each 1D and 2D
 #: projection, as the multi-jittered pattern does; ``ldsampler``'s padded
-#: (0, 2)-sequences are what "zsobol" draws, in z-order).
+#: (0, 2)-sequences, shuffled per pixel, are what "sobol" draws).
 MITSUBA_SAMPLERS: dict[str, tuple[set[str], str]] = {
     "independent": ({"sample_count", "seed"}, "independent"),
     "stratified": ({"sample_count", "seed", "jitter"}, "stratified"),
     "multijitter": ({"sample_count", "seed", "jitter"}, "multijitter"),
     "orthogonal": ({"sample_count", "seed", "jitter", "strength"}, "multijitter"),
-    "ldsampler": ({"sample_count", "seed"}, "zsobol"),
+    "ldsampler": ({"sample_count", "seed"}, "sobol"),
 }
 
 
