@@ -146,7 +146,8 @@ def sampler_relmse(mi, spp_list=(16, 64), seeds: int = 4, ref_spp: int = 4096,
 
 def suite_samplers(n: int, repeat: int, mi) -> list[Timing]:
     """Render time per sample with each sampler (demo scene and a triangle
-    mesh under the sky, 256 x 96, 64 spp, direct and path), and a table of
+    mesh under the sky, 256 x 96, 64 spp, direct and path), beside Mitsuba
+    3 (llvm_ad_rgb) with each of its samplers in the same run, and a table of
     the relMSE each reaches at equal spp beside Mitsuba's samplers
     (:func:`sampler_relmse`)."""
     from ..demo import demo_scene
@@ -164,11 +165,21 @@ def suite_samplers(n: int, repeat: int, mi) -> list[Timing]:
         scene = mcs.Scene.from_mitsuba(d)
         h, w = scene.shape
         for integrator in ("direct", "path"):
-            runs = [lambda s=s: mcs.render(scene, 64, integrator=integrator, sampler=s,
-                                           progress=False) for s in SAMPLERS]
-            seconds = measure_side_by_side(runs, min(repeat, 3), 1)
-            out += [Timing(f"render {name}, {integrator}", f"mcsample {s}", "float32",
-                           w * h * 64, t) for s, t in zip(SAMPLERS, seconds)]
+            runs = [(f"mcsample {s}", lambda s=s: mcs.render(
+                scene, 64, integrator=integrator, sampler=s, progress=False)) for s in SAMPLERS]
+            if mi is not None:
+                # Mitsuba's samplers, the plain mi.render (its JIT warmed up
+                # by measure_side_by_side's warm-up run).
+                mi_int = mi.load_dict({"type": integrator})
+                for kind in MITSUBA_SAMPLERS:
+                    md = scene.to_mitsuba(spp=64)
+                    md["sensor"]["sampler"]["type"] = kind
+                    mi_scene = mi.load_dict(md)
+                    runs.append((f"Mitsuba {kind}", lambda m=mi_scene: np.asarray(
+                        mi.render(m, integrator=mi_int, spp=64))))
+            seconds = measure_side_by_side([f for _, f in runs], min(repeat, 3), 1)
+            out += [Timing(f"render {name}, {integrator}", impl, "float32", w * h * 64, t)
+                    for (impl, _), t in zip(runs, seconds)]
     rows = sampler_relmse(mi)
     print("relMSE at equal spp, demo scene (direct, MIS), mean of 4 seeds, each renderer "
           "against its own 4096-spp render:")
