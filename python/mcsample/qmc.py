@@ -65,13 +65,11 @@ def _count(n: object, arg: str) -> int:
 class _Engine(_scipy_qmc.QMCEngine):
     """The shared part: position, ``random``, ``fast_forward``, ``reset``."""
 
-    _points: _core.SobolPoints | _core.HaltonPoints | _core.PatternPoints
+    _points: _core.Points
     seed: int
     """The 64-bit seed the scramble was drawn from."""
 
-    def __init__(
-        self, points: _core.SobolPoints | _core.HaltonPoints | _core.PatternPoints, seed: int
-    ) -> None:
+    def __init__(self, points: _core.Points, seed: int) -> None:
         self._points = points
         self.seed = seed
         super().__init__(d=points.d)
@@ -144,16 +142,16 @@ class Sobol(_Engine):
     def __init__(
         self, d: int, *, scramble: bool | Literal["lms"] = True, seed: SeedLike = None
     ) -> None:
-        kind: Literal["owen", "none", "lms"]
+        kind: Literal["sobol-owen", "sobol", "sobol-lms"]
         if isinstance(scramble, (bool, np.bool_)):
-            kind = "owen" if scramble else "none"
+            kind = "sobol-owen" if scramble else "sobol"
         elif scramble == "lms":
-            kind = "lms"
+            kind = "sobol-lms"
         else:
             raise ValueError(f'scramble = {scramble!r}: must be True, "lms" or False')
         self._scramble = scramble
         value = resolve_seed(seed)
-        super().__init__(_core.SobolPoints(d, kind, value), value)
+        super().__init__(_core.Points(kind, d, value), value)
 
     def random_base2(self, m: int, *, dtype: DType = np.float64) -> np.ndarray:
         """The next ``2**m`` points, keeping the count drawn a power of two.
@@ -195,7 +193,7 @@ class Halton(_Engine):
             raise ValueError(f"scramble = {scramble!r}: must be True or False")
         self._scramble = bool(scramble)
         value = resolve_seed(seed)
-        super().__init__(_core.HaltonPoints(d, bool(scramble), value), value)
+        super().__init__(_core.Points("halton-permuted" if scramble else "halton", d, value), value)
 
 
 class LatinHypercube(_Engine):
@@ -219,49 +217,46 @@ class LatinHypercube(_Engine):
         self._scramble = bool(scramble)
         value = resolve_seed(seed)
         kind: Literal["lhs", "lhs-centered"] = "lhs" if scramble else "lhs-centered"
-        super().__init__(_core.PatternPoints(kind, d, value), value)
+        super().__init__(_core.Points(kind, d, value), value)
+
+
+_PATTERN_PARAMETERS = """
+    Parameters
+    ----------
+    d : int
+        Dimensions, 1 to 65536.
+    seed : int, None or numpy.random.Generator, keyword only
+        None (default) draws fresh random bits.
+    """
 
 
 class _Pattern(_Engine):
-    """An engine of patterns of one kind (``_kind``) and no options."""
+    """An engine of patterns of one kind (``_kind``) and no options; a
+    subclass's docstring is its summary followed by ``_PATTERN_PARAMETERS``."""
 
     _kind: Literal["stratified", "multijitter"]
 
     def __init__(self, d: int, *, seed: SeedLike = None) -> None:
         value = resolve_seed(seed)
-        super().__init__(_core.PatternPoints(self._kind, d, value), value)
+        super().__init__(_core.Points(self._kind, d, value), value)
 
 
 class Stratified(_Pattern):
-    """Jittered strata, as Mitsuba's ``stratified`` sampler: each
+    __doc__ = """Jittered strata, as Mitsuba's ``stratified`` sampler: each
     ``random(n)`` shuffles the strata of an r x r grid (r = ceil(sqrt(n)))
     per pair of dimensions and jitters each point in its stratum (a last odd
     dimension is stratified in n intervals). With n a square every stratum
     gets one point.
-
-    Parameters
-    ----------
-    d : int
-        Dimensions, 1 to 65536.
-    seed : int, None or numpy.random.Generator, keyword only
-        None (default) draws fresh random bits.
-    """
+    """ + _PATTERN_PARAMETERS
 
     _kind = "stratified"
 
 
 class MultiJitter(_Pattern):
-    """Kensler's correlated multi-jittered points (2013), as Mitsuba's
+    __doc__ = """Kensler's correlated multi-jittered points (2013), as Mitsuba's
     ``multijitter`` sampler: per pair of dimensions, each ``random(n)`` is
     stratified in an m x k grid (m = floor(sqrt(n)), k = ceil(n/m)) and in
     n intervals along y (and along x when n = m k).
-
-    Parameters
-    ----------
-    d : int
-        Dimensions, 1 to 65536.
-    seed : int, None or numpy.random.Generator, keyword only
-        None (default) draws fresh random bits.
-    """
+    """ + _PATTERN_PARAMETERS
 
     _kind = "multijitter"

@@ -18,41 +18,57 @@ use pyo3::prelude::*;
 /// Values one call may ask for (`n·d`), as `mcsample.uniform`.
 const MAX_VALUES: u64 = 1 << 40;
 
-/// A core point generator: rows of `dims` values filled from `start` (an
-/// index, or a pattern's number).
-trait Fill: Sync {
-    fn dims(&self) -> usize;
-    fn fill<F: Real>(&self, start: u64, out: &mut [F]) -> crate::Result<()>;
+/// A core point generator of any kind.
+enum Engine {
+    Sobol(Sobol),
+    Halton(Halton),
+    Patterns(Patterns),
 }
 
-macro_rules! fill_by_core {
-    ($($engine:ty),*) => {$(
-        impl Fill for $engine {
-            fn dims(&self) -> usize {
-                <$engine>::dims(self)
-            }
-            fn fill<F: Real>(&self, start: u64, out: &mut [F]) -> crate::Result<()> {
-                <$engine>::fill(self, start, out)
-            }
+impl Engine {
+    fn dims(&self) -> usize {
+        match self {
+            Engine::Sobol(e) => e.dims(),
+            Engine::Halton(e) => e.dims(),
+            Engine::Patterns(e) => e.dims(),
         }
-    )*};
+    }
+
+    /// Rows of `dims` values from `start`: the index of the first point
+    /// of a sequence, the number of a pattern.
+    fn fill<F: Real>(&self, start: u64, out: &mut [F]) -> crate::Result<()> {
+        match self {
+            Engine::Sobol(e) => e.fill(start, out),
+            Engine::Halton(e) => e.fill(start, out),
+            Engine::Patterns(e) => e.fill(start, out),
+        }
+    }
+
+    /// The indices `n` points from `start` take, `(first, end)`: they must
+    /// stay below `end`. A pattern's points are numbered from 0.
+    fn span(&self, start: u64) -> (u64, u64) {
+        match self {
+            Engine::Sobol(_) => (start, 1 << 32),
+            Engine::Halton(_) => (start, HALTON_MAX_INDEX),
+            Engine::Patterns(_) => (0, PATTERN_MAX_POINTS),
+        }
+    }
 }
-fill_by_core!(Sobol, Halton, Patterns);
 
 /// `n` points of `engine` from `start` (argument `n`, an int), as a fresh
 /// `(n, d)` array of the float type `dtype` asks for. Checked before
-/// anything is allocated: the points' indices `first .. first + n` stay
-/// below `end`, and `n·d` ≤ [`MAX_VALUES`].
+/// anything is allocated: the points' indices stay in the engine's
+/// [`Engine::span`], and `n·d` ≤ [`MAX_VALUES`].
 fn draw<'py>(
     py: Python<'py>,
-    engine: &impl Fill,
+    engine: &Engine,
     start: u64,
     n: &Obj<'py>,
     dtype: Option<&Obj<'py>>,
-    (first, end): (u64, u64),
 ) -> PyResult<Obj<'py>> {
     let n = index_arg(n, "n", 0, u64::MAX)?;
     let d = engine.dims();
+    let (first, end) = engine.span(start);
     let too_many = |requirement: String| -> PyResult<Obj<'py>> {
         Err(Error::Integer {
             arg: "n",
@@ -79,7 +95,7 @@ fn draw<'py>(
 /// A fresh array of `shape` filled by `engine` from `start`, GIL released.
 fn filled<'py, F: Element + Real>(
     py: Python<'py>,
-    engine: &impl Fill,
+    engine: &Engine,
     start: u64,
     shape: [usize; 2],
 ) -> PyResult<Obj<'py>> {
@@ -92,182 +108,103 @@ fn filled<'py, F: Element + Real>(
     Ok(out.into_any())
 }
 
-/// Sobol' points with Joe and Kuo's direction numbers (scipy's), in
-/// scipy's Gray-code order: the engine behind ``mcsample.qmc.Sobol``.
+/// Quasi-random points and stratified patterns, filled from any index: the
+/// engine behind ``mcsample.qmc``'s ``Sobol``, ``Halton``,
+/// ``LatinHypercube``, ``Stratified`` and ``MultiJitter``.
 ///
 /// Parameters
 /// ----------
+/// kind : str
+///     Sequences, drawn from any index: ``"sobol"`` (Joe and Kuo's direction
+///     numbers in scipy's Gray-code order, scipy's ``scramble=False``
+///     points bit for bit), ``"sobol-owen"`` (Owen's nested uniform
+///     scrambling, a hash per dimension), ``"sobol-lms"`` (a random linear
+///     matrix scramble with a digital shift, scipy's kind), ``"halton"``
+///     (the first ``d`` primes as bases; scipy's ``scramble=False`` points)
+///     and ``"halton-permuted"`` (a random permutation of the digits per
+///     digit position and dimension). Patterns of ``n`` points drawn whole:
+///     ``"lhs"`` / ``"lhs-centered"`` (a Latin hypercube, jittered in its
+///     intervals or at their centres), ``"stratified"`` (shuffled strata of a
+///     square grid per pair of dimensions, Mitsuba's ``stratified``) and
+///     ``"multijitter"`` (Kensler's correlated multi-jitter per pair,
+///     Mitsuba's ``multijitter``).
 /// d : int
-///     Dimensions, 1 to 21201.
-/// scramble : "none", "owen" or "lms"
-///     The plain sequence (scipy's ``scramble=False`` points, bit for bit),
-///     Owen's nested uniform scrambling (a hash per dimension), or a random
-///     linear matrix scramble with a digital shift (scipy's kind).
+///     Dimensions: 1 to 21201 for Sobol', 1 to 65536 for the rest (permuted
+///     Halton: while the digit permutations fit in 2**26 entries, d <= 2191).
 /// seed : int, None or numpy.random.Generator
-///     The scramble's random bits (default 0).
-#[pyclass(module = "mcsample._core.qmc", name = "SobolPoints", frozen)]
-pub struct PySobolPoints(Sobol);
+///     The scramble's or pattern's random bits (default 0).
+#[pyclass(module = "mcsample._core.qmc", name = "Points", frozen)]
+pub struct PyPoints(Engine);
 
 #[pymethods]
-impl PySobolPoints {
-    #[new]
-    #[pyo3(signature = (d, scramble = "owen", seed = 0))]
-    fn new(d: &Obj<'_>, scramble: &str, #[pyo3(from_py_with = seed)] seed: u64) -> PyResult<Self> {
-        let d = index_arg(d, "d", 1, crate::qmc::SOBOL_MAX_DIMENSIONS as u64)? as usize;
-        let scramble = choice(
-            "scramble",
-            scramble,
-            &[
-                ("none", Scramble::None),
-                ("owen", Scramble::Owen),
-                ("lms", Scramble::LinearMatrix),
-            ],
-        )?;
-        Ok(Self(Sobol::new(d, scramble, seed)?))
-    }
-
-    /// Points ``first .. first + n - 1`` (indices below 2**32).
-    ///
-    /// Parameters
-    /// ----------
-    /// first, n : int >= 0
-    /// dtype : float64 (default) or float32
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (n, d), in [0, 1): float64 multiples of 2**-32
-    /// (float32: of 2**-23).
-    #[pyo3(signature = (first, n, dtype = None))]
-    fn points<'py>(
-        &self,
-        py: Python<'py>,
-        first: &Obj<'py>,
-        n: &Obj<'py>,
-        dtype: Option<&Obj<'py>>,
-    ) -> PyResult<Obj<'py>> {
-        let first = index_arg(first, "first", 0, u64::MAX)?;
-        draw(py, &self.0, first, n, dtype, (first, 1 << 32))
-    }
-
-    /// The number of dimensions.
-    #[getter]
-    fn d(&self) -> usize {
-        self.0.dims()
-    }
-}
-
-/// Halton points (the first ``d`` primes as bases), plain or with random
-/// digit permutations: the engine behind ``mcsample.qmc.Halton``.
-///
-/// Parameters
-/// ----------
-/// d : int
-///     Dimensions, 1 to 65536 (scrambled: while the digit permutations fit
-///     in 2**26 entries: d <= 2191).
-/// scramble : bool
-///     False: scipy's ``scramble=False`` points, bit for bit; True: a random
-///     permutation of the digits per digit position and dimension.
-/// seed : int, None or numpy.random.Generator
-///     The permutations' random bits (default 0).
-#[pyclass(module = "mcsample._core.qmc", name = "HaltonPoints", frozen)]
-pub struct PyHaltonPoints(Halton);
-
-#[pymethods]
-impl PyHaltonPoints {
-    #[new]
-    #[pyo3(signature = (d, scramble = true, seed = 0))]
-    fn new(d: &Obj<'_>, scramble: bool, #[pyo3(from_py_with = seed)] seed: u64) -> PyResult<Self> {
-        let d = index_arg(d, "d", 1, crate::qmc::HALTON_MAX_DIMENSIONS as u64)? as usize;
-        Ok(Self(Halton::new(d, scramble, seed)?))
-    }
-
-    /// Points ``first .. first + n - 1`` (indices below 2**53).
-    ///
-    /// Parameters
-    /// ----------
-    /// first, n : int >= 0
-    /// dtype : float64 (default) or float32
-    ///
-    /// Returns
-    /// -------
-    /// ndarray, shape (n, d), in [0, 1).
-    #[pyo3(signature = (first, n, dtype = None))]
-    fn points<'py>(
-        &self,
-        py: Python<'py>,
-        first: &Obj<'py>,
-        n: &Obj<'py>,
-        dtype: Option<&Obj<'py>>,
-    ) -> PyResult<Obj<'py>> {
-        let first = index_arg(first, "first", 0, u64::MAX)?;
-        draw(py, &self.0, first, n, dtype, (first, HALTON_MAX_INDEX))
-    }
-
-    /// The number of dimensions.
-    #[getter]
-    fn d(&self) -> usize {
-        self.0.dims()
-    }
-}
-
-/// Stratified patterns of ``n`` points drawn whole: the engine behind
-/// ``mcsample.qmc.LatinHypercube``, ``Stratified`` and ``MultiJitter``.
-///
-/// Parameters
-/// ----------
-/// kind : "lhs", "lhs-centered", "stratified" or "multijitter"
-///     A Latin hypercube (jittered in its intervals, or at their centres);
-///     shuffled strata of a square grid per pair of dimensions (Mitsuba's
-///     ``stratified``); Kensler's correlated multi-jitter per pair
-///     (Mitsuba's ``multijitter``).
-/// d : int
-///     Dimensions, 1 to 65536.
-/// seed : int, None or numpy.random.Generator
-///     The patterns' random bits (default 0).
-#[pyclass(module = "mcsample._core.qmc", name = "PatternPoints", frozen)]
-pub struct PyPatternPoints(Patterns);
-
-#[pymethods]
-impl PyPatternPoints {
+impl PyPoints {
     #[new]
     #[pyo3(signature = (kind, d, seed = 0))]
     fn new(kind: &str, d: &Obj<'_>, #[pyo3(from_py_with = seed)] seed: u64) -> PyResult<Self> {
+        #[derive(Clone, Copy, PartialEq)]
+        enum Kind {
+            Sobol(Scramble),
+            Halton(bool),
+            Pattern(Pattern),
+        }
         let kind = choice(
             "kind",
             kind,
             &[
-                ("lhs", Pattern::LatinHypercube { centered: false }),
-                ("lhs-centered", Pattern::LatinHypercube { centered: true }),
-                ("stratified", Pattern::Stratified),
-                ("multijitter", Pattern::MultiJitter),
+                ("sobol", Kind::Sobol(Scramble::None)),
+                ("sobol-owen", Kind::Sobol(Scramble::Owen)),
+                ("sobol-lms", Kind::Sobol(Scramble::LinearMatrix)),
+                ("halton", Kind::Halton(false)),
+                ("halton-permuted", Kind::Halton(true)),
+                (
+                    "lhs",
+                    Kind::Pattern(Pattern::LatinHypercube { centered: false }),
+                ),
+                (
+                    "lhs-centered",
+                    Kind::Pattern(Pattern::LatinHypercube { centered: true }),
+                ),
+                ("stratified", Kind::Pattern(Pattern::Stratified)),
+                ("multijitter", Kind::Pattern(Pattern::MultiJitter)),
             ],
         )?;
-        let d = index_arg(d, "d", 1, crate::qmc::PATTERN_MAX_DIMENSIONS as u64)? as usize;
-        Ok(Self(Patterns::new(kind, d, seed)?))
+        let max_dims = match kind {
+            Kind::Sobol(_) => crate::qmc::SOBOL_MAX_DIMENSIONS,
+            Kind::Halton(_) => crate::qmc::HALTON_MAX_DIMENSIONS,
+            Kind::Pattern(_) => crate::qmc::PATTERN_MAX_DIMENSIONS,
+        };
+        let d = index_arg(d, "d", 1, max_dims as u64)? as usize;
+        Ok(Self(match kind {
+            Kind::Sobol(scramble) => Engine::Sobol(Sobol::new(d, scramble, seed)?),
+            Kind::Halton(scramble) => Engine::Halton(Halton::new(d, scramble, seed)?),
+            Kind::Pattern(pattern) => Engine::Patterns(Patterns::new(pattern, d, seed)?),
+        }))
     }
 
-    /// The pattern numbered ``number`` (the points drawn before it), of ``n``
-    /// points (at most 2**30).
+    /// ``n`` points from ``start``: of a sequence, the points
+    /// ``start .. start + n - 1`` (indices below 2**32 for Sobol', 2**53 for
+    /// Halton); of patterns, the pattern numbered ``start`` (the points
+    /// drawn before it), of ``n`` points (at most 2**30).
     ///
     /// Parameters
     /// ----------
-    /// number, n : int >= 0
+    /// start, n : int >= 0
     /// dtype : float64 (default) or float32
     ///
     /// Returns
     /// -------
-    /// ndarray, shape (n, d), in [0, 1).
-    #[pyo3(signature = (number, n, dtype = None))]
+    /// ndarray, shape (n, d), in [0, 1) (Sobol': float64 multiples of 2**-32,
+    /// float32 of 2**-23).
+    #[pyo3(signature = (start, n, dtype = None))]
     fn points<'py>(
         &self,
         py: Python<'py>,
-        number: &Obj<'py>,
+        start: &Obj<'py>,
         n: &Obj<'py>,
         dtype: Option<&Obj<'py>>,
     ) -> PyResult<Obj<'py>> {
-        let number = index_arg(number, "number", 0, u64::MAX)?;
-        // A pattern's points are numbered from 0.
-        draw(py, &self.0, number, n, dtype, (0, PATTERN_MAX_POINTS))
+        let start = index_arg(start, "start", 0, u64::MAX)?;
+        draw(py, &self.0, start, n, dtype)
     }
 
     /// The number of dimensions.
@@ -279,8 +216,6 @@ impl PyPatternPoints {
 
 /// Registers the point generators in module `m`.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_class::<PySobolPoints>()?;
-    m.add_class::<PyHaltonPoints>()?;
-    m.add_class::<PyPatternPoints>()?;
+    m.add_class::<PyPoints>()?;
     Ok(())
 }
