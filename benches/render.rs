@@ -79,7 +79,7 @@ fn scene(with_plane: bool) -> Scene {
     }
     Scene::new(
         shapes,
-        Some(Environment::Map(Box::new(env))),
+        Some(Environment::Map(std::sync::Arc::new(env))),
         camera,
         SIZE,
         SIZE,

@@ -13,6 +13,8 @@
 //! keeps its arrays, up to `RECYCLE_MAX_BYTES` in all. A buffer that its
 //! maker overwrites whole ([`Buffer::for_overwrite`]) reuses one as it is.
 
+use crate::alloc;
+use crate::error::Result;
 use bytemuck::Pod;
 use memmap2::MmapMut;
 use std::ops::{Deref, DerefMut};
@@ -67,47 +69,56 @@ pub struct Buffer<T: Pod> {
 }
 
 impl<T: Pod> Buffer<T> {
-    /// `len` zeros.
-    pub fn zeroed(len: usize) -> Self {
-        let (storage, recycled) = allocate::<T>(len);
+    /// `len` zeros, for `what` (named if the memory cannot be had).
+    ///
+    /// # Errors
+    /// [`Error::Memory`](crate::error::Error::Memory).
+    pub fn zeroed(len: usize, what: &'static str) -> Result<Self> {
+        let (storage, recycled) = allocate::<T>(len, what)?;
         let mut buffer = Buffer { storage, len };
         if recycled {
             buffer.fill(T::zeroed());
         }
-        buffer
+        Ok(buffer)
     }
 
     /// `len` values that the caller overwrites before reading them: a
     /// recycled map keeps what its last buffer held (any bit pattern is a
     /// valid `T`), which saves zeroing it.
-    pub fn for_overwrite(len: usize) -> Self {
-        Buffer {
-            storage: allocate::<T>(len).0,
+    ///
+    /// # Errors
+    /// [`Error::Memory`](crate::error::Error::Memory).
+    pub fn for_overwrite(len: usize, what: &'static str) -> Result<Self> {
+        Ok(Buffer {
+            storage: allocate::<T>(len, what)?.0,
             len,
-        }
+        })
     }
 
     /// A copy of `values`.
-    pub fn from_slice(values: &[T]) -> Self {
-        let mut buffer = Self::for_overwrite(values.len());
+    ///
+    /// # Errors
+    /// [`Error::Memory`](crate::error::Error::Memory).
+    pub fn from_slice(values: &[T], what: &'static str) -> Result<Self> {
+        let mut buffer = Self::for_overwrite(values.len(), what)?;
         buffer.copy_from_slice(values);
-        buffer
+        Ok(buffer)
     }
 }
 
 /// Storage for `len` values of `T`, and whether it is a recycled map (which
 /// holds old values; fresh storage holds zeros).
-fn allocate<T: Pod>(len: usize) -> (Storage<T>, bool) {
+fn allocate<T: Pod>(len: usize, what: &'static str) -> Result<(Storage<T>, bool)> {
     let bytes = len.saturating_mul(size_of::<T>());
     if bytes >= MAP_MIN_BYTES {
         if let Some(map) = take_recycled(bytes) {
-            return (Storage::Mapped(map), true);
+            return Ok((Storage::Mapped(map), true));
         }
         if let Some(map) = fresh_map(bytes) {
-            return (Storage::Mapped(map), false);
+            return Ok((Storage::Mapped(map), false));
         }
     }
-    (Storage::Heap(vec![T::zeroed(); len]), false)
+    Ok((Storage::Heap(alloc::filled(len, T::zeroed(), what)?), false))
 }
 
 impl<T: Pod> Drop for Buffer<T> {
@@ -139,9 +150,16 @@ impl<T: Pod> DerefMut for Buffer<T> {
     }
 }
 
+/// Infallible, as `Vec`'s clone: mcsample's own code does not clone buffers
+/// whose size follows the input.
 impl<T: Pod> Clone for Buffer<T> {
     fn clone(&self) -> Self {
-        Self::from_slice(self)
+        let mut buffer = Buffer {
+            storage: Storage::Heap(vec![T::zeroed(); self.len]),
+            len: self.len,
+        };
+        buffer.copy_from_slice(self);
+        buffer
     }
 }
 
@@ -159,7 +177,7 @@ mod tests {
     #[test]
     fn small_and_large_buffers_hold_their_values() {
         for len in [0, 3, 1 << 18] {
-            let mut b = Buffer::<f64>::zeroed(len);
+            let mut b = Buffer::<f64>::zeroed(len, "b").unwrap();
             assert_eq!(b.len(), len);
             assert!(b.iter().all(|&x| x == 0.0));
             for (i, x) in b.iter_mut().enumerate() {
@@ -169,9 +187,20 @@ mod tests {
             assert!(c.iter().enumerate().all(|(i, &x)| x == i as f64));
         }
         // A recycled map comes back as zeros.
-        drop(Buffer::<f64>::from_slice(&[7.0; 1 << 18]));
-        assert!(Buffer::<f64>::zeroed(1 << 18).iter().all(|&x| x == 0.0));
-        let u = Buffer::from_slice(&[1u32, 2, 3]);
+        drop(Buffer::<f64>::from_slice(&[7.0; 1 << 18], "b").unwrap());
+        assert!(
+            Buffer::<f64>::zeroed(1 << 18, "b")
+                .unwrap()
+                .iter()
+                .all(|&x| x == 0.0)
+        );
+        let u = Buffer::from_slice(&[1u32, 2, 3], "u").unwrap();
         assert_eq!(&u[..], &[1, 2, 3]);
+    }
+
+    #[test]
+    fn a_buffer_beyond_memory_is_an_error() {
+        let e = Buffer::<f64>::zeroed(usize::MAX / 16, "the table").unwrap_err();
+        assert!(e.to_string().contains("the table"), "{e}");
     }
 }

@@ -141,6 +141,17 @@ pub enum Error {
         /// The system's reason.
         message: String,
     },
+    /// Memory that cannot be had (Python's `MemoryError`).
+    #[error(
+        "not enough memory for {what}: {bytes} bytes ({gib:.2} GiB) were asked for",
+        gib = *.bytes as f64 / (1u64 << 30) as f64
+    )]
+    Memory {
+        /// What the memory was for, e.g. `the film`.
+        what: &'static str,
+        /// How many bytes were asked for.
+        bytes: u128,
+    },
     /// A file that cannot be read or written, or whose content is invalid.
     #[error("{path}: {message}")]
     Io {

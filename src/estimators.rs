@@ -23,6 +23,7 @@
 //! With the Phong BRDF in the frame of `n`: bsdf (its own sampling), emitter
 //! (the map's), and mis of the two.
 
+use crate::alloc;
 use crate::envmap::EnvMap;
 use crate::error::{Error, Result};
 use crate::frame::Frame;
@@ -141,7 +142,7 @@ impl Plan {
     ///
     /// # Errors
     /// [`Error::Integer`] for `n = 0`, or `n` above the sampler's
-    /// [`Sampler::max_count`].
+    /// [`Sampler::max_count`]; [`Error::Memory`].
     fn estimate(self, draws: u64, f: impl Fn(&mut Stream) -> V3<f64> + Sync) -> Result<Estimate> {
         let Plan { n, seed, .. } = self;
         self.sampler.check_count("n", n as u64)?;
@@ -159,7 +160,12 @@ impl Plan {
             n as u64,
             ZOrder::new((0, 0), (1, 1), n as u64, seed),
         );
-        let parts = Mutex::new(Vec::new());
+        // One partial sum per chunk, reserved up front (2^26 of them for the
+        // largest n): too many for memory is an error before any work.
+        let parts = Mutex::new(alloc::with_capacity(
+            n.div_ceil(parallel::CHUNK),
+            "the partial sums",
+        )?);
         parallel::for_each_chunk(n, (), |range, ()| {
             // One partial sum per block of CHUNK items, whatever the range a
             // thread is handed: the same sums in the same order on any pool.

@@ -5,8 +5,30 @@
 //! Pixels are linear RGB(A) `f32`, row-major `(height, width, channels)`,
 //! row 0 at the top. Every failure is an [`Error::Io`] naming the path.
 
+use crate::alloc;
 use crate::error::{Error, Result};
 use std::path::Path;
+
+/// Pixels an image read from a file may have: `2^28` (1 GiB a channel of
+/// float32), checked on the file's header before anything is decoded.
+pub const MAX_PIXELS: usize = 1 << 28;
+
+/// Checks a file's image size, read from its header, before decoding:
+/// at most [`MAX_PIXELS`] pixels, and memory for `channels` floats a
+/// pixel there to be had.
+fn check_size(path: &Path, width: usize, height: usize, channels: usize) -> Result<()> {
+    let pixels = width.saturating_mul(height);
+    if pixels > MAX_PIXELS {
+        return Err(Error::Argument {
+            arg: "path",
+            message: format!(
+                "{}: the image is {width} x {height} = {pixels} pixels; at most 2**28 = {MAX_PIXELS} are supported",
+                path.display()
+            ),
+        });
+    }
+    alloc::probe::<f32>(pixels * channels, "the image")
+}
 
 /// A linear image: `height × width × channels` floats, row 0 at the top.
 #[derive(Clone, Debug, PartialEq)]
@@ -56,9 +78,20 @@ impl Raster {
 ///
 /// # Errors
 /// [`Error::Io`] if the file cannot be opened, is not OpenEXR, is truncated,
-/// or has no R, G and B channels.
+/// or has no R, G and B channels; [`Error::Argument`] for an image of more
+/// than [`MAX_PIXELS`]; [`Error::Memory`].
 pub fn read_exr(path: &Path) -> Result<Raster> {
     use exr::prelude::*;
+    let cannot = |e: exr::error::Error| io_error(path, format!("cannot read OpenEXR: {e}"));
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(cannot)?;
+    for header in &meta.headers {
+        check_size(
+            path,
+            header.layer_size.width(),
+            header.layer_size.height(),
+            4,
+        )?;
+    }
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -86,7 +119,7 @@ pub fn read_exr(path: &Path) -> Result<Raster> {
         .first_valid_layer()
         .all_attributes()
         .from_file(path)
-        .map_err(|e| io_error(path, format!("cannot read OpenEXR: {e}")))?;
+        .map_err(cannot)?;
     Ok(image.layer_data.channel_data.pixels)
 }
 
@@ -122,14 +155,22 @@ pub fn write_exr(path: &Path, image: &Raster, half: bool) -> Result<()> {
 ///
 /// # Errors
 /// [`Error::Io`] if the file cannot be opened, is not Radiance HDR or is
-/// truncated.
+/// truncated; [`Error::Argument`] for an image of more than
+/// [`MAX_PIXELS`]; [`Error::Memory`].
 pub fn read_hdr(path: &Path) -> Result<Raster> {
-    let reader = image::ImageReader::open(path).map_err(|e| io_error(path, e))?;
-    let mut reader = reader;
-    reader.set_format(image::ImageFormat::Hdr);
-    let decoded = reader
-        .decode()
-        .map_err(|e| io_error(path, format!("cannot read Radiance HDR: {e}")))?;
+    let cannot = |e: image::ImageError| io_error(path, format!("cannot read Radiance HDR: {e}"));
+    let reader = || -> Result<_> {
+        let mut reader = image::ImageReader::open(path).map_err(|e| io_error(path, e))?;
+        reader.set_format(image::ImageFormat::Hdr);
+        Ok(reader)
+    };
+    let (width, height) = reader()?.into_dimensions().map_err(cannot)?;
+    check_size(path, width as usize, height as usize, 3)?;
+    let mut reader = reader()?;
+    // The size is checked above; the decoder's own cap (512 MiB) would
+    // refuse maps of more than about 9.4 K x 4.7 K texels.
+    reader.no_limits();
+    let decoded = reader.decode().map_err(cannot)?;
     let rgb = decoded.into_rgb32f();
     Ok(Raster {
         width: rgb.width() as usize,
@@ -186,18 +227,14 @@ pub fn encode_png(name: &Path, image: &Raster, exposure: f32, srgb: bool) -> Res
             requirement: "a PNG cannot show NaN".into(),
         });
     }
-    let bytes: Vec<u8> = image
-        .data
-        .iter()
-        .enumerate()
-        .map(|(i, &v)| {
-            if image.channels == 4 && i % 4 == 3 {
-                tonemap(v, 0.0, false)
-            } else {
-                tonemap(v, exposure, srgb)
-            }
-        })
-        .collect();
+    let tonemapped = image.data.iter().enumerate().map(|(i, &v)| {
+        if image.channels == 4 && i % 4 == 3 {
+            tonemap(v, 0.0, false)
+        } else {
+            tonemap(v, exposure, srgb)
+        }
+    });
+    let bytes = alloc::collect(tonemapped, "the PNG's bytes")?;
     let color = if image.channels == 4 {
         image::ExtendedColorType::Rgba8
     } else {

@@ -8,6 +8,8 @@
 //! - [`rng`]: PCG32 with jump-ahead, uniform batches.
 //! - [`parallel`]: the batch engine (chunks on a rayon pool, thread count).
 //! - [`warp`]: `square_to_*` warps, their densities and inverses.
+//! - [`alloc`]: fallible allocation (a request too big for memory is an
+//!   error, never an abort).
 //! - [`buffer`]: large flat arrays on huge pages.
 //! - [`distr`]: discrete tables (CDF inversion, alias), 2D tables and
 //!   piecewise-constant densities.
@@ -37,6 +39,7 @@
 #![deny(missing_docs)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
+pub mod alloc;
 pub mod buffer;
 pub mod distr;
 pub mod envmap;

@@ -108,9 +108,11 @@ impl Rng {
 /// of `Rng::new(seed, 0)`.
 ///
 /// # Errors
-/// Only if the thread count cannot be determined.
+/// [`crate::Error::Memory`] when the memory cannot be had; if the thread
+/// count cannot be determined.
 pub fn uniform<F: Real>(n: usize, dim: usize, seed: u64) -> Result<Vec<F>> {
-    let mut out = vec![F::zero(); n * dim];
+    let len = n.saturating_mul(dim);
+    let mut out = crate::alloc::filled(len, F::zero(), "the uniform values")?;
     Rng::new(seed, 0).fill(&mut out)?;
     Ok(out)
 }

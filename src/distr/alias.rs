@@ -5,7 +5,7 @@ use super::{GROUP, Weights, all_weights, check_len, find_invalid};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
-use crate::{parallel, simd};
+use crate::{alloc, parallel, simd};
 use rayon::prelude::*;
 use std::hint::select_unpredictable;
 
@@ -392,7 +392,7 @@ impl AliasTable {
         // (dividing by the sum only when asked keeps divisions out of the
         // build); the weights are checked on the way. The copy is streamed
         // past the caches, so that it leaves them to the sweeps.
-        let mut copy = Buffer::<f64>::for_overwrite(weights.len());
+        let mut copy = Buffer::<f64>::for_overwrite(weights.len(), "the table's weights")?;
         let (block_totals, valid): (Vec<f64>, Vec<bool>) = copy
             .par_chunks_mut(BLOCK)
             .zip(weights.par_chunks(BLOCK))
@@ -411,7 +411,7 @@ impl AliasTable {
         let to_share = weights.len() as f64 / sum;
 
         // Each block swept on its own, then the leftovers of all blocks.
-        let mut cells = Buffer::<[u32; 2]>::for_overwrite(weights.len());
+        let mut cells = Buffer::<[u32; 2]>::for_overwrite(weights.len(), "the alias cells")?;
         let leftovers: Vec<Vec<(u32, f64)>> = cells
             .par_chunks_mut(BLOCK)
             .zip(weights.par_chunks(BLOCK))
@@ -422,7 +422,10 @@ impl AliasTable {
                 leftovers
             })
             .collect();
-        let leftovers: Vec<(u32, f64)> = leftovers.into_iter().flatten().collect();
+        let mut flat =
+            alloc::with_capacity(leftovers.iter().map(Vec::len).sum(), "the alias leftovers")?;
+        leftovers.into_iter().for_each(|block| flat.extend(block));
+        let leftovers: Vec<(u32, f64)> = flat;
         let mut sweep = Sweep::default();
         sweep.classify(leftovers.len(), |t| leftovers[t].1);
         if sweep.n_heavy == 0 {

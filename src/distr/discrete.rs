@@ -54,7 +54,7 @@ impl Discrete1D {
     /// [`Error::TooLarge`] above [`super::MAX_ENTRIES`] entries.
     pub fn new(weights: &[f64]) -> Result<Self> {
         check_len("weights", weights.len())?;
-        let (table, valid) = parallel::install(|| Self::build(weights))?;
+        let (table, valid) = parallel::install(|| Self::build(weights))??;
         if !valid {
             find_invalid("weights", weights, |i| format!("[{i}]"))?;
         }
@@ -63,8 +63,11 @@ impl Discrete1D {
 
     /// A distribution from weights already checked to be finite and
     /// `>= 0`; `None` when they are empty or sum to 0.
-    pub(crate) fn from_checked(weights: &[f64]) -> Option<Self> {
-        Self::build(weights).0
+    ///
+    /// # Errors
+    /// [`Error::Memory`] when the table's memory cannot be had.
+    pub(crate) fn from_checked(weights: &[f64]) -> Result<Option<Self>> {
+        Ok(Self::build(weights)?.0)
     }
 
     /// The distribution of `weights` (`None` when they are empty or do not
@@ -72,11 +75,11 @@ impl Discrete1D {
     /// and `>= 0` (checked on the way; a table from invalid weights is
     /// meaningless). Tables longer than [`SUM_BLOCK`] are summed in
     /// parallel (on the current rayon pool).
-    fn build(weights: &[f64]) -> (Option<Self>, bool) {
+    fn build(weights: &[f64]) -> Result<(Option<Self>, bool)> {
         // The copy of the weights and each block's running sums from 0, in
         // parallel; then to each block the sum of the blocks before it.
-        let mut copy = Buffer::for_overwrite(weights.len());
-        let mut cdf = Buffer::for_overwrite(weights.len());
+        let mut copy = Buffer::for_overwrite(weights.len(), "the table's weights")?;
+        let mut cdf = Buffer::for_overwrite(weights.len(), "the table's running sums")?;
         let (totals, valid): (Vec<f64>, Vec<bool>) = (
             cdf.par_chunks_mut(SUM_BLOCK),
             copy.par_chunks_mut(SUM_BLOCK),
@@ -93,16 +96,16 @@ impl Discrete1D {
             acc += total;
         }
         let Some((first, last)) = positive_range(weights) else {
-            return (None, valid);
+            return Ok((None, valid));
         };
         if !(valid && acc > 0.0 && acc.is_finite()) {
-            return (None, valid);
+            return Ok((None, valid));
         }
         cdf.par_chunks_mut(SUM_BLOCK)
             .zip(offsets)
             .skip(1)
             .for_each(|(cdf, offset)| cdf.iter_mut().for_each(|c| *c += offset));
-        let mut guide = Buffer::for_overwrite(guide_len(weights.len()));
+        let mut guide = Buffer::for_overwrite(guide_len(weights.len()), "the table's guide")?;
         fill_guide(&cdf, acc, (first, last), &mut guide);
         let table = Discrete1D {
             weights: Weights::new(copy, acc),
@@ -111,7 +114,7 @@ impl Discrete1D {
             last,
             guide,
         };
-        (Some(table), valid)
+        Ok((Some(table), valid))
     }
 
     /// Running sum of the weights before entry `i`: `C_{i−1}` (0 for i = 0).

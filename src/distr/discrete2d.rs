@@ -5,7 +5,7 @@ use super::{Discrete1D, GROUP, check_weights};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
-use crate::{parallel, simd};
+use crate::{alloc, parallel, simd};
 use rayon::prelude::*;
 
 /// A discrete distribution over the cells `(row, col)` of a `rows × cols`
@@ -104,12 +104,13 @@ impl Discrete2D {
             });
         }
         let g = guide_len(cols);
-        let mut copy = Buffer::<f64>::for_overwrite(weights.len());
-        let mut cdf = Buffer::<f64>::for_overwrite(weights.len());
-        let mut guide = Buffer::<u32>::for_overwrite(weights.len() / cols_nz * g);
+        let mut copy = Buffer::<f64>::for_overwrite(weights.len(), "the table's weights")?;
+        let mut cdf = Buffer::<f64>::for_overwrite(weights.len(), "the table's running sums")?;
+        let n_rows = weights.len() / cols_nz;
+        let mut guide = Buffer::<u32>::for_overwrite(n_rows * g, "the table's guides")?;
         let guides: Vec<&mut [u32]> = match g {
-            0 => (0..weights.len() / cols_nz).map(|_| &mut [][..]).collect(),
-            _ => guide.chunks_mut(g).collect(),
+            0 => alloc::collect((0..n_rows).map(|_| &mut [][..]), "the table's rows")?,
+            _ => alloc::collect(guide.chunks_mut(g), "the table's rows")?,
         };
         let row_tables = weights
             .chunks(cols_nz)
@@ -121,11 +122,14 @@ impl Discrete2D {
         let spans: Vec<Option<(f64, usize, usize)>> = if weights.len() < 1 << 16 {
             row_tables.map(fill).collect()
         } else {
-            let row_tables: Vec<_> = row_tables.collect();
-            parallel::install(|| row_tables.into_par_iter().map(fill).collect())?
+            let row_tables = alloc::collect(row_tables, "the table's rows")?;
+            parallel::install(|| {
+                alloc::par_collect(row_tables.into_par_iter().map(fill), "the table's rows")
+            })??
         };
-        let row_sums: Vec<f64> = spans.iter().map(|s| s.map_or(0.0, |s| s.0)).collect();
-        let marginal = Discrete1D::from_checked(&row_sums).ok_or(Error::AllZero { arg })?;
+        let row_sums =
+            alloc::collect(spans.iter().map(|s| s.map_or(0.0, |s| s.0)), "the row sums")?;
+        let marginal = Discrete1D::from_checked(&row_sums)?.ok_or(Error::AllZero { arg })?;
         Ok(Discrete2D {
             marginal,
             cols,

@@ -2,6 +2,7 @@
 //! on a grid of vertices, the form of Mitsuba 3's `Hierarchical2D` (which
 //! its `envmap` emitter samples).
 
+use crate::alloc;
 use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;
 use crate::math::Real;
@@ -34,7 +35,7 @@ impl BilinearGrid {
     /// at least 2), checked by [`Discrete2D::new`] on the patch integrals.
     pub fn new(values: Vec<f64>, cols: usize, rows: usize) -> Result<Self> {
         let (px, py) = (cols - 1, rows - 1);
-        let mut patch = Vec::with_capacity(px * py);
+        let mut patch = alloc::with_capacity(px * py, "the sampling grid's patches")?;
         for y in 0..py {
             for x in 0..px {
                 let i = y * cols + x;

@@ -3,6 +3,7 @@
 
 use super::mapping::Mapping;
 use super::{EnvMap, Options, Sampling};
+use crate::alloc;
 use crate::error::Result;
 
 impl EnvMap {
@@ -15,7 +16,7 @@ impl EnvMap {
     /// # Errors
     /// As [`EnvMap::new`] for the new shape.
     pub fn convert(&self, mapping: Mapping, width: usize, height: usize) -> Result<EnvMap> {
-        let mut data = Vec::with_capacity(width * height * 3);
+        let mut data = alloc::with_capacity(width * height * 3, "the resampled texels")?;
         for y in 0..height {
             for x in 0..width {
                 let p = texel_centre(mapping, width, height, x, y);

@@ -13,7 +13,7 @@ use super::{Options, Sampling};
 use crate::buffer::Buffer;
 use crate::distr::PiecewiseConstant2D;
 use crate::error::Result;
-use crate::parallel;
+use crate::{alloc, parallel};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -68,7 +68,9 @@ fn sampling_luminance(
     compensate: bool,
 ) -> Result<Vec<f64>> {
     let luminance = |t: &[f32; 3]| (0..3).map(|k| weights[k] * f64::from(t[k])).sum::<f64>();
-    let lum: Vec<f64> = parallel::install(|| image.texels().par_iter().map(luminance).collect())?;
+    let mut lum = parallel::install(|| {
+        alloc::par_collect(image.texels().par_iter().map(luminance), "the luminances")
+    })??;
     if !compensate {
         return Ok(lum);
     }
@@ -87,7 +89,8 @@ fn sampling_luminance(
     if mean - min <= 0.01 * mean {
         return Ok(lum);
     }
-    Ok(lum.into_iter().map(|l| (l - mean).max(0.0)).collect())
+    lum.iter_mut().for_each(|l| *l = (*l - mean).max(0.0));
+    Ok(lum)
 }
 
 /// The piecewise-constant table of [`Sampling::Piecewise`] (or
@@ -145,7 +148,7 @@ fn piecewise_table(image: &Image, options: &Options) -> Result<(Distribution, Bu
     };
     // Rows are independent: fill them on all cores. (A Buffer: it becomes
     // the polar table's densities, read at random, best on huge pages.)
-    let mut values = Buffer::zeroed(rows * cols);
+    let mut values = Buffer::zeroed(rows * cols, "the sampling table")?;
     parallel::install(|| values.par_chunks_mut(cols).enumerate().for_each(fill_row))?;
     let distribution = PiecewiseConstant2D::new(&values, rows, cols, domain)
         .map_or(Distribution::Black, Distribution::Piecewise);
@@ -213,7 +216,7 @@ fn angular_sector(
 fn mitsuba_grid(image: &Image, compensate: bool) -> Result<Distribution> {
     let lum = sampling_luminance(image, Mapping::LatLong, MITSUBA_LUMINANCE, compensate)?;
     let (w, h) = (image.width(), image.height());
-    let mut values = Vec::with_capacity((w + 1) * h);
+    let mut values = alloc::with_capacity((w + 1) * h, "the sampling grid")?;
     for y in 0..h {
         let sin_theta = (y as f64 * PI / (h - 1) as f64).sin().max(0.0);
         let row = &lum[y * w..(y + 1) * w];

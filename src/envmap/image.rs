@@ -10,7 +10,9 @@
 //!   beyond the outermost centres; an angular map is black outside its unit
 //!   circle.
 
+use super::MAX_TEXELS;
 use super::mapping::Mapping;
+use crate::alloc;
 use crate::error::{Error, Result};
 use crate::math::{Real, luminance};
 use crate::simd;
@@ -36,8 +38,10 @@ impl Image {
     ///
     /// # Errors
     /// [`Error::Shape`] for an empty image, a non-square angular map or
-    /// cube face; [`Error::InvalidWeight`] for a NaN, infinite or negative
-    /// value, named `image[y, x, c]` (`image[face, y, x, c]` for cube maps).
+    /// cube face; [`Error::TooLarge`] above [`MAX_TEXELS`] texels;
+    /// [`Error::InvalidWeight`] for a NaN, infinite or negative value, named
+    /// `image[y, x, c]` (`image[face, y, x, c]` for cube maps);
+    /// [`Error::Memory`] when the texels' memory cannot be had.
     pub fn new(mapping: Mapping, width: usize, height: usize, data: &[f32]) -> Result<Self> {
         let shape_error = |expected: &str| Error::Shape {
             arg: "image",
@@ -57,6 +61,13 @@ impl Image {
                 });
             }
             _ => {}
+        }
+        if width * height > MAX_TEXELS {
+            return Err(Error::TooLarge {
+                arg: "image",
+                len: width * height,
+                max: MAX_TEXELS,
+            });
         }
         // One branch-free pass for the common case (NaN fails both
         // comparisons); find the index only on failure.
@@ -80,16 +91,18 @@ impl Image {
                 value: f64::from(data[i]),
             });
         }
-        let mut texels: Vec<[f32; 3]> = data.as_chunks::<3>().0.to_vec();
+        let mut texels: Vec<[f32; 3]> = alloc::copy(data.as_chunks::<3>().0, "the texels")?;
         let (mut width, mut height) = (width, height);
         if mapping == Mapping::LatLong && width < 2 {
-            texels = texels.iter().flat_map(|&t| [t, t]).collect();
+            let mut doubled = alloc::with_capacity(2 * texels.len(), "the texels")?;
+            doubled.extend(texels.iter().flat_map(|&t| [t, t]));
+            texels = doubled;
             width = 2;
         }
         if mapping == Mapping::LatLong && height < 3 {
-            let last = texels[(height - 1) * width..].to_vec();
+            alloc::reserve(&mut texels, (3 - height) * width, "the texels")?;
             for _ in height..3 {
-                texels.extend_from_slice(&last);
+                texels.extend_from_within((height - 1) * width..height * width);
             }
             height = 3;
         }

@@ -53,6 +53,10 @@ mod polar;
 mod sample;
 
 pub use batch::EnvSamples;
+
+/// Texels an environment map may have, by any way in (an array, a file,
+/// `convert`): `2^28`, a 16384 × 16384 map (3 GiB of float32 RGB).
+pub const MAX_TEXELS: usize = crate::io::MAX_PIXELS;
 pub use bilinear::BilinearGrid;
 pub use cell_sampler::CellSampler;
 pub use convert::texel_centre;

@@ -100,7 +100,7 @@ impl PolarTable {
         let integral = table.integral();
         parallel::install(|| weights.par_iter_mut().for_each(|w| *w /= integral))?;
         let density = weights;
-        let mut density_f32 = Buffer::for_overwrite(density.len());
+        let mut density_f32 = Buffer::for_overwrite(density.len(), "the polar table")?;
         parallel::install(|| {
             (density_f32.par_iter_mut(), density.par_iter())
                 .into_par_iter()

@@ -11,12 +11,13 @@
 //! - outputs are fresh numpy arrays, or the caller's `out` ([`output`]).
 
 use super::args::type_name;
+use crate::alloc;
 use crate::error::{Error, shape_str};
 use crate::math::Real;
 use crate::python::{Obj, Out};
 use numpy::{AllowTypeChange, Element, PyArrayDescrMethods, PyArrayDyn, PyArrayLikeDyn};
 use numpy::{PyArrayMethods, PyReadwriteArrayDyn, PyUntypedArray, PyUntypedArrayMethods};
-use pyo3::exceptions::PyTypeError;
+use pyo3::exceptions::{PyMemoryError, PyTypeError};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 
@@ -206,16 +207,18 @@ pub struct Points<'py, F: Element, const K: usize> {
 impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
     /// Reads `ob` as points of dimension `K`.
     pub fn extract(ob: &Obj<'py>, arg: &'static str) -> PyResult<Self> {
-        let array: PyArrayLikeDyn<'py, F, AllowTypeChange> = ob
-            .extract()
-            .map_err(|e| PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}")))?;
+        let array: PyArrayLikeDyn<'py, F, AllowTypeChange> =
+            ob.extract().map_err(|e| not_numbers(ob.py(), arg, e))?;
         let batch = batch_shape::<K>(arg, array.shape())?;
         // Only C order can be read in place (a Fortran-ordered array is
         // contiguous too, in the wrong order): copy anything else once.
         let owned = if array.is_c_contiguous() {
             None
         } else {
-            Some(array.as_array().iter().copied().collect())
+            Some(alloc::collect(
+                array.as_array().iter().copied(),
+                "a copy of the points",
+            )?)
         };
         Ok(Points {
             array,
@@ -260,6 +263,17 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
             requirement: check.requirement(0),
         }
         .into()
+    }
+}
+
+/// The error of an argument `arg` that does not convert to an array of
+/// numbers: TypeError, except numpy's MemoryError (a conversion that needs
+/// a copy too big for memory), which passes unchanged.
+pub fn not_numbers(py: Python<'_>, arg: &str, e: PyErr) -> PyErr {
+    if e.is_instance_of::<PyMemoryError>(py) {
+        e
+    } else {
+        PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}"))
     }
 }
 
@@ -379,11 +393,11 @@ impl<const K: usize> Indices<K> {
         let flat: Vec<i128> = match kind.as_str() {
             "i" => {
                 let a: PyArrayLikeDyn<'_, i64, AllowTypeChange> = array.extract()?;
-                a.as_array().iter().map(|&v| i128::from(v)).collect()
+                alloc::collect(a.as_array().iter().map(|&v| i128::from(v)), "the indices")?
             }
             "u" => {
                 let a: PyArrayLikeDyn<'_, u64, AllowTypeChange> = array.extract()?;
-                a.as_array().iter().map(|&v| i128::from(v)).collect()
+                alloc::collect(a.as_array().iter().map(|&v| i128::from(v)), "the indices")?
             }
             "O" => {
                 let mut values = Vec::new();
@@ -398,7 +412,7 @@ impl<const K: usize> Indices<K> {
             }
             _ => return Err(not_integers(arg, &dtype)),
         };
-        let mut rows = Vec::with_capacity(flat.len() / K);
+        let mut rows = alloc::with_capacity(flat.len() / K, "the indices")?;
         for (i, chunk) in flat.as_chunks::<K>().0.iter().enumerate() {
             let mut row = [0usize; K];
             for (k, (&v, &bound)) in chunk.iter().zip(&bounds).enumerate() {
@@ -452,9 +466,8 @@ pub struct Table<'py> {
 impl<'py> Table<'py> {
     /// Reads `ob` (argument `arg`).
     pub fn extract(ob: &Obj<'py>, arg: &'static str, ndim: usize) -> PyResult<Self> {
-        let array: PyArrayLikeDyn<'py, f64, AllowTypeChange> = ob
-            .extract()
-            .map_err(|e| PyTypeError::new_err(format!("{arg} must be an array of numbers: {e}")))?;
+        let array: PyArrayLikeDyn<'py, f64, AllowTypeChange> =
+            ob.extract().map_err(|e| not_numbers(ob.py(), arg, e))?;
         let shape = array.shape().to_vec();
         if shape.len() != ndim {
             return Err(Error::Shape {
@@ -468,7 +481,13 @@ impl<'py> Table<'py> {
             }
             .into());
         }
-        let owned = (!array.is_c_contiguous()).then(|| array.as_array().iter().copied().collect());
+        let owned = match array.is_c_contiguous() {
+            true => None,
+            false => Some(alloc::collect(
+                array.as_array().iter().copied(),
+                "a copy of the table",
+            )?),
+        };
         Ok(Table {
             array,
             owned,

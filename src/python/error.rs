@@ -1,10 +1,11 @@
-//! Error mapping: core [`Error`]s become `ValueError` / `OSError` (and
+//! Error mapping: core [`Error`]s become `ValueError` / `OSError` /
+//! `MemoryError` (and
 //! `RuntimeError` when the worker threads cannot start) with the core's
 //! message unchanged; a Rust panic becomes `RuntimeError` (never PyO3's
 //! `PanicException`, which `except Exception` does not catch).
 
 use crate::error::Error;
-use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
@@ -12,6 +13,7 @@ impl From<Error> for PyErr {
     fn from(e: Error) -> PyErr {
         match e {
             Error::Io { .. } => PyOSError::new_err(e.to_string()),
+            Error::Memory { .. } => PyMemoryError::new_err(e.to_string()),
             Error::ThreadPool { .. } => PyRuntimeError::new_err(e.to_string()),
             Error::InvalidWeight { .. }
             | Error::AllZero { .. }

@@ -5,6 +5,7 @@ use super::arrays::{Check, Points, PyFloat, broadcast, finish, position, result_
 use super::arrays::{with_precision, zeros};
 use super::batch::map_into;
 use super::parallel::run_batch;
+use crate::alloc;
 use crate::error::{Error, shape_str};
 use crate::frame::Frame;
 use crate::math::Real;
@@ -49,7 +50,7 @@ impl PyFrame {
         op: fn(&Frame<F>, [F; 3]) -> [F; 3],
     ) -> PyResult<Obj<'py>> {
         let v = Points::<F, 3>::extract(v, "v")?;
-        let frames: Vec<Frame<F>> = self.frames.iter().map(cast).collect();
+        let frames = alloc::collect(self.frames.iter().map(cast), "the frames")?;
         if self.batch.is_empty() {
             let f = frames[0];
             return map_into(py, &v, Check::Finite, None, move |x| op(&f, x));
@@ -106,7 +107,7 @@ impl PyFrame {
     #[new]
     fn new(normal: &Obj<'_>) -> PyResult<Self> {
         let normals = Points::<f64, 3>::extract(normal, "normal")?;
-        let mut frames = Vec::with_capacity(normals.n);
+        let mut frames = alloc::with_capacity(normals.n, "the frames")?;
         for (i, n) in normals.rows().iter().enumerate() {
             let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
             if !(len.is_finite() && len > 0.0) {

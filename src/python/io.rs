@@ -3,6 +3,7 @@
 //! `OSError` naming the path, wrong arrays `ValueError`.
 
 use super::parallel::detached;
+use crate::alloc;
 use crate::error::{Error, shape_str};
 use crate::io::{self, Raster};
 use crate::python::Obj;
@@ -25,7 +26,7 @@ fn from_numpy(image: &Obj<'_>) -> PyResult<Raster> {
             width,
             height,
             channels,
-            data: array.as_array().iter().copied().collect(),
+            data: alloc::collect(array.as_array().iter().copied(), "a copy of image")?,
         }),
         _ => Err(Error::Shape {
             arg: "image",
@@ -166,14 +167,15 @@ fn read_mesh<'py>(
     path: PathBuf,
 ) -> PyResult<(Obj<'py>, Obj<'py>, Option<Obj<'py>>)> {
     let mesh = detached(py, || crate::render::mesh_file::read_mesh(&path))?;
+    // The rows as they are (no copy): numpy takes over the Vec.
     let rows3 = |v: Vec<[f64; 3]>| -> PyResult<Obj<'py>> {
         let n = v.len();
-        Ok(PyArray1::from_vec(py, v.into_iter().flatten().collect())
+        Ok(PyArray1::from_vec(py, v.into_flattened())
             .reshape([n, 3])?
             .into_any())
     };
     let m = mesh.faces.len();
-    let faces = PyArray1::from_vec(py, mesh.faces.into_iter().flatten().collect())
+    let faces = PyArray1::from_vec(py, mesh.faces.into_flattened())
         .reshape([m, 3])?
         .into_any();
     Ok((

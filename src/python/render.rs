@@ -17,6 +17,7 @@ use super::batch::map_pair;
 use super::envmap::PyEnvMap;
 use super::error::guarded;
 use super::phong::PyPhong;
+use crate::alloc;
 use crate::error::Error;
 use crate::render::camera::{Camera, FovAxis};
 use crate::render::scene::{Environment, Geometry, Material, Shape, affine};
@@ -36,11 +37,12 @@ fn rows<'py, T: numpy::Element + Copy, const K: usize>(
         }
         .into());
     }
-    Ok(view
-        .rows()
-        .into_iter()
-        .map(|r| std::array::from_fn(|k| r[k]))
-        .collect())
+    Ok(alloc::collect(
+        view.rows()
+            .into_iter()
+            .map(|r| std::array::from_fn(|k| r[k])),
+        arg,
+    )?)
 }
 
 /// Checks that every channel of the RGB radiance `value` (argument `arg`)
@@ -165,7 +167,7 @@ impl PySceneBuilder {
 
     /// Lights the scene with an environment map.
     fn set_envmap(&mut self, env: PyRef<'_, PyEnvMap>) -> PyResult<()> {
-        self.set_environment(Environment::Map(Box::new(env.inner().clone())))
+        self.set_environment(Environment::Map(Arc::clone(env.inner())))
     }
 
     /// Lights the scene with the same radiance from every direction.

@@ -25,6 +25,7 @@ use glam::Vec3A;
 use super::accel::Hit;
 use super::scene::{LightSample, Scene};
 use super::shape::Ray;
+use crate::alloc;
 use crate::frame::Frame;
 use crate::sampler::{Sampler, Stream};
 
@@ -195,6 +196,20 @@ pub struct Escaped {
 }
 
 impl Escaped {
+    /// Room for `n` rays (the samples of a batch: a path escapes once).
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when the memory cannot be had.
+    pub fn reserve(&mut self, n: usize) -> crate::Result<()> {
+        const WHAT: &str = "the batch's escaped rays";
+        alloc::reserve(&mut self.slot, n, WHAT)?;
+        alloc::reserve(&mut self.dir, n, WHAT)?;
+        alloc::reserve(&mut self.beta, n, WHAT)?;
+        alloc::reserve(&mut self.bsdf_pdf, n, WHAT)?;
+        alloc::reserve(&mut self.radiance, n, WHAT)?;
+        alloc::reserve(&mut self.light_pdf, n, WHAT)
+    }
+
     /// Forgets every ray (keeping the memory).
     pub fn clear(&mut self) {
         self.slot.clear();

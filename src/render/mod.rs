@@ -27,6 +27,7 @@
 
 pub mod accel;
 pub mod camera;
+pub mod geometry;
 pub mod integrator;
 pub mod mesh_file;
 pub mod scene;
@@ -41,6 +42,7 @@ use rayon::prelude::*;
 pub use integrator::{Heuristic, Integrator, Settings, Strategy, dims};
 pub use scene::Scene;
 
+use crate::alloc;
 use crate::error::Result;
 use crate::math::luminance;
 use crate::parallel;
@@ -111,13 +113,22 @@ impl Batch {
         spp: u32,
         y: usize,
         pixels: std::ops::Range<usize>,
-    ) {
+    ) -> Result<()> {
         let (width, height) = scene.film();
         let (inv_width, inv_height) = (1.0 / width as f32, 1.0 / height as f32);
         self.escaped.clear();
         self.radiance.clear();
         self.camera_u.clear();
-        let mut streams = Vec::with_capacity(pixels.len());
+        // Reserved up front (samples grow with spp): a batch too big for
+        // memory is an error, not an abort.
+        let n = pixels.len() * spp.max(1) as usize;
+        const WHAT: &str = "a batch of samples";
+        alloc::reserve(&mut self.camera_u, n, WHAT)?;
+        alloc::reserve(&mut self.rays, n, WHAT)?;
+        alloc::reserve(&mut self.hits, n, WHAT)?;
+        alloc::reserve(&mut self.radiance, n, WHAT)?;
+        self.escaped.reserve(n)?;
+        let mut streams = alloc::with_capacity(pixels.len(), WHAT)?;
         for x in pixels {
             let pixel = (y * width + x) as u64;
             let key = mix(seed, pixel);
@@ -175,6 +186,7 @@ impl Batch {
             }
         }
         integrator::add_escaped(scene, settings, &mut self.escaped, &mut self.radiance);
+        Ok(())
     }
 }
 
@@ -248,9 +260,9 @@ pub fn render(
     if settings.sampler == Sampler::ZSobol {
         ZOrder::check((width, height), u64::from(spp))?;
     }
-    let mut mean = vec![0.0f32; width * height * 3];
-    let mut variance = vec![0.0f32; width * height * 3];
-    let mut luminance_variance = vec![0.0f32; width * height];
+    let mut mean = alloc::filled(width * height * 3, 0.0f32, "the film's means")?;
+    let mut variance = alloc::filled(width * height * 3, 0.0f32, "the film's variances")?;
+    let mut luminance_variance = alloc::filled(width * height, 0.0f32, "the film's variances")?;
     // Pixels per batch: about BATCH samples, at least one pixel.
     let group = (BATCH / spp.max(1) as usize).max(1);
     parallel::install(|| {
@@ -258,15 +270,15 @@ pub fn render(
             .zip(variance.par_chunks_mut(width * 3))
             .zip(luminance_variance.par_chunks_mut(width))
             .enumerate()
-            .for_each_init(
+            .try_for_each_init(
                 Batch::default,
                 |batch, (y, ((mean_row, var_row), lum_row))| {
                     for x0 in (0..width).step_by(group) {
                         if progress.cancel.load(Ordering::Relaxed) {
-                            return;
+                            return Ok(());
                         }
                         let pixels = x0..(x0 + group).min(width);
-                        batch.run(scene, settings, seed, spp, y, pixels.clone());
+                        batch.run(scene, settings, seed, spp, y, pixels.clone())?;
                         let per_pixel = batch.radiance.chunks(spp.max(1) as usize);
                         for (x, samples) in pixels.zip(per_pixel.chain(std::iter::repeat(&[][..])))
                         {
@@ -279,9 +291,10 @@ pub fn render(
                     progress
                         .samples
                         .fetch_add(width as u64 * u64::from(spp), Ordering::Relaxed);
+                    Ok(())
                 },
-            );
-    })?;
+            )
+    })??;
     Ok(Image {
         width,
         height,

@@ -2,11 +2,15 @@
 //! environment, the camera and the film size; and its lights, chosen by
 //! power for emitter sampling.
 
-use glam::{DVec3, Vec3A};
+use glam::Vec3A;
+use std::sync::Arc;
 
 use super::accel::{Accel, Primitive};
 use super::camera::Camera;
-use super::shape::{Disk, Ray, Sphere, SurfacePoint, Triangle};
+use super::geometry::check_primitives;
+pub use super::geometry::{Geometry, MAX_PRIMITIVES, affine};
+use super::shape::{Ray, SurfacePoint};
+use crate::alloc;
 use crate::distr::Discrete1D;
 use crate::envmap::{CellSampler, EnvMap, EnvSample};
 use crate::error::{Error, Result};
@@ -25,17 +29,6 @@ pub struct Material {
     pub two_sided: bool,
 }
 
-/// The geometry of one shape.
-#[derive(Clone, Debug)]
-pub enum Geometry {
-    /// A triangle mesh (world space).
-    Mesh(Vec<Triangle>),
-    /// A sphere.
-    Sphere(Sphere),
-    /// A disk.
-    Disk(Disk),
-}
-
 /// A shape: geometry, material and, for an area light, its radiance (RGB,
 /// emitted from the front side only, constant over the surface).
 #[derive(Clone, Debug)]
@@ -52,7 +45,7 @@ pub struct Shape {
 #[derive(Clone, Debug)]
 pub enum Environment {
     /// An environment map (sampled by its own importance sampling).
-    Map(Box<EnvMap>),
+    Map(Arc<EnvMap>),
     /// The same radiance from every direction (sampled uniformly on the
     /// sphere, pdf `1/(4π)`).
     Constant([f64; 3]),
@@ -209,7 +202,9 @@ impl Scene {
                 requirement: "width and height must be >= 1",
             });
         }
-        let mut primitives = Vec::new();
+        let count: usize = shapes.iter().map(|s| s.geometry.primitive_count()).sum();
+        check_primitives("shapes", count)?;
+        let mut primitives = alloc::with_capacity(count, "the scene's primitives")?;
         let mut materials = Vec::with_capacity(shapes.len());
         let mut emission = Vec::with_capacity(shapes.len());
         let mut light_of_shape = Vec::with_capacity(shapes.len());
@@ -220,7 +215,8 @@ impl Scene {
             let first = primitives.len() as u32;
             let areas: Vec<f64> = match shape.geometry {
                 Geometry::Mesh(tris) => {
-                    let areas = tris.iter().map(|t| f64::from(t.area())).collect();
+                    let areas =
+                        alloc::collect(tris.iter().map(|t| f64::from(t.area())), "the areas")?;
                     primitives.extend(tris.into_iter().map(|t| (Primitive::Triangle(t), id)));
                     areas
                 }
@@ -257,7 +253,7 @@ impl Scene {
                 light_of_shape.push(None);
             }
         }
-        let accel = Accel::new(primitives);
+        let accel = Accel::new(primitives)?;
         let radius = accel
             .bounds()
             .map_or(1.0, |(lo, hi)| 0.5 * f64::from((hi - lo).length()));
@@ -494,157 +490,4 @@ impl Scene {
             }
         }
     }
-}
-
-fn finite_rows<const K: usize>(arg: &'static str, rows: &[[f64; K]]) -> Result<()> {
-    for (i, row) in rows.iter().enumerate() {
-        if let Some(k) = row.iter().position(|v| !v.is_finite()) {
-            return Err(Error::Element {
-                arg,
-                index: format!("[{i}, {k}]"),
-                value: row[k],
-                requirement: "must be finite".into(),
-            });
-        }
-    }
-    Ok(())
-}
-
-/// Angle-weighted vertex normals (Thürmer and Wüthrich): each face adds its
-/// unit normal times its corner angle at the vertex.
-fn vertex_normals(vertices: &[Vec3A], faces: &[[usize; 3]]) -> Vec<Vec3A> {
-    let mut normals = vec![Vec3A::ZERO; vertices.len()];
-    for f in faces {
-        let p = f.map(|i| vertices[i]);
-        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-        for k in 0..3 {
-            let a = (p[(k + 1) % 3] - p[k]).normalize_or_zero();
-            let b = (p[(k + 2) % 3] - p[k]).normalize_or_zero();
-            let angle = a.dot(b).clamp(-1.0, 1.0).acos();
-            normals[f[k]] += n * angle;
-        }
-    }
-    normals.iter().map(|n| n.normalize_or_zero()).collect()
-}
-
-impl Geometry {
-    /// A triangle mesh of `vertices` (world space) and `faces` (vertex
-    /// indices, counter-clockwise seen from the front). Shading normals:
-    /// `normals` when given (one per vertex), else angle-weighted vertex
-    /// normals unless `face_normals`, as Mitsuba's meshes.
-    ///
-    /// # Errors
-    /// [`Error::Element`] for a coordinate or normal that is not finite,
-    /// [`Error::Index`] for a face index out of range, [`Error::Shape`] for
-    /// normals not one per vertex.
-    pub fn mesh(
-        vertices: &[[f64; 3]],
-        faces: &[[i64; 3]],
-        normals: Option<&[[f64; 3]]>,
-        face_normals: bool,
-    ) -> Result<Self> {
-        finite_rows("vertices", vertices)?;
-        let nv = vertices.len();
-        let mut idx = Vec::with_capacity(faces.len());
-        for (i, f) in faces.iter().enumerate() {
-            if let Some(k) = f.iter().position(|&v| v < 0 || v as usize >= nv) {
-                return Err(Error::Index {
-                    arg: "faces",
-                    index: format!("[{i}, {k}]"),
-                    value: f[k],
-                    len: nv,
-                });
-            }
-            idx.push(f.map(|v| v as usize));
-        }
-        let points: Vec<Vec3A> = vertices
-            .iter()
-            .map(|v| Vec3A::from(DVec3::from(*v).as_vec3()))
-            .collect();
-        let shading: Option<Vec<Vec3A>> = match (normals, face_normals) {
-            (_, true) => None,
-            (Some(n), false) => {
-                finite_rows("normals", n)?;
-                if n.len() != nv {
-                    return Err(Error::Shape {
-                        arg: "normals",
-                        expected: format!("({nv}, 3), one per vertex"),
-                        got: format!("({}, 3)", n.len()),
-                    });
-                }
-                Some(
-                    n.iter()
-                        .map(|v| Vec3A::from(DVec3::from(*v).as_vec3()).normalize_or_zero())
-                        .collect(),
-                )
-            }
-            (None, false) => Some(vertex_normals(&points, &idx)),
-        };
-        let tris = idx
-            .iter()
-            .map(|f| {
-                let p = f.map(|i| points[i]);
-                Triangle {
-                    p0: p[0],
-                    e1: p[1] - p[0],
-                    e2: p[2] - p[0],
-                    normals: shading.as_ref().map(|n| f.map(|i| n[i])),
-                }
-            })
-            // Degenerate triangles are never hit and have no area to sample.
-            .filter(|t| t.area() > 0.0)
-            .collect();
-        Ok(Geometry::Mesh(tris))
-    }
-
-    /// A sphere of `radius > 0` around `center`; normals inward if `flip`.
-    ///
-    /// # Errors
-    /// [`Error::Parameter`] for a radius that is not finite and > 0,
-    /// [`Error::Element`] for a centre that is not finite.
-    pub fn sphere(center: [f64; 3], radius: f64, flip: bool) -> Result<Self> {
-        finite_rows("center", &[center])?;
-        if !(radius > 0.0 && radius.is_finite()) {
-            return Err(Error::Parameter {
-                arg: "radius",
-                value: radius,
-                requirement: "must be finite and > 0",
-            });
-        }
-        Ok(Geometry::Sphere(Sphere {
-            center: DVec3::from(center),
-            radius,
-            flip,
-        }))
-    }
-
-    /// Mitsuba's `disk`: the unit disk in the plane z = 0 (normal +z) placed
-    /// by the affine `to_world` (row-major 4×4; the last row is ignored).
-    ///
-    /// # Errors
-    /// [`Error::Element`] for a matrix entry that is not finite,
-    /// [`Error::Parameter`] for a matrix that flattens the disk.
-    pub fn disk(to_world: [[f64; 4]; 4]) -> Result<Self> {
-        let m = affine("to_world", to_world)?;
-        Disk::new(m).map(Geometry::Disk).ok_or(Error::Parameter {
-            arg: "to_world",
-            value: 0.0,
-            requirement: "must not flatten the disk (its determinant is 0)",
-        })
-    }
-}
-
-/// The affine map of a row-major 4×4 matrix (its last row ignored).
-///
-/// # Errors
-/// [`Error::Element`] for an entry that is not finite.
-pub fn affine(arg: &'static str, m: [[f64; 4]; 4]) -> Result<glam::Affine3A> {
-    finite_rows(arg, &m)?;
-    let col = |c: usize| glam::Vec3::new(m[0][c] as f32, m[1][c] as f32, m[2][c] as f32);
-    Ok(glam::Affine3A::from_cols(
-        col(0).into(),
-        col(1).into(),
-        col(2).into(),
-        col(3).into(),
-    ))
 }

@@ -1,11 +1,13 @@
 //! The inputs of ``EnvMap``: its options (mapping, sampling, `to_world`),
 //! its image as an array, and image files.
 
-use crate::envmap::{Mapping, Matrix3, Options, Sampling};
+use crate::alloc;
+use crate::envmap::{MAX_TEXELS, Mapping, Matrix3, Options, Sampling};
 use crate::error::{Error, shape_str};
 use crate::io;
 use crate::python::Obj;
 use crate::python::args::choice;
+use crate::python::arrays::not_numbers;
 use numpy::{AllowTypeChange, PyArrayLikeDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
@@ -82,7 +84,7 @@ pub fn image_arg<'py>(
 ) -> PyResult<(usize, usize, PyArrayLikeDyn<'py, f32, AllowTypeChange>)> {
     let array: PyArrayLikeDyn<'py, f32, AllowTypeChange> = image
         .extract()
-        .map_err(|e| PyTypeError::new_err(format!("image must be an array of numbers: {e}")))?;
+        .map_err(|e| not_numbers(image.py(), "image", e))?;
     let shape = array.shape().to_vec();
     let (width, height) = match (mapping, shape.as_slice()) {
         (Mapping::Cube, [6, r, r2, 3]) if r == r2 => (*r, 6 * r),
@@ -99,6 +101,15 @@ pub fn image_arg<'py>(
             .into());
         }
     };
+    // Checked before the array is copied (a non-contiguous one is).
+    if width * height > MAX_TEXELS {
+        return Err(Error::TooLarge {
+            arg: "image",
+            len: width * height,
+            max: MAX_TEXELS,
+        }
+        .into());
+    }
     Ok((width, height, array))
 }
 
@@ -114,11 +125,18 @@ pub fn read_image(path: &Path, mapping: Mapping) -> crate::Result<(usize, usize,
     } else {
         io::read_exr(path)?
     };
-    let rgb: Vec<f32> = raster
-        .data
-        .chunks(raster.channels)
-        .flat_map(|px| [px[0], px[1], px[2]])
-        .collect();
+    let rgb: Vec<f32> = if raster.channels == 3 {
+        raster.data
+    } else {
+        let mut rgb = alloc::with_capacity(raster.width * raster.height * 3, "the image")?;
+        rgb.extend(
+            raster
+                .data
+                .chunks(raster.channels)
+                .flat_map(|px| [px[0], px[1], px[2]]),
+        );
+        rgb
+    };
     let (w, h) = (raster.width, raster.height);
     if mapping != Mapping::Cube || h == 6 * w {
         return Ok((w, h, rgb));
@@ -132,7 +150,7 @@ pub fn read_image(path: &Path, mapping: Mapping) -> crate::Result<(usize, usize,
         });
     }
     // Horizontal strip: face f is columns [f·R, (f + 1)·R).
-    let mut stacked = Vec::with_capacity(rgb.len());
+    let mut stacked = alloc::with_capacity(rgb.len(), "the cube map's faces")?;
     for face in 0..6 {
         for y in 0..h {
             let start = (y * w + face * h) * 3;

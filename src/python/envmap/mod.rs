@@ -4,10 +4,11 @@
 mod input;
 
 use super::args::index_arg;
-use super::arrays::{Check, Points, PyFloat, finish, output, with_precision, writable};
+use super::arrays::{Check, Points, PyFloat, finish, output, with_precision, writable, zeros};
 use super::batch::{map_each, map_into};
 use super::parallel::{detached, run_batch};
 use super::records::record;
+use crate::alloc;
 use crate::envmap::{EnvMap, EnvSamples, Mapping, Options, TableFloat};
 use crate::error::Error;
 use crate::io::Raster;
@@ -18,6 +19,7 @@ use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyType};
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// A float type the envmap bindings compute in: a [`PyFloat`] whose
 /// sampling-table densities the map keeps ([`TableFloat`]).
@@ -69,7 +71,7 @@ record! {
 ///
 /// Everything after ``image`` is keyword-only.
 #[pyclass(module = "mcsample._core", name = "EnvMap", frozen)]
-pub struct PyEnvMap(EnvMap);
+pub struct PyEnvMap(Arc<EnvMap>);
 
 /// The three arrays of `EnvMap.sample`'s `out` (direction, pdf, weight), or
 /// none.
@@ -92,7 +94,9 @@ fn finite<F: EnvFloat>(x: &[F; 3]) -> bool {
 
 impl PyEnvMap {
     fn build(py: Python<'_>, w: usize, h: usize, data: &[f32], options: Options) -> PyResult<Self> {
-        Ok(Self(detached(py, || EnvMap::new(w, h, data, options))?))
+        Ok(Self(Arc::new(detached(py, || {
+            EnvMap::new(w, h, data, options)
+        })?)))
     }
 
     fn directions<'py, F: EnvFloat, const M: usize>(
@@ -233,7 +237,7 @@ impl PyEnvMap {
         match array.as_slice().ok().filter(|_| array.is_c_contiguous()) {
             Some(data) => Self::build(py, w, h, data, options),
             None => {
-                let data: Vec<f32> = array.as_array().iter().copied().collect();
+                let data = alloc::collect(array.as_array().iter().copied(), "a copy of image")?;
                 Self::build(py, w, h, &data, options)
             }
         }
@@ -413,7 +417,7 @@ impl PyEnvMap {
             .into());
         }
         let env = &self.0;
-        Ok(Self(detached(py, || env.convert(mapping, w, h))?))
+        Ok(Self(Arc::new(detached(py, || env.convert(mapping, w, h))?)))
     }
 
     /// The texels, float32: (H, W, 3), or (6, R, R, 3) for cube maps (tiny
@@ -421,13 +425,16 @@ impl PyEnvMap {
     #[getter]
     fn image<'py>(&self, py: Python<'py>) -> PyResult<Obj<'py>> {
         let img = self.0.image();
-        let flat: Vec<f32> = img.texels().iter().flatten().copied().collect();
-        let array = PyArray1::from_vec(py, flat);
         let (w, h) = (img.width(), img.height());
-        Ok(match self.0.options().mapping {
-            Mapping::Cube => array.reshape([6, w, w, 3])?.into_any(),
-            _ => array.reshape([h, w, 3])?.into_any(),
-        })
+        let array = match self.0.options().mapping {
+            Mapping::Cube => zeros::<f32>(py, &[6, w, w, 3])?,
+            _ => zeros::<f32>(py, &[h, w, 3])?,
+        };
+        array
+            .readwrite()
+            .as_slice_mut()?
+            .copy_from_slice(img.texels().as_flattened());
+        Ok(array.into_any())
     }
 
     /// "latlong", "angular" or "cube".
@@ -473,7 +480,7 @@ impl PyEnvMap {
         let texels = img.texels();
         let raster = if self.0.options().mapping == Mapping::Cube {
             // Face f's row y, texel x sits at column f w + x of row y.
-            let mut data = vec![0.0f32; 6 * w * w * 3];
+            let mut data = alloc::filled(6 * w * w * 3, 0.0f32, "the PNG's pixels")?;
             for (k, t) in texels.iter().enumerate() {
                 let (f, y, x) = (k / (w * w), (k / w) % w, k % w);
                 let at = 3 * (y * 6 * w + f * w + x);
@@ -486,7 +493,8 @@ impl PyEnvMap {
                 data,
             }
         } else {
-            let data = texels.iter().flat_map(|t| t.map(|v| v * scale)).collect();
+            let mut data = alloc::with_capacity(texels.len() * 3, "the PNG's pixels")?;
+            data.extend(texels.iter().flat_map(|t| t.map(|v| v * scale)));
             Raster {
                 width: w,
                 height: h,
@@ -515,8 +523,8 @@ impl PyEnvMap {
 }
 
 impl PyEnvMap {
-    /// The core map (for the estimators' bindings).
-    pub fn inner(&self) -> &EnvMap {
+    /// The core map (for the estimators' and the scene's bindings), shared.
+    pub fn inner(&self) -> &Arc<EnvMap> {
         &self.0
     }
 }
