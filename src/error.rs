@@ -162,6 +162,17 @@ pub enum Error {
     },
 }
 
+/// Checks a count of `len` entries of `arg` against the most supported.
+///
+/// # Errors
+/// [`Error::TooLarge`] when `len > max`.
+pub fn check_at_most(arg: &'static str, len: usize, max: usize) -> Result<()> {
+    if len > max {
+        return Err(Error::TooLarge { arg, len, max });
+    }
+    Ok(())
+}
+
 /// The plural ending of a count of `n`.
 fn plural(n: &usize) -> &'static str {
     if *n == 1 { "" } else { "s" }

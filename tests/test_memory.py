@@ -111,6 +111,7 @@ GROUPS: dict[str, list[str]] = {
         "mcs.render(scene(4, 4, mesh=(8, 2 * 10**7)), 1, progress=False)",
         "mcs.render(scene(4, 4, ply=True), 1, progress=False)",
         "mcs.io.read_mesh(write_ply())",
+        "mcs.io.read_mesh(write_obj())",
     ],
     "qmc": [
         "mcs.qmc.Sobol(8, seed=1).random(10**9)",
@@ -142,6 +143,13 @@ _RUNNER = textwrap.dedent("""
         path = os.path.join(tmp, "big.ply")
         with open(path, "wb") as f:
             f.write(PLY_HEADER.encode())
+        return path
+
+    def write_obj():
+        # A sparse file of 4 GiB (no disk used): too big to read.
+        path = os.path.join(tmp, "big.obj")
+        with open(path, "wb") as f:
+            f.truncate(4 << 30)
         return path
 
     def scene(w, h, mesh=None, ply=False):

@@ -96,13 +96,7 @@ impl Discrete2D {
         check_weights(arg, weights, |i| {
             format!("[{}, {}]", i / cols_nz, i % cols_nz)
         })?;
-        if rows > super::MAX_ENTRIES || cols > super::MAX_ENTRIES {
-            return Err(Error::TooLarge {
-                arg,
-                len: rows.max(cols),
-                max: super::MAX_ENTRIES,
-            });
-        }
+        crate::error::check_at_most(arg, rows.max(cols), super::MAX_ENTRIES)?;
         let g = guide_len(cols);
         let mut copy = Buffer::<f64>::for_overwrite(weights.len(), "the table's weights")?;
         let mut cdf = Buffer::<f64>::for_overwrite(weights.len(), "the table's running sums")?;

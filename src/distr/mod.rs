@@ -53,14 +53,7 @@ fn all_weights(weights: &[f64]) -> bool {
 
 /// Checks that a table of `len` entries has at most [`MAX_ENTRIES`].
 fn check_len(arg: &'static str, len: usize) -> Result<()> {
-    if len > MAX_ENTRIES {
-        return Err(Error::TooLarge {
-            arg,
-            len,
-            max: MAX_ENTRIES,
-        });
-    }
-    Ok(())
+    crate::error::check_at_most(arg, len, MAX_ENTRIES)
 }
 
 /// The error for the first entry of `weights` that is not a weight (see

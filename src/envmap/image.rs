@@ -13,7 +13,7 @@
 use super::MAX_TEXELS;
 use super::mapping::Mapping;
 use crate::alloc;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, check_at_most};
 use crate::math::{Real, luminance};
 use crate::simd;
 
@@ -62,13 +62,7 @@ impl Image {
             }
             _ => {}
         }
-        if width * height > MAX_TEXELS {
-            return Err(Error::TooLarge {
-                arg: "image",
-                len: width * height,
-                max: MAX_TEXELS,
-            });
-        }
+        check_at_most("image", width * height, MAX_TEXELS)?;
         // One branch-free pass for the common case (NaN fails both
         // comparisons); find the index only on failure.
         let valid = |v: f32| (0.0..=f32::MAX).contains(&v);

@@ -56,14 +56,7 @@ pub const MAX_PRIMITIVES: usize = u32::MAX as usize;
 
 /// Checks a count of `arg` against [`MAX_PRIMITIVES`].
 pub(crate) fn check_primitives(arg: &'static str, len: usize) -> Result<()> {
-    if len > MAX_PRIMITIVES {
-        return Err(Error::TooLarge {
-            arg,
-            len,
-            max: MAX_PRIMITIVES,
-        });
-    }
-    Ok(())
+    crate::error::check_at_most(arg, len, MAX_PRIMITIVES)
 }
 
 impl Geometry {

@@ -143,7 +143,17 @@ fn read_ply(path: &Path) -> Result<MeshData> {
     })
 }
 
+/// Memory an OBJ file takes to read, per byte of the file (its text holds
+/// about 30 bytes a vertex, which become 12 bytes in the reader and 24 in
+/// [`MeshData`]), checked before the reader starts.
+const OBJ_BYTES_PER_FILE_BYTE: u64 = 4;
+
 fn read_obj(path: &Path) -> Result<MeshData> {
+    let size = std::fs::metadata(path)
+        .map_err(|e| io_error(path, e.to_string()))?
+        .len();
+    let bytes = usize::try_from(size.saturating_mul(OBJ_BYTES_PER_FILE_BYTE)).unwrap_or(usize::MAX);
+    alloc::probe::<u8>(bytes, "the OBJ file's mesh")?;
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,

@@ -3,7 +3,7 @@
 
 use crate::alloc;
 use crate::envmap::{MAX_TEXELS, Mapping, Matrix3, Options, Sampling};
-use crate::error::{Error, shape_str};
+use crate::error::{Error, check_at_most, shape_str};
 use crate::io;
 use crate::python::Obj;
 use crate::python::args::choice;
@@ -102,14 +102,7 @@ pub fn image_arg<'py>(
         }
     };
     // Checked before the array is copied (a non-contiguous one is).
-    if width * height > MAX_TEXELS {
-        return Err(Error::TooLarge {
-            arg: "image",
-            len: width * height,
-            max: MAX_TEXELS,
-        }
-        .into());
-    }
+    check_at_most("image", width * height, MAX_TEXELS)?;
     Ok((width, height, array))
 }
 
