@@ -67,7 +67,9 @@ impl Discrete1D {
     /// # Errors
     /// [`Error::Memory`] when the table's memory cannot be had.
     pub(crate) fn from_checked(weights: &[f64]) -> Result<Option<Self>> {
-        Ok(Self::build(weights)?.0)
+        // On mcsample's pool: rayon's global pool would ignore the thread
+        // count, and its threads do not exist in a forked child.
+        Ok(parallel::install(|| Self::build(weights))??.0)
     }
 
     /// The distribution of `weights` (`None` when they are empty or do not

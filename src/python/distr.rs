@@ -6,11 +6,24 @@
 use super::arrays::{Check, Indices, Points, Table, with_precision};
 use super::batch::{map_chunks, map_indices, map_into, map2};
 use super::parallel::detached;
+use super::pickle::reduce;
 use super::records::record;
 use crate::distr;
 use crate::python::Obj;
-use numpy::PyArray1;
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+
+/// A `(rows, cols)` array of the row-major `values`.
+fn table_2d<'py>(
+    py: Python<'py>,
+    values: &[f64],
+    (rows, cols): (usize, usize),
+) -> PyResult<Obj<'py>> {
+    Ok(PyArray1::from_slice(py, values)
+        .reshape([rows, cols])?
+        .into_any())
+}
 
 /// The `(N,)` array of `f(i)` for `i in 0..n`.
 fn per_index<'py>(
@@ -95,6 +108,12 @@ macro_rules! index_table_methods {
 
             fn __repr__(&self) -> String {
                 format!(concat!($name, "(n={}, sum={})"), self.0.len(), self.0.sum())
+            }
+
+            /// Pickles as the weights it was built from.
+            fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Obj<'py>> {
+                let w = PyArray1::from_slice(slf.py(), slf.get().0.weights());
+                reduce(slf.as_any(), None, PyTuple::new(slf.py(), [w])?, None)
             }
 
             $($extra)*
@@ -286,6 +305,13 @@ impl PyDiscrete2D {
         let (rows, cols) = self.shape;
         format!("Discrete2D(shape=({rows}, {cols}), sum={})", self.sum)
     }
+
+    /// Pickles as the weights it was built from.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Obj<'py>> {
+        let this = slf.get();
+        let w = table_2d(slf.py(), this.table.weights(), this.shape)?;
+        reduce(slf.as_any(), None, PyTuple::new(slf.py(), [w])?, None)
+    }
 }
 
 /// A piecewise-constant density on [a, b]: n equal cells with densities
@@ -403,6 +429,23 @@ impl PyPiecewiseConstant1D {
             self.0.table().len()
         )
     }
+
+    /// Pickles as the values and interval it was built from.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Obj<'py>> {
+        let py = slf.py();
+        let this = &slf.get().0;
+        let values = PyArray1::from_slice(py, this.table().weights());
+        let (a, b) = this.domain();
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("a", a)?;
+        kwargs.set_item("b", b)?;
+        reduce(
+            slf.as_any(),
+            None,
+            PyTuple::new(py, [values])?,
+            Some(kwargs),
+        )
+    }
 }
 
 /// A piecewise-constant density on the rectangle
@@ -511,6 +554,22 @@ impl PyPiecewiseConstant2D {
         format!(
             "PiecewiseConstant2D(shape=({rows}, {cols}), domain={:?})",
             self.0.domain()
+        )
+    }
+
+    /// Pickles as the values and domain it was built from.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Obj<'py>> {
+        let py = slf.py();
+        let this = &slf.get().0;
+        let values = table_2d(py, this.table().weights(), this.table().shape())?;
+        let [x, y] = this.domain();
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("domain", ((x[0], x[1]), (y[0], y[1])))?;
+        reduce(
+            slf.as_any(),
+            None,
+            PyTuple::new(py, [values])?,
+            Some(kwargs),
         )
     }
 }

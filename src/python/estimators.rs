@@ -5,6 +5,7 @@ use super::args::{choice, heuristic_arg, index_arg, seed, three_floats};
 use super::envmap::PyEnvMap;
 use super::parallel::detached;
 use super::phong::PyPhong;
+use super::pickle::reduce;
 use crate::estimators::{self, Estimate, Plan, Strategy};
 use crate::python::Obj;
 use crate::sampler::Sampler;
@@ -43,6 +44,25 @@ impl PyEstimate {
     #[getter]
     fn strategy(&self) -> &'static str {
         self.strategy.name()
+    }
+
+    /// The estimate of these numbers (the unpickling constructor).
+    #[staticmethod]
+    #[doc(hidden)]
+    fn _from_fields(value: [f64; 3], stderr: [f64; 3], n: usize, strategy: &str) -> PyResult<Self> {
+        let strategy = choice("strategy", strategy, &[IRRADIANCE, REFLECTED].concat())?;
+        Ok(PyEstimate {
+            estimate: Estimate { value, stderr, n },
+            strategy,
+        })
+    }
+
+    /// Pickles as its numbers.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Obj<'py>> {
+        let this = slf.get();
+        let e = &this.estimate;
+        let args = (e.value, e.stderr, e.n, this.strategy.name()).into_pyobject(slf.py())?;
+        reduce(slf.as_any(), Some("_from_fields"), args, None)
     }
 
     fn __repr__(&self) -> String {

@@ -5,6 +5,7 @@ use super::arrays::{Check, Points, PyFloat, broadcast, finish, position, result_
 use super::arrays::{with_precision, zeros};
 use super::batch::map_into;
 use super::parallel::run_batch;
+use super::pickle::reduce;
 use crate::alloc;
 use crate::error::{Error, shape_str};
 use crate::frame::Frame;
@@ -12,6 +13,7 @@ use crate::math::Real;
 use crate::python::Obj;
 use numpy::PyArrayMethods;
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 
 /// An orthonormal frame (s, t, n) around a normal, built without a branch
 /// that breaks near +-z (Duff et al. 2017); right-handed, s x t = n. The
@@ -176,6 +178,43 @@ impl PyFrame {
 
     fn __len__(&self) -> usize {
         self.frames.len()
+    }
+
+    /// The frames of `frames` (`(..., 9)`: s, t and n of each), the
+    /// unpickling constructor (frames made once, copied bit for bit).
+    #[doc(hidden)]
+    #[staticmethod]
+    fn _from_frames(frames: &Obj<'_>) -> PyResult<Self> {
+        let rows = Points::<f64, 9>::extract(frames, "frames")?;
+        let frames = alloc::collect(
+            rows.rows().iter().map(|r| Frame {
+                s: [r[0], r[1], r[2]],
+                t: [r[3], r[4], r[5]],
+                n: [r[6], r[7], r[8]],
+            }),
+            "the frames",
+        )?;
+        Ok(PyFrame {
+            frames,
+            batch: rows.batch,
+        })
+    }
+
+    /// Pickles as its frames.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Obj<'py>> {
+        let py = slf.py();
+        let this = slf.get();
+        let mut flat = alloc::with_capacity(9 * this.frames.len(), "the frames")?;
+        flat.extend(this.frames.iter().flat_map(|f| [f.s, f.t, f.n]).flatten());
+        let mut shape = this.batch.clone();
+        shape.push(9);
+        let frames = numpy::PyArray1::from_vec(py, flat).reshape(shape)?;
+        reduce(
+            slf.as_any(),
+            Some("_from_frames"),
+            PyTuple::new(py, [frames])?,
+            None,
+        )
     }
 
     fn __repr__(&self) -> String {

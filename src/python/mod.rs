@@ -14,6 +14,7 @@ mod io;
 mod mis;
 mod parallel;
 mod phong;
+mod pickle;
 mod qmc;
 mod records;
 mod render;

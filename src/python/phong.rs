@@ -4,10 +4,12 @@
 use super::args::{choice, three_floats};
 use super::arrays::{Check, Points, PyFloat, result_shape, with_precision, zeros};
 use super::batch::{map_pair, pair_shape, run_batch_pair};
+use super::pickle::reduce;
 use crate::phong::{Phong, PhongSamples, Selection};
 use crate::python::Obj;
 use numpy::PyArrayMethods;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use super::records::record;
 
@@ -48,7 +50,7 @@ record! {
 ///     max(rho_s)) over channels, or the same with Rec. 709 luminance
 ///     (Mitsuba 0.6's rule).
 #[pyclass(module = "mcsample._core", name = "Phong", frozen)]
-pub struct PyPhong(Phong);
+pub struct PyPhong(Phong, &'static str);
 
 impl PyPhong {
     fn pair<'py, F: PyFloat, const M: usize>(
@@ -77,16 +79,19 @@ impl PyPhong {
         exponent: f64,
         selection: &str,
     ) -> PyResult<Self> {
-        let selection = choice(
+        let (selection, name) = choice(
             "selection",
             selection,
-            &[("max", Selection::Max), ("luminance", Selection::Luminance)],
+            &[
+                ("max", (Selection::Max, "max")),
+                ("luminance", (Selection::Luminance, "luminance")),
+            ],
         )?;
         let (d, s) = (
             three_floats(diffuse, "diffuse", true)?,
             three_floats(specular, "specular", true)?,
         );
-        Ok(Self(Phong::new(d, s, exponent, selection)?))
+        Ok(Self(Phong::new(d, s, exponent, selection)?, name))
     }
 
     /// BRDF values f_r(wi, wo) per RGB channel, without the cosine.
@@ -164,6 +169,16 @@ impl PyPhong {
             self.0.specular(),
             self.0.exponent()
         )
+    }
+
+    /// Pickles as the parameters it was built from.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Obj<'py>> {
+        let py = slf.py();
+        let this = slf.get();
+        let args = (this.0.diffuse(), this.0.specular(), this.0.exponent());
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("selection", this.1)?;
+        reduce(slf.as_any(), None, args.into_pyobject(py)?, Some(kwargs))
     }
 }
 

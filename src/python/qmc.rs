@@ -5,6 +5,7 @@
 use super::args::{choice, index_arg, seed};
 use super::arrays::zeros;
 use super::parallel::detached;
+use super::pickle::reduce;
 use super::rng::wants_float32;
 use crate::error::Error;
 use crate::math::Real;
@@ -134,7 +135,12 @@ fn filled<'py, F: Element + Real>(
 /// seed : int, None or numpy.random.Generator
 ///     The scramble's or pattern's random bits (default 0).
 #[pyclass(module = "mcsample._core.qmc", name = "Points", frozen)]
-pub struct PyPoints(Engine);
+pub struct PyPoints {
+    engine: Engine,
+    /// The constructor's arguments (for pickling).
+    kind: &'static str,
+    seed: u64,
+}
 
 #[pymethods]
 impl PyPoints {
@@ -147,38 +153,47 @@ impl PyPoints {
             Halton(bool),
             Pattern(Pattern),
         }
-        let kind = choice(
-            "kind",
-            kind,
-            &[
-                ("sobol", Kind::Sobol(Scramble::None)),
-                ("sobol-owen", Kind::Sobol(Scramble::Owen)),
-                ("sobol-lms", Kind::Sobol(Scramble::LinearMatrix)),
-                ("halton", Kind::Halton(false)),
-                ("halton-permuted", Kind::Halton(true)),
-                (
-                    "lhs",
-                    Kind::Pattern(Pattern::LatinHypercube { centered: false }),
-                ),
-                (
-                    "lhs-centered",
-                    Kind::Pattern(Pattern::LatinHypercube { centered: true }),
-                ),
-                ("stratified", Kind::Pattern(Pattern::Stratified)),
-                ("multijitter", Kind::Pattern(Pattern::MultiJitter)),
-            ],
-        )?;
+        let options = [
+            ("sobol", Kind::Sobol(Scramble::None)),
+            ("sobol-owen", Kind::Sobol(Scramble::Owen)),
+            ("sobol-lms", Kind::Sobol(Scramble::LinearMatrix)),
+            ("halton", Kind::Halton(false)),
+            ("halton-permuted", Kind::Halton(true)),
+            (
+                "lhs",
+                Kind::Pattern(Pattern::LatinHypercube { centered: false }),
+            ),
+            (
+                "lhs-centered",
+                Kind::Pattern(Pattern::LatinHypercube { centered: true }),
+            ),
+            ("stratified", Kind::Pattern(Pattern::Stratified)),
+            ("multijitter", Kind::Pattern(Pattern::MultiJitter)),
+        ];
+        let (kind, name) = choice("kind", kind, &options.map(|(n, k)| (n, (k, n))))?;
         let max_dims = match kind {
             Kind::Sobol(_) => crate::qmc::SOBOL_MAX_DIMENSIONS,
             Kind::Halton(_) => crate::qmc::HALTON_MAX_DIMENSIONS,
             Kind::Pattern(_) => crate::qmc::PATTERN_MAX_DIMENSIONS,
         };
         let d = index_arg(d, "d", 1, max_dims as u64)? as usize;
-        Ok(Self(match kind {
+        let engine = match kind {
             Kind::Sobol(scramble) => Engine::Sobol(Sobol::new(d, scramble, seed)?),
             Kind::Halton(scramble) => Engine::Halton(Halton::new(d, scramble, seed)?),
             Kind::Pattern(pattern) => Engine::Patterns(Patterns::new(pattern, d, seed)?),
-        }))
+        };
+        Ok(Self {
+            engine,
+            kind: name,
+            seed,
+        })
+    }
+
+    /// Pickles as its kind, dimensions and seed.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Obj<'py>> {
+        let this = slf.get();
+        let args = (this.kind, this.engine.dims(), this.seed).into_pyobject(slf.py())?;
+        reduce(slf.as_any(), None, args, None)
     }
 
     /// ``n`` points from ``start``: of a sequence, the points
@@ -204,13 +219,13 @@ impl PyPoints {
         dtype: Option<&Obj<'py>>,
     ) -> PyResult<Obj<'py>> {
         let start = index_arg(start, "start", 0, u64::MAX)?;
-        draw(py, &self.0, start, n, dtype)
+        draw(py, &self.engine, start, n, dtype)
     }
 
     /// The number of dimensions.
     #[getter]
     fn d(&self) -> usize {
-        self.0.dims()
+        self.engine.dims()
     }
 }
 

@@ -53,6 +53,20 @@ macro_rules! record {
                 true
             }
 
+            /// The record of these fields (the unpickling constructor).
+            #[staticmethod]
+            #[doc(hidden)]
+            fn _from_fields($($field: $crate::python::Obj<'_>),+) -> Self {
+                Self::new($($field),+)
+            }
+
+            /// Pickles as its fields.
+            fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<$crate::python::Obj<'py>> {
+                let this = slf.get();
+                let fields = $crate::python::records::tuple(slf.py(), &[$(&this.$field),+])?;
+                $crate::python::pickle::reduce(slf.as_any(), Some("_from_fields"), fields, None)
+            }
+
             fn __len__(&self) -> usize {
                 [$(stringify!($field)),+].len()
             }

@@ -3,6 +3,7 @@
 use super::args::{index_arg, seed};
 use super::arrays::{finish, zeros};
 use super::parallel::detached;
+use super::pickle::reduce;
 use crate::math::Real;
 use crate::python::Obj;
 use crate::rng::{MAX_STREAM, Rng};
@@ -107,6 +108,9 @@ pub struct PyRng {
     rng: Rng,
     seed: u64,
     stream: u64,
+    /// Outputs drawn or skipped since seeding, modulo 2^64 (PCG32's
+    /// period): with the seed and stream, the whole state.
+    drawn: u64,
 }
 
 #[pymethods]
@@ -121,7 +125,29 @@ impl PyRng {
             rng: Rng::new(seed, stream),
             seed,
             stream,
+            drawn: 0,
         })
+    }
+
+    /// The generator of `seed` and `stream` after `drawn` outputs (the
+    /// unpickling constructor).
+    #[staticmethod]
+    fn _from_position(seed: u64, stream: u64, drawn: u64) -> Self {
+        let mut rng = Rng::new(seed, stream);
+        rng.advance(drawn);
+        PyRng {
+            rng,
+            seed,
+            stream,
+            drawn,
+        }
+    }
+
+    /// Pickles as its seed, stream and position.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Obj<'py>> {
+        let this = slf.borrow();
+        let args = (this.seed, this.stream, this.drawn).into_pyobject(slf.py())?;
+        reduce(slf.as_any(), Some("_from_position"), args, None)
     }
 
     /// Uniform floats in [0, 1).
@@ -144,11 +170,13 @@ impl PyRng {
         dtype: Option<&Obj<'py>>,
     ) -> PyResult<Obj<'py>> {
         let shape = parse_shape(shape)?;
-        if wants_float32(py, dtype)? {
-            random_array::<f32>(py, &mut self.rng, &shape)
+        let values = if wants_float32(py, dtype)? {
+            random_array::<f32>(py, &mut self.rng, &shape)?
         } else {
-            random_array::<f64>(py, &mut self.rng, &shape)
-        }
+            random_array::<f64>(py, &mut self.rng, &shape)?
+        };
+        self.count(&shape);
+        Ok(values)
     }
 
     /// Raw 32-bit outputs.
@@ -168,6 +196,7 @@ impl PyRng {
     ) -> PyResult<Obj<'py>> {
         let shape = parse_shape(shape)?;
         let out: Bound<'py, PyArrayDyn<u32>> = zeros(py, &shape)?;
+        self.count(&shape);
         {
             let mut guard = out.readwrite();
             let flat = guard.as_slice_mut()?;
@@ -179,7 +208,9 @@ impl PyRng {
 
     /// Skips ``n`` outputs (0 <= n < 2**64) in O(log n) steps.
     fn advance(&mut self, n: &Obj<'_>) -> PyResult<()> {
-        self.rng.advance(index_arg(n, "n", 0, u64::MAX)?);
+        let n = index_arg(n, "n", 0, u64::MAX)?;
+        self.rng.advance(n);
+        self.drawn = self.drawn.wrapping_add(n);
         Ok(())
     }
 
@@ -210,6 +241,14 @@ impl PyRng {
 
     fn __repr__(&self) -> String {
         format!("Rng(seed={}, stream={})", self.seed, self.stream)
+    }
+}
+
+impl PyRng {
+    /// Counts the outputs an array of `shape` draws (one each).
+    fn count(&mut self, shape: &[usize]) {
+        let n = shape.iter().map(|&d| d as u64).product::<u64>();
+        self.drawn = self.drawn.wrapping_add(n);
     }
 }
 

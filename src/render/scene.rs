@@ -338,7 +338,7 @@ impl Scene {
     /// Density per steradian with which emitter sampling from the shading
     /// point `x` draws the direction `d` that reaches shape `shape` at
     /// distance `dist`, where its geometric normal is `ng`: the choice of
-    /// the light times [`Sphere::cone_pdf`] for a sphere seen from outside,
+    /// the light times [`Sphere::cone_pdf`](super::shape::Sphere::cone_pdf) for a sphere seen from outside,
     /// else `dist² / (|cos θ_light| A)` (uniform by area `A`, turned into
     /// solid angle).
     #[inline]

@@ -79,6 +79,11 @@ class Scene:
         return (f"Scene({shapes}; {lights} area lights; {env}; camera {c.width}x{c.height}, "
                 f"fov {c.fov:g} ({c.fov_axis}))")
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickles without the compiled scene (built again on first use,
+        to the same bits)."""
+        return {**self.__dict__, "_compiled": None}
+
     @classmethod
     def from_mitsuba(cls, d: Mapping[str, Any]) -> "Scene":
         """Reads a Mitsuba 3 scene dict (the subset in this module's doc).

@@ -7,6 +7,7 @@ use super::args::index_arg;
 use super::arrays::{Check, Points, PyFloat, finish, output, with_precision, writable, zeros};
 use super::batch::{map_each, map_into};
 use super::parallel::{detached, run_batch};
+use super::pickle::reduce;
 use super::records::record;
 use crate::alloc;
 use crate::envmap::{EnvMap, EnvSamples, Mapping, Options, TableFloat};
@@ -17,7 +18,7 @@ use input::{image_arg, mapping_arg, read_image, sampling_arg, to_world_arg};
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyDict, PyType};
+use pyo3::types::{PyBytes, PyDict, PyTuple, PyType};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -506,6 +507,18 @@ impl PyEnvMap {
             crate::io::encode_png(std::path::Path::new("EnvMap"), &raster, 0.0, true)
         })?;
         Ok(PyBytes::new(py, &png))
+    }
+
+    /// Pickles as its image and options (the tables are built again, to
+    /// the same bits).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Obj<'py>> {
+        let py = slf.py();
+        let kwargs = PyDict::new(py);
+        for key in ["mapping", "sampling", "scale", "compensate", "to_world"] {
+            kwargs.set_item(key, slf.getattr(key)?)?;
+        }
+        let image = slf.getattr("image")?;
+        reduce(slf.as_any(), None, PyTuple::new(py, [image])?, Some(kwargs))
     }
 
     fn __repr__(&self) -> String {
