@@ -1,6 +1,7 @@
 //! Image files: OpenEXR (read RGB / RGBA with half or float channels, write
-//! float or half), Radiance `.hdr` (RGBE, read) and PNG (write, tone-mapped
-//! with an exposure and the sRGB transfer curve).
+//! float or half, ZIP-compressed), Radiance `.hdr` (RGBE, read; signature
+//! `#?RADIANCE` or `#?RGBE`) and PNG (write, tone-mapped with an exposure
+//! and the sRGB transfer curve).
 //!
 //! Pixels are linear RGB(A) `f32`, row-major `(height, width, channels)`,
 //! row 0 at the top. Every failure is an [`Error::Io`] naming the path.
@@ -145,9 +146,13 @@ pub fn write_exr(path: &Path, image: &Raster, half: bool) -> Result<()> {
             AnyChannel::new(name, samples)
         })
         .collect();
-    let result = Image::from_channels((image.width, image.height), AnyChannels::sort(channels))
-        .write()
-        .to_file(path);
+    // ZIP in blocks of 16 scanlines: lossless, and it shrinks float data
+    // (RLE, the exr crate's default, barely does).
+    let size = (image.width, image.height);
+    let result =
+        Image::from_encoded_channels(size, Encoding::SMALL_LOSSLESS, AnyChannels::sort(channels))
+            .write()
+            .to_file(path);
     result.map_err(|e| io_error(path, format!("cannot write OpenEXR: {e}")))
 }
 
@@ -158,19 +163,26 @@ pub fn write_exr(path: &Path, image: &Raster, half: bool) -> Result<()> {
 /// truncated; [`Error::Argument`] for an image of more than
 /// [`MAX_PIXELS`]; [`Error::Memory`].
 pub fn read_hdr(path: &Path) -> Result<Raster> {
+    use image::ImageDecoder;
+    use std::io::{BufRead, Read};
     let cannot = |e: image::ImageError| io_error(path, format!("cannot read Radiance HDR: {e}"));
-    let reader = || -> Result<_> {
-        let mut reader = image::ImageReader::open(path).map_err(|e| io_error(path, e))?;
-        reader.set_format(image::ImageFormat::Hdr);
-        Ok(reader)
-    };
-    let (width, height) = reader()?.into_dimensions().map_err(cannot)?;
+    let file = std::fs::File::open(path).map_err(|e| io_error(path, e))?;
+    let mut file = std::io::BufReader::new(file);
+    // The signature line: `#?RADIANCE`, or `#?RGBE` as Mitsuba and other
+    // tools write it (the same format), which the decoder does not know.
+    let mut signature = Vec::new();
+    (&mut file)
+        .take(64)
+        .read_until(b'\n', &mut signature)
+        .map_err(|e| io_error(path, e))?;
+    if signature == b"#?RGBE\n" {
+        signature = b"#?RADIANCE\n".to_vec();
+    }
+    let source = std::io::BufReader::new(std::io::Cursor::new(signature).chain(file));
+    let decoder = image::codecs::hdr::HdrDecoder::new(source).map_err(cannot)?;
+    let (width, height) = decoder.dimensions();
     check_size(path, width as usize, height as usize, 3)?;
-    let mut reader = reader()?;
-    // The size is checked above; the decoder's own cap (512 MiB) would
-    // refuse maps of more than about 9.4 K x 4.7 K texels.
-    reader.no_limits();
-    let decoded = reader.decode().map_err(cannot)?;
+    let decoded = image::DynamicImage::from_decoder(decoder).map_err(cannot)?;
     let rgb = decoded.into_rgb32f();
     Ok(Raster {
         width: rgb.width() as usize,

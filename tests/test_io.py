@@ -6,6 +6,7 @@ import os
 import numpy as np
 import pytest
 
+import mcsample as mcs
 from mcsample import io
 
 
@@ -58,6 +59,34 @@ def test_hdr_read(tmp_path, image):
     # RGBE keeps 8 bits of mantissa relative to the pixel's largest channel.
     err = np.abs(back - image) / image.max(axis=2, keepdims=True)
     assert err.max() < 2**-7
+
+
+def test_hdr_written_by_mitsuba_reads_as_mitsuba_reads_it(tmp_path, image, mi):
+    """Mitsuba writes the signature ``#?RGBE`` (the same format as
+    ``#?RADIANCE``): the file reads, with Mitsuba's values to the bit, and
+    as the same bytes under the other signature."""
+    path = tmp_path / "m.hdr"
+    mi.Bitmap(np.ascontiguousarray(image[..., :3])).write(str(path))
+    assert path.read_bytes().startswith(b"#?RGBE\n")
+    ours = io.read_hdr(path)
+    theirs = np.array(mi.Bitmap(str(path)), dtype=np.float32)
+    assert np.array_equal(ours, theirs[..., :3])
+    renamed = tmp_path / "r.hdr"
+    renamed.write_bytes(b"#?RADIANCE\n" + path.read_bytes()[len(b"#?RGBE\n"):])
+    assert np.array_equal(io.read_hdr(renamed), ours)
+    env = mcs.EnvMap.load(path)
+    assert np.array_equal(env.image, ours)
+
+
+def test_exr_is_written_compressed(tmp_path):
+    """ZIP: a smooth float image shrinks well below its raw size (RLE, the
+    old default, kept it at 99 %)."""
+    y, x = np.mgrid[0:60, 0:160].astype(np.float32)
+    img = np.stack([np.sin(x / 9) + 2, np.cos(y / 7) + 2, x * y / 9600], axis=-1)
+    path = tmp_path / "z.exr"
+    io.write_exr(path, img)
+    assert path.stat().st_size < 0.8 * img.nbytes
+    assert np.array_equal(io.read_exr(path), img)
 
 
 @pytest.mark.parametrize("reader,name", [(io.read_exr, "t.exr"), (io.read_hdr, "t.hdr")])

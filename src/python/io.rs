@@ -38,7 +38,8 @@ fn from_numpy(image: &Obj<'_>) -> PyResult<Raster> {
 }
 
 /// Reads an OpenEXR file (first layer with R, G, B; half, float or uint
-/// channels).
+/// channels; the compressions the exr crate decodes). At most 2**28
+/// pixels.
 ///
 /// Parameters
 /// ----------
@@ -54,7 +55,8 @@ pub fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Obj<'py>> {
     to_numpy(py, raster)
 }
 
-/// Writes an OpenEXR file.
+/// Writes an OpenEXR file, ZIP-compressed (lossless, blocks of 16
+/// scanlines), one part, scanlines.
 ///
 /// Parameters
 /// ----------
@@ -69,7 +71,8 @@ pub fn write_exr(py: Python<'_>, path: PathBuf, image: &Obj<'_>, half: bool) -> 
     detached(py, || io::write_exr(&path, &raster, half))
 }
 
-/// Reads a Radiance RGBE (.hdr) file.
+/// Reads a Radiance RGBE (.hdr) file, with the signature ``#?RADIANCE``
+/// or ``#?RGBE`` (as Mitsuba writes it). At most 2**28 pixels.
 ///
 /// Parameters
 /// ----------
