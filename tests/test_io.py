@@ -140,3 +140,22 @@ def test_png_exposure_and_srgb(tmp_path):
     with pytest.raises(ValueError, match=r"image\[1, 2, 1\] = NaN"):
         io.write_png(path, img)
     assert os.path.getsize(path) > 0
+
+
+def test_envmap_load_clamps_negative_texels_with_a_warning(tmp_path, image):
+    """A file with a pixel of -1e-3 (left by compression or resampling)
+    loads, as Mitsuba's envmap loads it, its negatives clamped to 0 with a
+    warning; a NaN is still refused."""
+    img = image.copy()
+    img[2, 3, 1] = -1e-3
+    img[4, 5, 0] = -2.5
+    path = tmp_path / "neg.exr"
+    io.write_exr(path, img)
+    with pytest.warns(UserWarning, match=r"2 negative values \(the lowest -2.5\) clamped to 0"):
+        env = mcs.EnvMap.load(path)
+    assert np.array_equal(env.image, np.maximum(img, 0))
+    img = np.maximum(img, 0)
+    img[1, 1, 2] = np.nan
+    io.write_exr(path, img)
+    with pytest.raises(ValueError, match="NaN"):
+        mcs.EnvMap.load(path)

@@ -16,9 +16,10 @@ use crate::io::Raster;
 use crate::python::{Obj, Out};
 use input::{image_arg, mapping_arg, read_image, sampling_arg, to_world_arg};
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
-use pyo3::exceptions::PyTypeError;
+use pyo3::exceptions::{PyTypeError, PyUserWarning};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyTuple, PyType};
+use std::ffi::CString;
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -250,7 +251,11 @@ impl PyEnvMap {
     /// -y, +z, -z. The other parameters are as for ``EnvMap``, and
     /// keyword-only (and checked as ``EnvMap`` checks them).
     ///
-    /// Raises OSError naming the path for a file that cannot be read.
+    /// Negative values (which compression and resampling leave in many
+    /// files) are clamped to 0, as renderers do, with a ``UserWarning``
+    /// giving their count and the most negative; NaN or infinite values
+    /// are refused (ValueError). Raises OSError naming the path for a file
+    /// that cannot be read.
     #[classmethod]
     #[pyo3(
         signature = (path, **options),
@@ -270,7 +275,27 @@ impl PyEnvMap {
             Some(name) => mapping_arg(&name.extract::<String>()?)?,
             None => Mapping::LatLong,
         };
-        let (w, h, data) = detached(py, || read_image(&path, mapping))?;
+        let (w, h, mut data) = detached(py, || read_image(&path, mapping))?;
+        let (negative, lowest) =
+            data.iter_mut()
+                .filter(|v| **v < 0.0)
+                .fold((0usize, 0.0f32), |(n, low), v| {
+                    let low = low.min(*v);
+                    *v = 0.0;
+                    (n + 1, low)
+                });
+        if negative > 0 {
+            let message = format!(
+                "{}: {negative} negative values (the lowest {lowest}) clamped to 0",
+                path.display()
+            );
+            PyErr::warn(
+                py,
+                &py.get_type::<PyUserWarning>(),
+                &CString::new(message)?,
+                1,
+            )?;
+        }
         // The constructor's layout: (6, R, R, 3) for a cube map's stacked
         // faces, (H, W, 3) otherwise.
         let shape = if mapping == Mapping::Cube {
