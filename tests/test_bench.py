@@ -26,3 +26,13 @@ def test_numpy_references_compute_the_same_warp(name, numpy_impl, args):
     u[:5] = [[0.0, 0.0], [1.0, 1.0], [0.5, 0.5], [0.0, 1.0], [0.25, 0.75]]
     ours = getattr(mcs.warp, name)(u, *args)
     np.testing.assert_allclose(numpy_impl(u, *args), ours, rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.parametrize("suite", ["rng", "warps", "distr", "phong", "envmap", "qmc"])
+def test_kernel_suites_run(suite):
+    """Each kernel suite of ``python -m mcsample bench`` runs (here at a tiny
+    size, without Mitsuba) and times every case it lists."""
+    from mcsample.bench import SUITES
+
+    timings = SUITES[suite](2000, 1, None)
+    assert timings and all(t.seconds > 0 for t in timings)

@@ -196,13 +196,13 @@ impl PyRng {
     ) -> PyResult<Obj<'py>> {
         let shape = parse_shape(shape)?;
         let out: Bound<'py, PyArrayDyn<u32>> = zeros(py, &shape)?;
-        self.count(&shape);
         {
             let mut guard = out.readwrite();
             let flat = guard.as_slice_mut()?;
             let rng = &mut self.rng;
             detached(py, || rng.fill_u32(flat))?;
         }
+        self.count(&shape);
         finish(out)
     }
 

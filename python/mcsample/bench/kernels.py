@@ -9,7 +9,7 @@ import numpy as np
 
 import mcsample as mcs
 
-from .timing import Timing, measure, measure_side_by_side
+from .timing import Timing, measure, measure_alternating, measure_side_by_side
 
 
 def _numpy_concentric_disk(u: np.ndarray) -> np.ndarray:
