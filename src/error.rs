@@ -173,6 +173,28 @@ pub fn check_at_most(arg: &'static str, len: usize, max: usize) -> Result<()> {
     Ok(())
 }
 
+/// Checks a scalar parameter: `ok` says whether `value` of `arg` is
+/// valid.
+///
+/// # Errors
+/// [`Error::Parameter`] stating `requirement` when `ok` is false.
+pub fn check_parameter(
+    arg: &'static str,
+    value: f64,
+    ok: bool,
+    requirement: &'static str,
+) -> Result<()> {
+    if ok {
+        Ok(())
+    } else {
+        Err(Error::Parameter {
+            arg,
+            value,
+            requirement,
+        })
+    }
+}
+
 /// The plural ending of a count of `n`.
 fn plural(n: &usize) -> &'static str {
     if *n == 1 { "" } else { "s" }

@@ -7,7 +7,7 @@
 use super::args::choice;
 use super::arrays::{Check, Points, PyFloat, with_precision};
 use super::batch::map_into;
-use crate::error::Error;
+use crate::error::{Result, check_parameter};
 use crate::math::Real;
 use crate::python::{Obj, Out};
 use crate::warp;
@@ -31,7 +31,7 @@ macro_rules! warps {
             $x:ident: [$k:tt; $check:ident] $x_doc:literal
             $(, $p:ident: $pty:ty = $p_doc:literal)*
         ) -> [$m:tt] $result_doc:literal
-        = |$F:ident| $kernel:expr;
+        = |$F:ident| $(let $bound:pat_param = $check_param:expr;)* $kernel:expr;
     )*) => {$(
         #[pyfunction]
         #[pyo3(signature = ($($($q,)*)? $x $(, $p)*, *, out = None))]
@@ -57,6 +57,7 @@ macro_rules! warps {
         ) -> PyResult<Obj<'py>> {
             with_precision!($x, $F => {
                 let points = Points::<$F, $k>::extract($x, stringify!($x))?;
+                $(let $bound = $check_param;)*
                 let kernel = shaped::<$F, $k, $m, _>($kernel);
                 map_into(py, &points, Check::$check, out, kernel)
             })
@@ -90,89 +91,44 @@ fn shaped<F, const K: usize, const M: usize, G: Fn([F; K]) -> [F; M]>(kernel: G)
 }
 
 /// `exponent`, checked: finite and >= 0.
-fn exponent_arg<F: Real>(exponent: f64) -> PyResult<F> {
-    if exponent.is_finite() && exponent >= 0.0 {
-        Ok(F::c(exponent))
-    } else {
-        Err(Error::Parameter {
-            arg: "exponent",
-            value: exponent,
-            requirement: "must be finite and >= 0",
-        }
-        .into())
-    }
+fn exponent_arg<F: Real>(exponent: f64) -> Result<F> {
+    let ok = exponent.is_finite() && exponent >= 0.0;
+    check_parameter("exponent", exponent, ok, "must be finite and >= 0")?;
+    Ok(F::c(exponent))
 }
 
 /// `cos_cutoff`, checked: in [-1, 1).
-fn cos_cutoff_arg<F: Real>(cos_cutoff: f64) -> PyResult<F> {
-    if (-1.0..1.0).contains(&cos_cutoff) {
-        Ok(F::c(cos_cutoff))
-    } else {
-        Err(Error::Parameter {
-            arg: "cos_cutoff",
-            value: cos_cutoff,
-            requirement: "must lie in [-1, 1)",
-        }
-        .into())
-    }
+fn cos_cutoff_arg<F: Real>(cos_cutoff: f64) -> Result<F> {
+    let ok = (-1.0..1.0).contains(&cos_cutoff);
+    check_parameter("cos_cutoff", cos_cutoff, ok, "must lie in [-1, 1)")?;
+    Ok(F::c(cos_cutoff))
 }
 
 /// `(a, b, c)` of the nonuniform tent, checked: finite, `a ≤ b ≤ c`, `a < c`,
 /// and `c − a` finite in the kernel's precision.
-fn tent_args<F: Real>(a: f64, b: f64, c: f64) -> PyResult<(F, F, F)> {
-    let bad = |arg, value, requirement| {
-        Err(Error::Parameter {
-            arg,
-            value,
-            requirement,
-        }
-        .into())
-    };
+fn tent_args<F: Real>(a: f64, b: f64, c: f64) -> Result<(F, F, F)> {
     for (arg, value) in [("a", a), ("b", b), ("c", c)] {
-        if !value.is_finite() {
-            return bad(arg, value, "must be finite");
-        }
+        check_parameter(arg, value, value.is_finite(), "must be finite")?;
     }
-    if c <= a {
-        return bad("c", c, "must be greater than a");
-    }
-    if !(a..=c).contains(&b) {
-        return bad("b", b, "must lie in [a, c]");
-    }
+    check_parameter("c", c, c > a, "must be greater than a")?;
+    check_parameter("b", b, (a..=c).contains(&b), "must lie in [a, c]")?;
     let (a, b, c) = (F::c(a), F::c(b), F::c(c));
-    if !(c - a).is_finite() {
-        return bad(
-            "c",
-            c.f64(),
-            "c - a must be a finite number in the input's precision",
-        );
-    }
+    let width = c - a;
+    let requirement = "c - a must be a finite number in the input's precision";
+    check_parameter("c", c.f64(), width.is_finite(), requirement)?;
     Ok((a, b, c))
 }
 
 /// `(v0, v1)` of the linear warps, checked (finite, `>= 0`, not both 0)
 /// and divided by the larger (the density depends only on their ratio, and
 /// their squares then cannot overflow).
-fn linear_args<F: Real>(v0: f64, v1: f64) -> PyResult<(F, F)> {
+fn linear_args<F: Real>(v0: f64, v1: f64) -> Result<(F, F)> {
     for (arg, value) in [("v0", v0), ("v1", v1)] {
-        if !(value.is_finite() && value >= 0.0) {
-            return Err(Error::Parameter {
-                arg,
-                value,
-                requirement: "must be finite and >= 0",
-            }
-            .into());
-        }
+        let ok = value.is_finite() && value >= 0.0;
+        check_parameter(arg, value, ok, "must be finite and >= 0")?;
     }
     let larger = v0.max(v1);
-    if larger == 0.0 {
-        return Err(Error::Parameter {
-            arg: "v1",
-            value: v1,
-            requirement: "v0 and v1 must not both be 0",
-        }
-        .into());
-    }
+    check_parameter("v1", v1, larger > 0.0, "v0 and v1 must not both be 0")?;
     Ok((F::c(v0 / larger), F::c(v1 / larger)))
 }
 
@@ -260,11 +216,8 @@ warps! {
         u: [2; Unit] "values in [0, 1]",
         exponent: f64 = "float >= 0, the lobe's n"
     ) -> [3] "unit vectors; density (n + 1)/(2 pi) cos^n theta per sr"
-        = |F| {
-            let n = exponent_arg::<F>(exponent)?;
-            #[inline(always)]
-            move |u| warp::square_to_cosine_power_hemisphere(u, n)
-        };
+        = |F| let n = exponent_arg(exponent)?;
+            move |u| warp::square_to_cosine_power_hemisphere(u, n);
 
     /// Density of ``square_to_cosine_power_hemisphere``:
     /// (n + 1)/(2 pi) cos^n theta per steradian for cos theta > 0, else 0.
@@ -272,11 +225,8 @@ warps! {
         x: [3; Finite] "unit vectors",
         exponent: f64 = "float >= 0, the lobe's n"
     ) -> [1] "per steradian"
-        = |F| {
-            let n = exponent_arg::<F>(exponent)?;
-            #[inline(always)]
-            move |d| [warp::square_to_cosine_power_hemisphere_pdf(d, n)]
-        };
+        = |F| let n = exponent_arg(exponent)?;
+            move |d| [warp::square_to_cosine_power_hemisphere_pdf(d, n)];
 
     /// Inverse of ``square_to_cosine_power_hemisphere``:
     /// (phi / 2 pi, cos^(n+1) theta).
@@ -284,22 +234,16 @@ warps! {
         x: [3; Finite] "unit vectors with z >= 0",
         exponent: f64 = "float >= 0, the lobe's n"
     ) -> [2] "in [0, 1]^2"
-        = |F| {
-            let n = exponent_arg::<F>(exponent)?;
-            #[inline(always)]
-            move |d| warp::cosine_power_hemisphere_to_square(d, n)
-        };
+        = |F| let n = exponent_arg(exponent)?;
+            move |d| warp::cosine_power_hemisphere_to_square(d, n);
 
     /// Uniform directions in the cone cos theta >= cos_cutoff around +z.
     fn square_to_uniform_cone(
         u: [2; Unit] "values in [0, 1]",
         cos_cutoff: f64 = "float in [-1, 1)"
     ) -> [3] "unit vectors; density 1 / (2 pi (1 - cos_cutoff)) per sr"
-        = |F| {
-            let c = cos_cutoff_arg::<F>(cos_cutoff)?;
-            #[inline(always)]
-            move |u| warp::square_to_uniform_cone(u, c)
-        };
+        = |F| let c = cos_cutoff_arg(cos_cutoff)?;
+            move |u| warp::square_to_uniform_cone(u, c);
 
     /// Density of ``square_to_uniform_cone``: 1 / (2 pi (1 - cos_cutoff))
     /// per steradian inside the cone, else 0.
@@ -307,22 +251,16 @@ warps! {
         x: [3; Finite] "unit vectors",
         cos_cutoff: f64 = "float in [-1, 1)"
     ) -> [1] "per steradian"
-        = |F| {
-            let c = cos_cutoff_arg::<F>(cos_cutoff)?;
-            #[inline(always)]
-            move |d| [warp::square_to_uniform_cone_pdf(d, c)]
-        };
+        = |F| let c = cos_cutoff_arg(cos_cutoff)?;
+            move |d| [warp::square_to_uniform_cone_pdf(d, c)];
 
     /// Inverse of ``square_to_uniform_cone``.
     fn uniform_cone_to_square(
         x: [3; Finite] "unit vectors inside the cone",
         cos_cutoff: f64 = "float in [-1, 1)"
     ) -> [2] "in [0, 1]^2"
-        = |F| {
-            let c = cos_cutoff_arg::<F>(cos_cutoff)?;
-            #[inline(always)]
-            move |d| warp::uniform_cone_to_square(d, c)
-        };
+        = |F| let c = cos_cutoff_arg(cos_cutoff)?;
+            move |d| warp::uniform_cone_to_square(d, c);
 
     /// Uniform points on the triangle (0, 0), (1, 0), (0, 1):
     /// t = sqrt(1 - u0), point (1 - t, t u1).
@@ -345,29 +283,20 @@ warps! {
     /// x = u^(1/(n+1)).
     fn interval_to_power(u: [1; Unit] "values in [0, 1]", exponent: f64 = "float >= 0")
         -> [1] "in [0, 1]"
-        = |F| {
-            let n = exponent_arg::<F>(exponent)?;
-            #[inline(always)]
-            move |u: [F; 1]| [warp::interval_to_power(u[0], n)]
-        };
+        = |F| let n = exponent_arg(exponent)?;
+            move |u: [F; 1]| [warp::interval_to_power(u[0], n)];
 
     /// Density of ``interval_to_power``: (n + 1) x^n on [0, 1], else 0.
     fn interval_to_power_pdf(x: [1; Finite] "finite", exponent: f64 = "float >= 0")
         -> [1] "per unit length"
-        = |F| {
-            let n = exponent_arg::<F>(exponent)?;
-            #[inline(always)]
-            move |x: [F; 1]| [warp::interval_to_power_pdf(x[0], n)]
-        };
+        = |F| let n = exponent_arg(exponent)?;
+            move |x: [F; 1]| [warp::interval_to_power_pdf(x[0], n)];
 
     /// Inverse of ``interval_to_power``: u = x^(n+1).
     fn power_to_interval(x: [1; Finite] "values in [0, 1]", exponent: f64 = "float >= 0")
         -> [1] "in [0, 1]"
-        = |F| {
-            let n = exponent_arg::<F>(exponent)?;
-            #[inline(always)]
-            move |x: [F; 1]| [warp::power_to_interval(x[0], n)]
-        };
+        = |F| let n = exponent_arg(exponent)?;
+            move |x: [F; 1]| [warp::power_to_interval(x[0], n)];
 
     /// The tent 1 - |x| on [-1, 1] by inversion (Mitsuba's
     /// ``interval_to_tent``): s = u - 1/2, x = sign(s) (1 - sqrt(1 - 2|s|)).
@@ -406,11 +335,8 @@ warps! {
           c: f64 = "float > a, the right end" }
         d: [1; Unit] "values in [0, 1] (the sample)"
     ) -> [1] "in [a, c]"
-        = |F| {
-            let (a, b, c) = tent_args::<F>(a, b, c)?;
-            #[inline(always)]
-            move |u: [F; 1]| [warp::interval_to_nonuniform_tent(a, b, c, u[0])]
-        };
+        = |F| let (a, b, c) = tent_args(a, b, c)?;
+            move |u: [F; 1]| [warp::interval_to_nonuniform_tent(a, b, c, u[0])];
 
     /// The linear density on [0, 1] from v0 at 0 to v1 at 1 by inversion:
     /// x = (v0 - sqrt((1 - u) v0^2 + u v1^2)) / (v0 - v1) (x = u when the
@@ -420,22 +346,16 @@ warps! {
           v1: f64 = "float >= 0, its value at 1 (not both 0)" }
         sample: [1; Unit] "values in [0, 1]"
     ) -> [1] "in [0, 1]; density 2((1 - x) v0 + x v1)/(v0 + v1) per unit length"
-        = |F| {
-            let (v0, v1) = linear_args::<F>(v0, v1)?;
-            #[inline(always)]
-            move |u: [F; 1]| [warp::interval_to_linear(v0, v1, u[0])]
-        };
+        = |F| let (v0, v1) = linear_args(v0, v1)?;
+            move |u: [F; 1]| [warp::interval_to_linear(v0, v1, u[0])];
 
     /// Inverse of ``interval_to_linear``: u = x (x v1 + (2 - x) v0)/(v0 + v1).
     fn linear_to_interval(
         { v0: f64 = "float >= 0", v1: f64 = "float >= 0 (not both 0)" }
         sample: [1; Finite] "values in [0, 1]"
     ) -> [1] "in [0, 1]"
-        = |F| {
-            let (v0, v1) = linear_args::<F>(v0, v1)?;
-            #[inline(always)]
-            move |x: [F; 1]| [warp::linear_to_interval(v0, v1, x[0])]
-        };
+        = |F| let (v0, v1) = linear_args(v0, v1)?;
+            move |x: [F; 1]| [warp::linear_to_interval(v0, v1, x[0])];
 
     /// The concentric map's polar coordinates as a point of the square
     /// (Mitsuba's ``square_to_uniform_square_concentric``): (phi / 2 pi,
