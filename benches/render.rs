@@ -13,7 +13,9 @@ use mcsample::envmap::{EnvMap, Options};
 use mcsample::phong::{Phong, Selection};
 use mcsample::render::camera::{Camera, FovAxis};
 use mcsample::render::scene::{Environment, Geometry, Material, Shape};
-use mcsample::render::{Heuristic, Integrator, Progress, Scene, Settings, Strategy, render};
+use mcsample::render::{
+    Heuristic, Integrator, Progress, Samples, Scene, Settings, Strategy, render,
+};
 use mcsample::sampler::Sampler;
 
 const SIZE: usize = 256;
@@ -116,7 +118,14 @@ fn main() {
             let mut times: Vec<f64> = (0..5)
                 .map(|seed| {
                     let start = Instant::now();
-                    render(&scene, SPP, seed, &settings, &Progress::default()).expect("render");
+                    render(
+                        &scene,
+                        Samples::all(SPP),
+                        seed,
+                        &settings,
+                        &Progress::default(),
+                    )
+                    .expect("render");
                     start.elapsed().as_secs_f64()
                 })
                 .collect();

@@ -13,7 +13,7 @@ import warnings
 from typing import Any, Callable, Literal
 
 from ._core.render import render as _render
-from .results import RenderResult
+from .results import Chunk, RenderResult
 from .estimators import Sampler
 from .scene import Scene
 from .scene.parse import MITSUBA_SAMPLERS
@@ -46,7 +46,8 @@ def render(scene: Scene, spp: int | None = None, *,
            strategy: Literal["bsdf", "emitter", "mis"] = "mis",
            heuristic: Literal["balance", "power"] = "power", max_depth: int | None = None,
            rr_depth: int | None = None, seed: SeedLike = 0, progress: bool = True,
-           hide_emitters: bool | None = None, sampler: Sampler | None = None) -> RenderResult:
+           hide_emitters: bool | None = None, sampler: Sampler | None = None,
+           first_sample: int | None = None, total_spp: int | None = None) -> RenderResult:
     """Renders ``scene`` with ``spp`` samples per pixel.
 
     Parameters
@@ -85,7 +86,8 @@ def render(scene: Scene, spp: int | None = None, *,
         Where each pixel's uniform numbers come from. Default: the scene
         dict's sensor sampler (Mitsuba's ``stratified``, ``multijitter``,
         ``orthogonal`` (as "multijitter") and ``ldsampler`` (as "sobol")),
-        else "independent", which keeps the bits of every earlier release.
+        else "independent": PCG32 numbers, a generator for each sample
+        (seeded by its pixel and its index in the pixel's sequence).
         "stratified" and "multijitter" jitter the strata of a grid (Mitsuba's
         samplers of those names); "sobol" is padded Owen-scrambled Sobol'
         (pbrt-v4's PaddedSobolSampler: each request a (0, m, 2)-net of the
@@ -100,6 +102,20 @@ def render(scene: Scene, spp: int | None = None, *,
         Under these samplers a pixel's samples are not independent, and
         ``variance`` (that of independent samples) usually overstates the
         error. The nets and blocks above are whole for power-of-two spp.
+
+    first_sample : int, optional
+        Render samples ``first_sample .. first_sample + spp - 1`` of each
+        pixel's sequence: a chunk of a larger render. The result keeps the
+        sums :meth:`RenderResult.merge` needs (8 float64 per pixel for each
+        power-of-two block of samples the chunk holds: one block when
+        ``spp`` is a power of two and ``first_sample`` a multiple of it), and
+        the merge of chunks covering samples ``0 .. S-1`` has the same bits
+        as one render of ``S`` spp with the same seed and settings.
+    total_spp : int, optional
+        Length of the sequence the chunk is part of (default
+        ``first_sample + spp``): the "stratified", "multijitter", "sobol"
+        and "zsobol" samplers lay their patterns over it, so the chunks of
+        one render must all give it (the independent sampler ignores it).
 
     Everything after ``spp`` is keyword-only.
 
@@ -116,15 +132,22 @@ def render(scene: Scene, spp: int | None = None, *,
         sampler = MITSUBA_SAMPLERS[scene.camera.sampler][1]  # type: ignore[assignment]
     height, width = scene.shape
     callback, bar = _progress_bar(width * height * max(int(spp), 1), progress)
+    seed = resolve_seed(seed)
     start = time.perf_counter()
     try:
-        image, variance, lum_var = _render(
-            scene.compiled, spp, resolve_seed(seed), settings["integrator"], strategy, heuristic,
+        image, variance, lum_var, blocks, sums = _render(
+            scene.compiled, spp, seed, settings["integrator"], strategy, heuristic,
             settings["max_depth"], settings["rr_depth"], settings["hide_emitters"], callback,
-            sampler)
+            sampler, first_sample, total_spp, first_sample is not None)
     finally:
         if bar is not None:
             bar.close()
     seconds = time.perf_counter() - start
+    first = blocks[0][0] if blocks else 0
+    chunk = None
+    if sums is not None:
+        total = first + int(spp) if total_spp is None else int(total_spp)
+        chunk = Chunk(blocks, sums, (scene.shape, seed, sampler, total, strategy, heuristic,
+                                     tuple(sorted(settings.items()))))
     return RenderResult(image.reshape(height, width, 3), variance.reshape(height, width, 3),
-                        lum_var.reshape(height, width), int(spp), seconds)
+                        lum_var.reshape(height, width), int(spp), seconds, first, chunk)

@@ -8,11 +8,11 @@ the rest of mcsample.
 from __future__ import annotations
 
 import dataclasses
-from typing import Any, Iterator
+from typing import Any, Iterable, Iterator
 
 import numpy as np
 
-__all__ = ["EmitterSample", "RenderResult", "Result", "TupleResult", "describe"]
+__all__ = ["Chunk", "EmitterSample", "RenderResult", "Result", "TupleResult", "describe"]
 
 
 def describe(value: Any) -> str:
@@ -62,6 +62,28 @@ class TupleResult(Result):
         return len(self._unpack)
 
 
+@dataclasses.dataclass(frozen=True, repr=False)
+class Chunk(Result):
+    """What :meth:`RenderResult.merge` needs of a chunk of a render.
+
+    Attributes
+    ----------
+    blocks : list of (int, int)
+        The chunk's samples as blocks ``(start, length)``: lengths are
+        powers of two, each start a multiple of its length; the pixel sums
+        are kept per block so that merges add them in one fixed order.
+    sums : ndarray (H * W * len(blocks) * 8,) float64
+        Per pixel and block: the sums of R, G, B, their squares, the
+        luminance and its square.
+    key : tuple
+        Shape, seed, sampler, sequence length and settings of the render.
+    """
+
+    blocks: list[tuple[int, int]]
+    sums: np.ndarray
+    key: tuple[Any, ...]
+
+
 @dataclasses.dataclass(repr=False)
 class RenderResult(Result):
     """A rendered image.
@@ -79,7 +101,12 @@ class RenderResult(Result):
     spp : int
         Samples per pixel.
     seconds : float
-        Wall-clock time of the render.
+        Wall-clock time of the render (of every chunk, for a merge).
+    first_sample : int
+        Index of the first sample in each pixel's sequence (0 unless
+        rendered with ``first_sample=``).
+    chunk : Chunk or None
+        What :meth:`merge` needs: kept by renders given ``first_sample``.
 
     In a notebook, a RenderResult shows as its tone-mapped image.
     """
@@ -89,6 +116,49 @@ class RenderResult(Result):
     luminance_variance: np.ndarray
     spp: int
     seconds: float
+    first_sample: int = 0
+    chunk: Chunk | None = None
+
+    _hidden = ("chunk",)
+
+    @classmethod
+    def merge(cls, results: Iterable[RenderResult]) -> RenderResult:
+        """The render of the samples that ``results`` cover together.
+
+        ``results`` are chunks of one render (``mcsample.render`` with the
+        same scene, seed and settings, each with ``first_sample=``), in any
+        order, covering consecutive samples without gaps or overlaps. The
+        merge of chunks covering samples ``0 .. S-1`` has the same bits
+        (image and variances) as one render of ``S`` spp; it can be merged
+        again with the chunks that follow it.
+
+        Raises ValueError for chunks of different renders (shape, seed,
+        sampler, ``total_spp`` or settings), with gaps or overlaps, or
+        rendered without ``first_sample``.
+        """
+        from ._core.render import merge
+
+        results = sorted(results, key=lambda r: r.first_sample)
+        if not results:
+            raise ValueError("results is empty: nothing to merge")
+        for r in results:
+            if not isinstance(r, RenderResult) or r.chunk is None:
+                raise ValueError(
+                    "results must be RenderResults of renders given first_sample= (which keep "
+                    "the sums a merge needs)")
+        key = results[0].chunk.key  # type: ignore[union-attr]
+        for r in results[1:]:
+            if r.chunk.key != key:  # type: ignore[union-attr]
+                raise ValueError(
+                    "results are chunks of different renders: shape, seed, sampler, total_spp "
+                    f"or settings differ ({key} and {r.chunk.key})")  # type: ignore[union-attr]
+        height, width = results[0].image.shape[:2]
+        image, variance, lum_var, blocks, sums = merge(
+            [(r.chunk.blocks, r.chunk.sums) for r in results], height * width)  # type: ignore[union-attr]
+        spp = sum(length for _, length in blocks)
+        return cls(image.reshape(height, width, 3), variance.reshape(height, width, 3),
+                   lum_var.reshape(height, width), spp, sum(r.seconds for r in results),
+                   results[0].first_sample, Chunk(blocks, sums, key))
 
     @property
     def luminance(self) -> np.ndarray:

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use std::sync::mpsc;
 use std::time::Duration;
 
-use numpy::{PyArray1, PyReadonlyArray2};
+use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use glam::Vec3A;
@@ -20,8 +20,9 @@ use super::phong::PyPhong;
 use crate::alloc;
 use crate::error::Error;
 use crate::render::camera::{Camera, FovAxis};
+use crate::render::film::{self, Block};
 use crate::render::scene::{Environment, Geometry, Material, Shape, affine};
-use crate::render::{Integrator, Progress, Scene, Settings, Strategy};
+use crate::render::{Integrator, Progress, Samples, Scene, Settings, Strategy};
 use crate::sampler::Sampler;
 
 fn rows<'py, T: numpy::Element + Copy, const K: usize>(
@@ -291,14 +292,17 @@ impl PyScene {
     }
 }
 
-/// Renders ``scene``; returns ``(image, variance, luminance_variance)`` as
-/// flat float32 arrays of ``height * width * 3`` (the last ``height *
-/// width``). ``callback(samples_done)`` is
+/// Renders samples ``first_sample .. first_sample + spp`` of each pixel's
+/// sequence of ``total_spp`` (default ``first_sample + spp``) of ``scene``;
+/// returns ``(image, variance, luminance_variance, blocks, sums)``: flat
+/// float32 arrays of ``height * width * 3`` (the third ``height * width``),
+/// the samples' blocks as ``(start, length)`` pairs, and (when
+/// ``keep_sums``) their float64 sums, 8 per pixel and block, else None.
+/// ``callback(samples_done)`` is
 /// called about ten times a second, holding the GIL; a pending signal (such
 /// as Ctrl-C) stops the render and is raised once its threads have stopped.
 #[pyfunction]
-#[allow(clippy::type_complexity)]
-#[pyo3(signature = (scene, spp, seed, integrator, strategy, heuristic, max_depth, rr_depth, hide_emitters = false, callback = None, sampler = "independent"))]
+#[pyo3(signature = (scene, spp, seed, integrator, strategy, heuristic, max_depth, rr_depth, hide_emitters = false, callback = None, sampler = "independent", first_sample = None, total_spp = None, keep_sums = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -313,12 +317,25 @@ pub fn render<'py>(
     hide_emitters: bool,
     callback: Option<Obj<'py>>,
     sampler: &str,
-) -> PyResult<(
-    Bound<'py, PyArray1<f32>>,
-    Bound<'py, PyArray1<f32>>,
-    Bound<'py, PyArray1<f32>>,
-)> {
+    first_sample: Option<Obj<'py>>,
+    total_spp: Option<Obj<'py>>,
+    keep_sums: bool,
+) -> PyResult<Film<'py>> {
     let spp = index_arg(spp, "spp", 1, u64::from(u32::MAX))? as u32;
+    let first = match first_sample {
+        Some(k) => index_arg(&k, "first_sample", 0, u64::MAX - u64::from(spp))?,
+        None => 0,
+    };
+    let total = match total_spp {
+        Some(t) => index_arg(&t, "total_spp", first + u64::from(spp), u64::MAX)?,
+        None => first + u64::from(spp),
+    };
+    let samples = Samples {
+        first,
+        count: spp,
+        total,
+        keep_sums,
+    };
     let seed = seed_arg(seed, "seed")?;
     let rr_depth = index_arg(rr_depth, "rr_depth", 0, u64::from(u32::MAX))? as u32;
     let settings = Settings {
@@ -350,7 +367,7 @@ pub fn render<'py>(
         std::thread::spawn(move || {
             let result = guarded(|| {
                 Ok(crate::render::render(
-                    &scene, spp, seed, &settings, &progress,
+                    &scene, samples, seed, &settings, &progress,
                 )?)
             });
             // The receiver outlives this thread (it joins it).
@@ -392,10 +409,62 @@ pub fn render<'py>(
     };
     let _ = worker.join();
     let image = outcome?;
-    Ok((
-        PyArray1::from_vec(py, image.mean),
-        PyArray1::from_vec(py, image.variance),
-        PyArray1::from_vec(py, image.luminance_variance),
+    Ok(film(
+        py,
+        [image.mean, image.variance, image.luminance_variance],
+        &image.blocks,
+        keep_sums.then_some(image.sums),
+    ))
+}
+
+/// What [`render`] and [`merge`] return: image, variance, luminance
+/// variance, blocks, sums.
+type Film<'py> = (
+    Bound<'py, PyArray1<f32>>,
+    Bound<'py, PyArray1<f32>>,
+    Bound<'py, PyArray1<f32>>,
+    Vec<(u64, u64)>,
+    Option<Bound<'py, PyArray1<f64>>>,
+);
+
+fn film<'py>(
+    py: Python<'py>,
+    [mean, variance, luminance_variance]: [Vec<f32>; 3],
+    blocks: &[Block],
+    sums: Option<Vec<f64>>,
+) -> Film<'py> {
+    (
+        PyArray1::from_vec(py, mean),
+        PyArray1::from_vec(py, variance),
+        PyArray1::from_vec(py, luminance_variance),
+        blocks.iter().map(|b| (b.start, b.len)).collect(),
+        sums.map(|s| PyArray1::from_vec(py, s)),
+    )
+}
+
+/// A chunk of a render: its blocks as `(start, length)` and its sums.
+type Chunk<'py> = (Vec<(u64, u64)>, PyReadonlyArray1<'py, f64>);
+
+/// Merges chunks of one render: ``chunks`` is a list of ``(blocks, sums)``
+/// as :func:`render` returns them with ``keep_sums``, in sample order, for a
+/// film of ``pixels`` pixels; returns what :func:`render` returns for the
+/// samples they cover (the same bits as rendering those samples at once).
+#[pyfunction]
+pub fn merge<'py>(py: Python<'py>, chunks: Vec<Chunk<'py>>, pixels: usize) -> PyResult<Film<'py>> {
+    let mut parts = Vec::with_capacity(chunks.len());
+    for (blocks, sums) in &chunks {
+        let blocks = blocks
+            .iter()
+            .map(|&(start, len)| Block::checked(start, len))
+            .collect::<Result<Vec<_>, _>>()?;
+        parts.push((blocks, sums.as_slice()?));
+    }
+    let merged = py.detach(|| film::merge(&parts, pixels))?;
+    Ok(film(
+        py,
+        [merged.mean, merged.variance, merged.luminance_variance],
+        &merged.blocks,
+        Some(merged.sums),
     ))
 }
 
@@ -404,5 +473,6 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PySceneBuilder>()?;
     m.add_class::<PyScene>()?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(merge, m)?)?;
     Ok(())
 }

@@ -5,11 +5,14 @@
 //!
 //! Pixel `(x, y)` is the mean of `spp` samples at uniform positions inside
 //! it (a box filter of radius ½, as Mitsuba's `box`); its variance is that of
-//! the mean, `s² / spp` with `s²` the unbiased sample variance. Each pixel
-//! draws from its own [`Stream`] of the settings' [`Sampler`] (keyed by
-//! `seed` and the pixel index; the independent sampler's PCG32 stream is
-//! seeded the same way), so the image does not depend on the thread count
-//! or on the order in which rows are rendered. The dimensions each random
+//! the mean, `s² / spp` with `s²` the unbiased sample variance, both from
+//! sums that merge exactly ([`film`]). Each pixel draws from its own
+//! [`Stream`] of the settings' [`Sampler`] (keyed by `seed` and the pixel
+//! index), and each sample of the independent sampler from a PCG32
+//! generator of its own (keyed by the pixel's key and the sample's index),
+//! so the image does not depend on the thread count, on the order in which
+//! rows are rendered, or on which samples were rendered before: a render of
+//! samples `k .. k + n` ([`Samples`]) is a chunk of a larger one. The dimensions each random
 //! decision takes are listed in [`integrator::dims`].
 //!
 //! Samples are rendered in batches of about `BATCH` (whole pixels of one
@@ -27,6 +30,7 @@
 
 pub mod accel;
 pub mod camera;
+pub mod film;
 pub mod geometry;
 pub mod integrator;
 pub mod mesh_file;
@@ -44,12 +48,12 @@ pub use scene::Scene;
 
 use crate::alloc;
 use crate::error::Result;
-use crate::math::luminance;
 use crate::parallel;
 use crate::rng::Rng;
 use crate::sampler::zorder::ZOrder;
 use crate::sampler::{Sampler, Stream};
 use accel::Hit;
+use film::{Block, Sums, Tree};
 use integrator::Escaped;
 use shape::Ray;
 
@@ -68,8 +72,61 @@ pub struct Image {
     /// Variance of each pixel's mean luminance (Rec. 709 Y of the samples),
     /// which accounts for the correlation between channels.
     pub luminance_variance: Vec<f32>,
+    /// The samples rendered: their blocks ([`film`]), the same for every
+    /// pixel.
+    pub blocks: Vec<Block>,
+    /// The [`Sums`] of each pixel's blocks, pixel by pixel (row-major, then
+    /// block), when [`Samples::keep_sums`] asked for them; else empty.
+    pub sums: Vec<f64>,
     /// Whether `cancel` stopped the render before every row was done.
     pub cancelled: bool,
+}
+
+/// Which samples of each pixel's sequence a render takes.
+#[derive(Clone, Copy, Debug)]
+pub struct Samples {
+    /// The first sample's index in the sequence.
+    pub first: u64,
+    /// Samples per pixel.
+    pub count: u32,
+    /// Length of the sequence (at least `first + count`): the count that
+    /// the stratified and Sobol' samplers lay their patterns over.
+    pub total: u64,
+    /// Whether to return each pixel's [`Sums`] (to merge chunks later).
+    pub keep_sums: bool,
+}
+
+impl Samples {
+    /// All `spp` samples of a sequence of `spp`, sums not kept.
+    pub fn all(spp: u32) -> Self {
+        Samples {
+            first: 0,
+            count: spp,
+            total: u64::from(spp),
+            keep_sums: false,
+        }
+    }
+}
+
+/// Draws the independent sampler takes before a sample's path: film and
+/// lens positions.
+const CAMERA_DRAWS: u64 = 4;
+
+/// Moves `stream` (of the pixel with index `pixel` and key `key`) to
+/// sample `index`. The independent sampler restarts from a PCG32 generator
+/// of the sample's own (seeded by the pixel's key and `index`, on stream
+/// `pixel`), `skip` draws in: the numbers of a sample do not depend on
+/// which samples were rendered before it, so a chunk of samples draws what
+/// a whole render draws.
+#[inline]
+fn start_sample(stream: &mut Stream, key: u64, pixel: u64, index: u64, skip: u64) {
+    // Other samplers index their patterns with it (their sequences have at
+    // most u32::MAX samples, `Sampler::max_count`).
+    stream.start(index as u32);
+    if let Some(rng) = stream.independent() {
+        *rng = Rng::new(mix(key, index), pixel);
+        rng.advance(skip);
+    }
 }
 
 /// State shared with whoever watches a render from another thread.
@@ -97,6 +154,8 @@ struct Batch {
     rays: Vec<Ray>,
     /// Where each camera ray first meets the scene.
     hits: Vec<Option<Hit>>,
+    /// One pixel's sums at a time.
+    tree: Tree<Sums>,
 }
 
 impl Batch {
@@ -110,10 +169,11 @@ impl Batch {
         scene: &Scene,
         settings: &Settings,
         seed: u64,
-        spp: u32,
+        samples: Samples,
         y: usize,
         pixels: std::ops::Range<usize>,
     ) -> Result<()> {
+        let spp = samples.count;
         let (width, height) = scene.film();
         let (inv_width, inv_height) = (1.0 / width as f32, 1.0 / height as f32);
         self.escaped.clear();
@@ -136,14 +196,14 @@ impl Batch {
                 settings.sampler,
                 key,
                 Rng::new(key, pixel),
-                u64::from(spp),
-                ZOrder::new((x, y), (width, height), u64::from(spp), seed),
+                samples.total,
+                ZOrder::new((x, y), (width, height), samples.total, seed),
             );
             // A pinhole ignores the lens: only the independent sampler,
             // whose draws come in order, must draw it.
             let lens_drawn = scene.camera().has_lens() || stream.independent().is_some();
-            for i in 0..spp {
-                stream.start(i);
+            for i in 0..u64::from(spp) {
+                start_sample(&mut stream, key, pixel, samples.first + i, 0);
                 let film = stream.get2::<f32>(dims::FILM);
                 let lens = if lens_drawn {
                     stream.get2(dims::LENS)
@@ -154,7 +214,7 @@ impl Batch {
                 let film_y = (y as f32 + film[1]) * inv_height;
                 self.camera_u.push([film_x, film_y, lens[0], lens[1]]);
             }
-            streams.push(stream);
+            streams.push((stream, key, pixel));
         }
         self.rays.resize(self.camera_u.len(), Ray::default());
         scene.camera().rays_into(&self.camera_u, &mut self.rays);
@@ -169,9 +229,9 @@ impl Batch {
         }));
         let spp = spp.max(1) as usize;
         let per_pixel = self.rays.chunks(spp).zip(self.hits.chunks(spp));
-        for (mut stream, (rays, hits)) in streams.into_iter().zip(per_pixel) {
-            for (i, (ray, hit)) in (0..).zip(rays.iter().zip(hits)) {
-                stream.start(i);
+        for ((mut stream, key, pixel), (rays, hits)) in streams.into_iter().zip(per_pixel) {
+            for (i, (ray, hit)) in (samples.first..).zip(rays.iter().zip(hits)) {
+                start_sample(&mut stream, key, pixel, i, CAMERA_DRAWS);
                 let slot = self.radiance.len() as u32;
                 let l = integrator::radiance(
                     scene,
@@ -190,47 +250,6 @@ impl Batch {
     }
 }
 
-/// A pixel's estimate from its samples.
-struct Moments {
-    /// Mean per channel.
-    mean: [f32; 3],
-    /// Variance of the mean per channel, `s²/n` (infinite for fewer than 2
-    /// samples).
-    variance: [f32; 3],
-    /// Variance of the mean luminance.
-    luminance_variance: f32,
-}
-
-/// Mean and variances of a pixel's `samples`, accumulated in `f64`.
-fn moments(samples: &[[f32; 3]]) -> Moments {
-    let n = samples.len() as f64;
-    let variance_of_mean = |sum: f64, sum_sq: f64| -> f32 {
-        if samples.len() > 1 {
-            (((sum_sq - sum * sum / n) / (n - 1.0)).max(0.0) / n) as f32
-        } else {
-            f32::INFINITY
-        }
-    };
-    let mut sum = [0.0f64; 3];
-    let mut sum_sq = [0.0f64; 3];
-    let (mut sum_y, mut sum_y_sq) = (0.0f64, 0.0f64);
-    for l in samples {
-        let l = l.map(f64::from);
-        for k in 0..3 {
-            sum[k] += l[k];
-            sum_sq[k] += l[k] * l[k];
-        }
-        let y = luminance(l);
-        sum_y += y;
-        sum_y_sq += y * y;
-    }
-    Moments {
-        mean: sum.map(|s| (s / n.max(1.0)) as f32),
-        variance: std::array::from_fn(|k| variance_of_mean(sum[k], sum_sq[k])),
-        luminance_variance: variance_of_mean(sum_y, sum_y_sq),
-    }
-}
-
 /// SplitMix64's finaliser: a well-mixed 64-bit state from the seed and the
 /// pixel index.
 fn mix(seed: u64, pixel: u64) -> u64 {
@@ -240,57 +259,95 @@ fn mix(seed: u64, pixel: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Renders `scene` with `spp` samples per pixel, rows in parallel on
-/// mcsample's thread pool. `progress` counts samples as rows finish and is
-/// polled for cancellation once per pixel.
+/// Renders samples `samples.first ..` (`samples.count` per pixel) of
+/// `scene`, rows in parallel on mcsample's thread pool. `progress` counts
+/// samples as rows finish and is polled for cancellation once per pixel.
 ///
 /// # Errors
-/// [`crate::Error::Integer`] naming `spp` when the sampler cannot make that
-/// many samples per pixel ([`Sampler::max_count`], [`ZOrder::check`]), and
+/// [`crate::Error::Integer`] naming `spp` when the sampler cannot make a
+/// sequence of `samples.total` samples per pixel ([`Sampler::max_count`],
+/// [`ZOrder::check`]), or when `samples.first + samples.count` exceeds it;
+/// [`crate::Error::Memory`] when the film does not fit in memory; and
 /// when the thread pool cannot start.
 pub fn render(
     scene: &Scene,
-    spp: u32,
+    samples: Samples,
     seed: u64,
     settings: &Settings,
     progress: &Progress,
 ) -> Result<Image> {
     let (width, height) = scene.film();
-    settings.sampler.check_count("spp", u64::from(spp))?;
-    if settings.sampler == Sampler::ZSobol {
-        ZOrder::check((width, height), u64::from(spp))?;
+    settings.sampler.check_count("spp", samples.total)?;
+    if samples.first.saturating_add(u64::from(samples.count)) > samples.total {
+        return Err(crate::Error::Integer {
+            arg: "first_sample",
+            value: samples.first.to_string(),
+            requirement: format!(
+                "first_sample + spp must be at most total_spp = {}",
+                samples.total
+            ),
+        });
     }
-    let mut mean = alloc::filled(width * height * 3, 0.0f32, "the film's means")?;
-    let mut variance = alloc::filled(width * height * 3, 0.0f32, "the film's variances")?;
-    let mut luminance_variance = alloc::filled(width * height, 0.0f32, "the film's variances")?;
+    if settings.sampler == Sampler::ZSobol {
+        ZOrder::check((width, height), samples.total)?;
+    }
+    let spp = samples.count.max(1) as usize;
+    let blocks = film::blocks(samples.first, u64::from(samples.count));
+    let pixels = width * height;
+    let mut mean = alloc::filled(pixels * 3, 0.0f32, "the film's means")?;
+    let mut variance = alloc::filled(pixels * 3, 0.0f32, "the film's variances")?;
+    let mut luminance_variance = alloc::filled(pixels, 0.0f32, "the film's variances")?;
+    let sums_per_pixel = if samples.keep_sums {
+        blocks.len() * 8
+    } else {
+        0
+    };
+    let mut sums = alloc::filled(pixels * sums_per_pixel, 0.0f64, "the film's sums")?;
+    // Each row's share of the sums (empty when they are not kept).
+    let mut sums_rows: Vec<&mut [f64]> = alloc::with_capacity(height, "the film's rows")?;
+    if sums_per_pixel > 0 {
+        sums_rows.extend(sums.chunks_mut(width * sums_per_pixel));
+    } else {
+        sums_rows.extend((0..height).map(|_| &mut [][..]));
+    }
     // Pixels per batch: about BATCH samples, at least one pixel.
-    let group = (BATCH / spp.max(1) as usize).max(1);
+    let group = (BATCH / spp).max(1);
     parallel::install(|| {
         mean.par_chunks_mut(width * 3)
             .zip(variance.par_chunks_mut(width * 3))
             .zip(luminance_variance.par_chunks_mut(width))
+            .zip(sums_rows.into_par_iter())
             .enumerate()
             .try_for_each_init(
                 Batch::default,
-                |batch, (y, ((mean_row, var_row), lum_row))| {
+                |batch, (y, (((mean_row, var_row), lum_row), sums_row))| {
                     for x0 in (0..width).step_by(group) {
                         if progress.cancel.load(Ordering::Relaxed) {
                             return Ok(());
                         }
                         let pixels = x0..(x0 + group).min(width);
-                        batch.run(scene, settings, seed, spp, y, pixels.clone())?;
-                        let per_pixel = batch.radiance.chunks(spp.max(1) as usize);
-                        for (x, samples) in pixels.zip(per_pixel.chain(std::iter::repeat(&[][..])))
-                        {
-                            let m = moments(samples);
-                            mean_row[3 * x..3 * x + 3].copy_from_slice(&m.mean);
-                            var_row[3 * x..3 * x + 3].copy_from_slice(&m.variance);
-                            lum_row[x] = m.luminance_variance;
+                        batch.run(scene, settings, seed, samples, y, pixels.clone())?;
+                        let Batch { radiance, tree, .. } = batch;
+                        for (x, pixel_samples) in pixels.zip(radiance.chunks(spp)) {
+                            tree.clear();
+                            for (i, l) in (samples.first..).zip(pixel_samples) {
+                                tree.push(Block::sample(i), film::sums_of(*l), film::add)?;
+                            }
+                            let sums_out = &mut sums_row[x * sums_per_pixel..][..sums_per_pixel];
+                            film::finish_pixel(
+                                tree,
+                                (
+                                    &mut mean_row[3 * x..3 * x + 3],
+                                    &mut var_row[3 * x..3 * x + 3],
+                                ),
+                                &mut lum_row[x],
+                                sums_out,
+                            );
                         }
                     }
                     progress
                         .samples
-                        .fetch_add(width as u64 * u64::from(spp), Ordering::Relaxed);
+                        .fetch_add(width as u64 * u64::from(samples.count), Ordering::Relaxed);
                     Ok(())
                 },
             )
@@ -301,6 +358,8 @@ pub fn render(
         mean,
         variance,
         luminance_variance,
+        blocks,
+        sums,
         cancelled: progress.cancel.load(Ordering::Relaxed),
     })
 }

@@ -452,7 +452,14 @@ fn render_puts_each_sample_in_its_own_pixel() {
     ];
     let scene = Scene::new(wall, None, camera(), 4, 4).unwrap();
     let s = settings(Integrator::Direct, Strategy::Mis);
-    let image = super::render(&scene, 8, 3, &s, &super::Progress::default()).unwrap();
+    let image = super::render(
+        &scene,
+        super::Samples::all(8),
+        3,
+        &s,
+        &super::Progress::default(),
+    )
+    .unwrap();
     assert_eq!((image.width, image.height), (4, 4));
     let red = |row: usize, col: usize| image.mean[(row * 4 + col) * 3];
     let mut seen = Vec::new();
@@ -489,7 +496,16 @@ fn render_reports_the_variance_of_each_pixels_mean() {
     };
     let seeds = 24;
     let images: Vec<_> = (0..seeds)
-        .map(|seed| super::render(&scene, 16, seed, &s, &super::Progress::default()).unwrap())
+        .map(|seed| {
+            super::render(
+                &scene,
+                super::Samples::all(16),
+                seed,
+                &s,
+                &super::Progress::default(),
+            )
+            .unwrap()
+        })
         .collect();
     assert_ne!(
         images[0].mean, images[1].mean,
@@ -539,7 +555,14 @@ fn render_reports_the_variance_of_each_pixels_mean() {
             "{name}: {total} ± {se}"
         );
     }
-    let one = super::render(&scene, 1, 0, &s, &super::Progress::default()).unwrap();
+    let one = super::render(
+        &scene,
+        super::Samples::all(1),
+        0,
+        &s,
+        &super::Progress::default(),
+    )
+    .unwrap();
     assert!(
         one.variance
             .iter()
@@ -559,7 +582,9 @@ fn pixel_moments_are_the_mean_and_the_variance_of_the_mean() {
         [2.0, 5.0, 0.0],
         [6.0, 3.0, 0.0],
     ];
-    let m = super::moments(&samples);
+    let sums = samples.iter().map(|l| super::film::sums_of(*l));
+    let total = sums.reduce(|a, b| super::film::add(&a, &b)).unwrap();
+    let m = super::film::moments(&total, 4);
     assert_eq!(m.mean, [3.0, 3.0, 1.0]);
     // Squared deviations 14, 6 and 6 over n − 1 = 3, over n = 4.
     let expected = [14.0 / 12.0, 0.5, 0.5];

@@ -9,7 +9,8 @@
 //! low-discrepancy sampler stratifies each decision across the samples:
 //!
 //! - [`Sampler::Independent`]: PCG32 numbers in the order they are asked
-//!   for, dimensions ignored (the bits of every earlier release);
+//!   for, dimensions ignored (the bits of every earlier release; the
+//!   renderer gives each sample a generator of its own);
 //! - [`Sampler::Stratified`] and [`Sampler::MultiJitter`]: each 1D request a
 //!   jittered stratum of `1/count`, each 2D request a point of a jittered
 //!   grid or of Kensler's correlated multi-jittered pattern

@@ -41,4 +41,13 @@ def render(
     max_depth: int, rr_depth: int, hide_emitters: bool = False,
     callback: Callable[[int], object] | None = None,
     sampler: Literal["independent", "stratified", "multijitter", "sobol", "zsobol"] = "independent",
-) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32]]: ...
+    first_sample: int | None = None, total_spp: int | None = None, keep_sums: bool = False,
+) -> _Film: ...
+
+#: image, variance, luminance variance (flat float32), blocks as (start,
+#: length), sums (flat float64, 8 per pixel and block; None unless kept).
+_Film = tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32],
+             list[tuple[int, int]], NDArray[np.float64] | None]
+
+def merge(chunks: list[tuple[list[tuple[int, int]], NDArray[np.float64]]],
+          pixels: int) -> _Film: ...

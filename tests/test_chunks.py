@@ -1,0 +1,138 @@
+"""Chunked renders: ``mcs.render(..., first_sample=k)`` renders samples
+``k .. k+spp-1`` of each pixel's sequence, and ``RenderResult.merge`` of
+chunks covering ``0 .. S-1`` has the bits of one render of ``S`` spp (image
+and both variances), for every sampler, integrator and chunking; chunks of
+different renders, with gaps or overlaps, are refused."""
+
+from __future__ import annotations
+
+import copy
+import pickle
+import random
+
+import numpy as np
+import pytest
+
+import mcsample as mcs
+from mcsample.demo import demo_scene
+from scenes import lit_room
+
+SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "zsobol")
+FIELDS = ("image", "variance", "luminance_variance")
+
+
+@pytest.fixture(scope="module")
+def demo():
+    return mcs.Scene.from_mitsuba(demo_scene(40, 16))
+
+
+@pytest.fixture(scope="module")
+def room():
+    return mcs.Scene.from_mitsuba(lit_room(width=24, height=16))
+
+
+def assert_same_bits(a: mcs.RenderResult, b: mcs.RenderResult) -> None:
+    for name in FIELDS:
+        x, y = getattr(a, name), getattr(b, name)
+        assert x.dtype == y.dtype == np.float32 and x.shape == y.shape, name
+        np.testing.assert_array_equal(x.view(np.uint32), y.view(np.uint32), err_msg=name)
+
+
+def chunks(scene, cuts, **kw):
+    total = cuts[-1]
+    return [mcs.render(scene, b - a, first_sample=a, total_spp=total, progress=False, **kw)
+            for a, b in zip(cuts[:-1], cuts[1:])]
+
+
+@pytest.mark.parametrize("sampler", SAMPLERS)
+@pytest.mark.parametrize("integrator", ["direct", "path"])
+def test_merged_chunks_have_the_bits_of_one_render(demo, sampler, integrator):
+    kw = dict(integrator=integrator, sampler=sampler, seed=11)
+    one = mcs.render(demo, 16, progress=False, **kw)
+    for cuts in ([0, 16], [0, 8, 16], [0, 1, 2, 7, 16], [0, 5, 6, 13, 16]):
+        parts = chunks(demo, cuts, **kw)
+        random.Random(len(cuts)).shuffle(parts)  # any order
+        merged = mcs.RenderResult.merge(parts)
+        assert_same_bits(merged, one)
+        assert (merged.spp, merged.first_sample) == (16, 0)
+
+
+@pytest.mark.parametrize("strategy", ["bsdf", "emitter", "mis"])
+def test_area_lights_and_russian_roulette_chunk_exactly(room, strategy):
+    kw = dict(integrator="path", strategy=strategy, seed=4, max_depth=-1, rr_depth=1)
+    one = mcs.render(room, 12, progress=False, **kw)
+    assert_same_bits(mcs.RenderResult.merge(chunks(room, [0, 3, 4, 12], **kw)), one)
+
+
+def test_merges_merge_again_and_pickle(demo):
+    """A progressive reference: merge what is done, render more, merge on;
+    a chunk that went through pickle (as to a worker and back) merges the
+    same."""
+    kw = dict(integrator="path", seed=2, total_spp=24, progress=False)
+    first = mcs.RenderResult.merge([mcs.render(demo, 8, first_sample=0, **kw),
+                                    mcs.render(demo, 5, first_sample=8, **kw)])
+    assert first.first_sample == 0 and first.spp == 13
+    later = pickle.loads(pickle.dumps(mcs.render(demo, 11, first_sample=13, **kw)))
+    both = mcs.RenderResult.merge([copy.deepcopy(first), later])
+    assert_same_bits(both, mcs.render(demo, 24, integrator="path", seed=2, progress=False))
+    # A merge that does not start at 0 is a chunk too.
+    tail = mcs.RenderResult.merge([mcs.render(demo, 4, first_sample=13, **kw),
+                                   mcs.render(demo, 7, first_sample=17, **kw)])
+    assert (tail.first_sample, tail.spp) == (13, 11)
+    assert_same_bits(mcs.RenderResult.merge([first, tail]), both)
+
+
+def test_first_sample_zero_is_the_plain_render_and_chunks_differ(demo):
+    one = mcs.render(demo, 8, seed=1, progress=False)
+    assert one.chunk is None and one.first_sample == 0
+    zero = mcs.render(demo, 8, seed=1, first_sample=0, progress=False)
+    assert_same_bits(zero, one)
+    assert zero.chunk is not None and zero.chunk.blocks == [(0, 8)]
+    # Later samples are other samples: not the first ones again.
+    later = mcs.render(demo, 8, seed=1, first_sample=8, progress=False)
+    assert not np.array_equal(later.image, one.image)
+    assert later.chunk.blocks == [(8, 8)]
+
+
+def test_chunk_sums_are_what_the_image_is_made_of(demo):
+    """The kept sums give the chunk's own mean and variance."""
+    r = mcs.render(demo, 6, seed=3, first_sample=2, progress=False)
+    assert r.chunk.blocks == [(2, 2), (4, 4)]
+    sums = r.chunk.sums.reshape(*r.image.shape[:2], 2, 8).sum(axis=2)
+    np.testing.assert_allclose(sums[..., :3] / 6, r.image, rtol=1e-6, atol=1e-7)
+    var = (sums[..., 3:6] - sums[..., :3] ** 2 / 6) / 5 / 6
+    np.testing.assert_allclose(var, r.variance, rtol=1e-4, atol=1e-9)
+
+
+def test_bad_merges_are_refused(demo):
+    kw = dict(progress=False, total_spp=8)
+    a = mcs.render(demo, 4, first_sample=0, seed=1, **kw)
+    b = mcs.render(demo, 4, first_sample=4, seed=1, **kw)
+    with pytest.raises(ValueError, match="do not follow one another"):
+        mcs.RenderResult.merge([a, mcs.render(demo, 2, first_sample=6, seed=1, **kw)])
+    with pytest.raises(ValueError, match="do not follow one another"):
+        mcs.RenderResult.merge([a, mcs.render(demo, 6, first_sample=2, seed=1, **kw)])
+    with pytest.raises(ValueError, match="different renders"):
+        mcs.RenderResult.merge([a, mcs.render(demo, 4, first_sample=4, seed=2, **kw)])
+    with pytest.raises(ValueError, match="different renders"):
+        mcs.RenderResult.merge([a, mcs.render(demo, 2, first_sample=4, seed=1,
+                                              progress=False)])  # total_spp 8 vs 6
+    with pytest.raises(ValueError, match="different renders"):
+        mcs.RenderResult.merge([a, mcs.render(demo, 4, first_sample=4, seed=1,
+                                              strategy="bsdf", **kw)])
+    with pytest.raises(ValueError, match="first_sample="):
+        mcs.RenderResult.merge([a, mcs.render(demo, 4, seed=1, progress=False)])
+    with pytest.raises(ValueError, match="empty"):
+        mcs.RenderResult.merge([])
+    assert mcs.RenderResult.merge([b, a]).spp == 8
+
+
+def test_bad_chunk_arguments_are_refused(demo):
+    with pytest.raises(ValueError, match="total_spp"):
+        mcs.render(demo, 4, first_sample=6, total_spp=8, progress=False)
+    with pytest.raises(ValueError, match="first_sample"):
+        mcs.render(demo, 4, first_sample=-1, progress=False)
+    with pytest.raises(ValueError, match="spp"):
+        mcs.render(demo, 4, first_sample=0, total_spp=2**40, sampler="sobol", progress=False)
+    with pytest.raises(TypeError):
+        mcs.render(demo, 4, first_sample=1.5, progress=False)
