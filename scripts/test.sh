@@ -14,7 +14,7 @@ if ! dpkg -s libllvm19 >/dev/null 2>&1 && command -v apt-get >/dev/null; then
 fi
 
 python -m pip install --quiet --upgrade pip
-python -m pip install --quiet ".[test,mitsuba,plot]"
+python -m pip install --quiet ".[test,mitsuba,plot,distributed]"
 
 rustup component add rustfmt clippy >/dev/null 2>&1 || true
 cargo fmt --check

@@ -114,9 +114,16 @@ def test_bad_merges_are_refused(demo):
         mcs.RenderResult.merge([a, mcs.render(demo, 6, first_sample=2, seed=1, **kw)])
     with pytest.raises(ValueError, match="different renders"):
         mcs.RenderResult.merge([a, mcs.render(demo, 4, first_sample=4, seed=2, **kw)])
+    # A sampler whose patterns span total_spp: 8 for one, 6 for the other.
+    strat = dict(seed=1, sampler="stratified", progress=False)
     with pytest.raises(ValueError, match="different renders"):
-        mcs.RenderResult.merge([a, mcs.render(demo, 2, first_sample=4, seed=1,
-                                              progress=False)])  # total_spp 8 vs 6
+        mcs.RenderResult.merge([mcs.render(demo, 4, first_sample=0, total_spp=8, **strat),
+                                mcs.render(demo, 2, first_sample=4, **strat)])
+    # The independent sampler's do not: a render continues with more samples.
+    ind = dict(seed=1, progress=False)
+    assert_same_bits(mcs.RenderResult.merge([mcs.render(demo, 4, first_sample=0, **ind),
+                                             mcs.render(demo, 2, first_sample=4, **ind)]),
+                     mcs.render(demo, 6, **ind))
     with pytest.raises(ValueError, match="different renders"):
         mcs.RenderResult.merge([a, mcs.render(demo, 4, first_sample=4, seed=1,
                                               strategy="bsdf", **kw)])

@@ -7,6 +7,7 @@ steradian on directions, +z normal) are in the README.
 """
 
 from . import data, distr, estimators, io, mis, mitsuba, plot, qmc, stats, warp
+from . import distributed
 from .rendering import render
 from .results import EmitterSample, RenderResult
 from .scene import Scene, look_at
@@ -54,6 +55,7 @@ __all__ = [
     "PiecewiseConstant2D",
     "Rng",
     "distr",
+    "distributed",
     "estimators",
     "__version__",
     "get_num_threads",

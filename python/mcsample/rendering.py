@@ -115,7 +115,8 @@ def render(scene: Scene, spp: int | None = None, *,
         Length of the sequence the chunk is part of (default
         ``first_sample + spp``): the "stratified", "multijitter", "sobol"
         and "zsobol" samplers lay their patterns over it, so the chunks of
-        one render must all give it (the independent sampler ignores it).
+        one render must all give it (the independent sampler ignores it: an
+        independent render can be continued with more samples).
 
     Everything after ``spp`` is keyword-only.
 
@@ -146,7 +147,10 @@ def render(scene: Scene, spp: int | None = None, *,
     first = blocks[0][0] if blocks else 0
     chunk = None
     if sums is not None:
-        total = first + int(spp) if total_spp is None else int(total_spp)
+        # The sequence length matters to the samplers that lay patterns over
+        # it: an independent render can be continued with more samples.
+        total = None if sampler == "independent" else first + int(spp) \
+            if total_spp is None else int(total_spp)
         chunk = Chunk(blocks, sums, (scene.shape, seed, sampler, total, strategy, heuristic,
                                      tuple(sorted(settings.items()))))
     return RenderResult(image.reshape(height, width, 3), variance.reshape(height, width, 3),
