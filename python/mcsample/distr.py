@@ -13,11 +13,11 @@ a density given as a Python callable.
 
 from __future__ import annotations
 
-import operator
 from typing import Any, Callable, Sequence, Union
 
 import numpy as np
 
+from ._args import integer
 from ._core import AliasTable, Discrete1D, Discrete2D, PiecewiseConstant1D, PiecewiseConstant2D, Rng
 
 __all__ = [
@@ -101,12 +101,7 @@ def rejection_sample(
         raise TypeError(f"bound must be a number, got {bound!r}") from None
     if not (np.isfinite(bound) and bound > 0):
         raise ValueError(f"bound = {bound}: must be finite and > 0")
-    try:
-        n = operator.index(n)
-    except TypeError:
-        raise TypeError(f"n must be an integer, got {n!r}") from None
-    if n < 0:
-        raise ValueError(f"n = {n}: must be >= 0")
+    n = integer(n, "n")
     lo, hi = _box(domain)
     dim = len(lo)
     rng = Rng(seed)

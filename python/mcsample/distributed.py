@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import contextlib
 import math
-import operator
 import time
 from typing import TYPE_CHECKING, Any, Iterator, Sequence
 
+from ._args import integer
 from ._core import get_num_threads, set_num_threads
 from .rendering import _progress_bar
 from .rendering import render as _render_local
@@ -122,16 +122,16 @@ def render(scene: Scene, spp: int, client: Client | None = None,
     for name in ("first_sample", "total_spp"):
         if name in kw:
             raise TypeError(f"{name} is chosen per chunk by mcsample.distributed.render")
-    spp = _positive(spp, "spp")
+    spp = integer(spp, "spp", 1)
     kw = {**kw, "seed": resolve_seed(seed), "total_spp": spp}
     start = time.perf_counter()
     with _client(client) as c:
         if chunks is None or isinstance(chunks, int):
             threads = sum(c.nthreads().values()) or 1
-            sizes = chunk_sizes(spp, 4 * threads if chunks is None else _positive(chunks,
-                                                                                     "chunks"))
+            count = 4 * threads if chunks is None else integer(chunks, "chunks", 1)
+            sizes = chunk_sizes(spp, count)
         else:
-            sizes = [_positive(n, "chunks") for n in chunks]
+            sizes = [integer(n, "chunks", 1) for n in chunks]
             if sum(sizes) != spp:
                 raise ValueError(f"chunks add up to {sum(sizes)} samples: they must add up to "
                                  f"spp = {spp}")
@@ -176,13 +176,3 @@ def _merge_as_completed(futures: list[Any], callback: Any, pixels: int) -> Rende
     assert merged is not None and not waiting
     return merged
 
-
-def _positive(value: Any, arg: str) -> int:
-    """A positive int, else TypeError / ValueError naming ``arg``."""
-    try:
-        n = operator.index(value)
-    except TypeError:
-        raise TypeError(f"{arg} must be an integer, got {type(value).__name__}") from None
-    if n < 1:
-        raise ValueError(f"{arg} = {n}: must be at least 1")
-    return n

@@ -36,7 +36,6 @@ everywhere in mcsample; the same seed gives the same points.
 
 from __future__ import annotations
 
-import operator
 from typing import Literal, Union
 
 import numpy as np
@@ -44,22 +43,12 @@ import numpy.typing as npt
 from scipy.stats import qmc as _scipy_qmc
 
 from ._core import qmc as _core
+from ._args import integer
 from .seeds import SeedLike, resolve_seed
 
 __all__ = ["Sobol", "Halton", "LatinHypercube", "Stratified", "MultiJitter"]
 
 DType = Union[type[np.float64], type[np.float32], np.dtype, str]
-
-
-def _count(n: object, arg: str) -> int:
-    """``n`` as an int >= 0, else TypeError / ValueError naming ``arg``."""
-    try:
-        value = operator.index(n)  # type: ignore[arg-type]
-    except TypeError:
-        raise TypeError(f"{arg} must be an integer, got {type(n).__name__}") from None
-    if value < 0:
-        raise ValueError(f"{arg} = {value}: must be >= 0")
-    return value
 
 
 class _Engine(_scipy_qmc.QMCEngine):
@@ -75,7 +64,7 @@ class _Engine(_scipy_qmc.QMCEngine):
         super().__init__(d=points.d)
 
     def _random(self, n: int = 1, *, workers: int = 1) -> np.ndarray:
-        return self._points.points(self.num_generated, _count(n, "n"))
+        return self._points.points(self.num_generated, integer(n, "n"))
 
     def random(
         self, n: int = 1, *, workers: int = 1, dtype: DType = np.float64
@@ -94,7 +83,7 @@ class _Engine(_scipy_qmc.QMCEngine):
         -------
         ndarray, shape (n, d), in [0, 1).
         """
-        n = _count(n, "n")
+        n = integer(n, "n")
         sample = self._points.points(self.num_generated, n, dtype)
         self.num_generated += n
         return sample
@@ -103,7 +92,7 @@ class _Engine(_scipy_qmc.QMCEngine):
         """Skips ``n`` points (n >= 0) in O(1); returns the engine. (For the
         patterns, which are drawn whole, it changes which pattern comes
         next.)"""
-        self.num_generated += _count(n, "n")
+        self.num_generated += integer(n, "n")
         return self
 
     def reset(self) -> _Engine:
@@ -160,7 +149,7 @@ class Sobol(_Engine):
         both powers of two (the balance of a Sobol' net needs them), as
         scipy does.
         """
-        m = _count(m, "m")
+        m = integer(m, "m")
         if m > 32:
             raise ValueError(f"m = {m}: must be at most 32 (2**32 points in all)")
         n = 2**m

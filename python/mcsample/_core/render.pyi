@@ -50,4 +50,5 @@ _Film = tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32],
              list[tuple[int, int]], NDArray[np.float64] | None]
 
 def merge(chunks: list[tuple[list[tuple[int, int]], NDArray[np.float64]]],
-          pixels: int) -> _Film: ...
+          pixels: int) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32],
+                                list[tuple[int, int]], NDArray[np.float64]]: ...
