@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # Installs everything the test suite needs on a fresh Debian machine
-# (libLLVM for Mitsuba's llvm variant, Python packages, this package) and
-# runs the whole suite: Rust format / lint / unit tests / docs, then pytest.
+# (libLLVM for Mitsuba's llvm variant, Python packages), builds this
+# package's abi3 wheel and smoke-tests it in fresh virtual environments
+# without Rust, installs it, and runs the whole suite: Rust format / lint /
+# unit tests / docs, stub check, then pytest.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+ROOT=$PWD
 
 # A libLLVM >= 16 lets Mitsuba 3 run its llvm_ad_rgb variant (Dr.Jit finds
 # it by itself); without one the suite falls back to scalar_rgb.
@@ -13,8 +16,35 @@ if ! dpkg -s libllvm19 >/dev/null 2>&1 && command -v apt-get >/dev/null; then
   $SUDO apt-get install -y -qq libllvm19 >/dev/null
 fi
 
-python -m pip install --quiet --upgrade pip
-python -m pip install --quiet ".[test,mitsuba,plot,distributed]"
+python -m pip install --quiet --upgrade pip "maturin>=1.7,<2"
+
+# The wheel users install: abi3 (one wheel for CPython 3.9+), stripped.
+rm -rf target/wheels
+maturin build --release --quiet
+WHEEL=$(ls "$PWD"/target/wheels/mcsample_toolkit-*-cp39-abi3-*.whl)
+ls -l "$WHEEL"
+
+# Installed into fresh virtual environments with no Rust toolchain on PATH
+# (this Python, and 3.9 and 3.13 where pyenv has them): a smoke test, run
+# outside the source tree.
+NO_RUST_PATH=$(echo "$PATH" | tr ':' '\n' | grep -v -E '[.]cargo|rustup' | paste -sd:)
+SMOKE=$(mktemp -d)
+i=0
+for py in python "$HOME"/.pyenv/versions/3.9*/bin/python "$HOME"/.pyenv/versions/3.13*/bin/python; do
+  command -v "$py" >/dev/null || continue
+  i=$((i + 1))
+  "$py" -m venv "$SMOKE/venv$i"
+  (cd "$SMOKE" && export PATH="$NO_RUST_PATH" &&
+    "$SMOKE/venv$i/bin/python" -m pip install --quiet "$WHEEL" &&
+    "$SMOKE/venv$i/bin/python" "$ROOT/scripts/smoke.py")
+done
+rm -rf "$SMOKE"
+
+# The same wheel, with what the suite needs, into this Python (the
+# distribution was called "mcsample" before: that name on the package index
+# is another project's).
+python -m pip uninstall --quiet -y mcsample 2>/dev/null || true
+python -m pip install --quiet "$WHEEL[test,mitsuba,plot,distributed]"
 
 rustup component add rustfmt clippy >/dev/null 2>&1 || true
 cargo fmt --check

@@ -11,7 +11,7 @@
 //! one for a chunk of `2^m` samples starting at a multiple of `2^m`);
 //! adjacent chunks are merged by adding sibling blocks ([`Tree::push`]).
 //! The estimate of samples `0 .. n` adds the blocks of `n`'s binary digits
-//! from the largest down ([`Tree::total`]), and turns the sums into the
+//! from the largest down ([`finish_pixel`]), and turns the sums into the
 //! mean, `Σl/n`, and the variance of the mean, `(Σl² − (Σl)²/n)/(n−1)/n`
 //! ([`moments`]).
 
@@ -181,17 +181,6 @@ impl<T> Tree<T> {
         }
         Ok(())
     }
-
-    /// The sum of every block, added in sample order (for samples `0 .. n`:
-    /// the blocks of `n`'s binary digits, largest first). `None` when empty.
-    pub fn total(&self, plus: impl Fn(&T, &T) -> T) -> Option<T>
-    where
-        T: Clone,
-    {
-        let mut nodes = self.nodes.iter();
-        let first = nodes.next()?.1.clone();
-        Some(nodes.fold(first, |acc, (_, v)| plus(&acc, v)))
-    }
 }
 
 /// A pixel's estimate from the [`Sums`] of its `n` samples.
@@ -223,22 +212,53 @@ pub fn moments(s: &Sums, n: u64) -> Moments {
     }
 }
 
-/// Writes a pixel's estimate from the blocks in `tree`: its mean and
-/// variance per channel (3 values each), the variance of its mean
-/// luminance, and, when `sums` is not empty, the sums of its blocks, 8 per
-/// block.
+/// The sums of a pixel's samples over each of `blocks` (which `samples`
+/// cover in order), appended to `out`: each block summed as the tree sums
+/// it (pairwise: left half + right half), the same bits as [`Tree::push`]
+/// of the samples one by one.
+pub fn block_sums(samples: &[[f32; 3]], blocks: &[Block], out: &mut Vec<Sums>) {
+    let mut rest = samples;
+    for block in blocks {
+        let (inside, after) = rest.split_at((block.len as usize).min(rest.len()));
+        out.push(pairwise(inside));
+        rest = after;
+    }
+}
+
+/// The tree sum of `samples` (a power-of-two count, or fewer when a render
+/// was stopped).
+fn pairwise(samples: &[[f32; 3]]) -> Sums {
+    match samples {
+        [] => Sums::default(),
+        [a] => sums_of(*a),
+        [a, b] => add(&sums_of(*a), &sums_of(*b)),
+        _ => {
+            let (left, right) = samples.split_at(samples.len().next_power_of_two() / 2);
+            add(&pairwise(left), &pairwise(right))
+        }
+    }
+}
+
+/// Writes a pixel's estimate from the sums of its blocks (`blocks`, in
+/// sample order) of `count` samples in all: its mean and variance per
+/// channel (3 values each), the variance of its mean luminance, and, when
+/// `sums` is not empty, the blocks' sums, 8 per block.
 pub fn finish_pixel(
-    tree: &Tree<Sums>,
+    blocks: &[Sums],
+    count: u64,
     (mean, variance): (&mut [f32], &mut [f32]),
     luminance_variance: &mut f32,
     sums: &mut [f64],
 ) {
-    let total = tree.total(add).unwrap_or_default();
-    let m = moments(&total, tree.span().1);
+    let total = match blocks {
+        [first, rest @ ..] => rest.iter().fold(*first, |acc, s| add(&acc, s)),
+        [] => Sums::default(),
+    };
+    let m = moments(&total, count);
     mean.copy_from_slice(&m.mean);
     variance.copy_from_slice(&m.variance);
     *luminance_variance = m.luminance_variance;
-    for (out, (_, s)) in sums.chunks_exact_mut(8).zip(tree.nodes()) {
+    for (out, s) in sums.chunks_exact_mut(8).zip(blocks) {
         out.copy_from_slice(s);
     }
 }
@@ -295,18 +315,23 @@ pub fn merge(chunks: &[(Vec<Block>, &[f64])], pixels: usize) -> Result<Merged> {
             .zip(merged.luminance_variance.par_iter_mut())
             .zip(merged.sums.par_chunks_mut(per_pixel.max(1)))
             .enumerate()
-            .for_each_init(Tree::new, |tree, (p, (((mean, var), lum), sums))| {
-                tree.clear();
-                for (blocks, chunk) in chunks {
-                    let of_pixel = &chunk[p * blocks.len() * 8..][..blocks.len() * 8];
-                    for (block, s) in blocks.iter().zip(of_pixel.chunks_exact(8)) {
-                        let s: Sums = std::array::from_fn(|k| s[k]);
-                        // The layout above has checked that they follow.
-                        let _ = tree.push(*block, s, add);
+            .for_each_init(
+                || (Tree::new(), Vec::new()),
+                |(tree, block_sums), (p, (((mean, var), lum), sums))| {
+                    tree.clear();
+                    for (blocks, chunk) in chunks {
+                        let of_pixel = &chunk[p * blocks.len() * 8..][..blocks.len() * 8];
+                        for (block, s) in blocks.iter().zip(of_pixel.chunks_exact(8)) {
+                            let s: Sums = std::array::from_fn(|k| s[k]);
+                            // The layout above has checked that they follow.
+                            let _ = tree.push(*block, s, add);
+                        }
                     }
-                }
-                finish_pixel(tree, (mean, var), lum, sums);
-            });
+                    block_sums.clear();
+                    block_sums.extend(tree.nodes().iter().map(|(_, s)| *s));
+                    finish_pixel(block_sums, count, (mean, var), lum, sums);
+                },
+            );
     })?;
     Ok(merged)
 }
@@ -331,6 +356,15 @@ pub struct Merged {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The blocks' sums added in order, as [`finish_pixel`] adds them.
+    fn total(tree: &Tree<f64>) -> f64 {
+        tree.nodes()
+            .iter()
+            .map(|(_, v)| *v)
+            .reduce(|a, b| a + b)
+            .unwrap()
+    }
 
     /// Pushes samples `range` (value = index) and returns the blocks.
     fn blocks_of(range: std::ops::Range<u64>) -> Vec<Block> {
@@ -360,6 +394,27 @@ mod tests {
     }
 
     #[test]
+    fn block_sums_are_the_trees() {
+        let sample = |i: u64| {
+            let x = (i as f32 * 0.618_034).fract();
+            [x * 1e4, 1.0 + x * 1e-4, (i % 5) as f32 * 3.3e7]
+        };
+        for first in 0..20 {
+            for count in 1..40 {
+                let samples: Vec<[f32; 3]> = (first..first + count).map(sample).collect();
+                let mut tree = Tree::new();
+                for (i, l) in (first..).zip(&samples) {
+                    tree.push(Block::sample(i), sums_of(*l), add).unwrap();
+                }
+                let mut fast = Vec::new();
+                block_sums(&samples, &blocks(first, count), &mut fast);
+                let slow: Vec<Sums> = tree.nodes().iter().map(|(_, s)| *s).collect();
+                assert_eq!(fast, slow, "{first} {count}");
+            }
+        }
+    }
+
+    #[test]
     fn merged_chunks_sum_as_one_run_for_any_split() {
         // Values whose sums round differently in different orders.
         let value = |i: u64| {
@@ -370,7 +425,7 @@ mod tests {
             for i in 0..37 {
                 t.push(Block::sample(i), value(i), |a, b| a + b).unwrap();
             }
-            t.total(|a, b| a + b).unwrap()
+            total(&t)
         };
         for cuts in [
             vec![0, 37],
@@ -390,11 +445,7 @@ mod tests {
                     merged.push(block, v, |a, b| a + b).unwrap();
                 }
             }
-            assert_eq!(
-                merged.total(|a, b| a + b).unwrap().to_bits(),
-                one.to_bits(),
-                "{cuts:?}"
-            );
+            assert_eq!(total(&merged).to_bits(), one.to_bits(), "{cuts:?}");
         }
     }
 

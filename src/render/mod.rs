@@ -53,7 +53,7 @@ use crate::rng::Rng;
 use crate::sampler::zorder::ZOrder;
 use crate::sampler::{Sampler, Stream};
 use accel::Hit;
-use film::{Block, Sums, Tree};
+use film::{Block, Sums};
 use integrator::Escaped;
 use shape::Ray;
 
@@ -108,24 +108,19 @@ impl Samples {
     }
 }
 
-/// Draws the independent sampler takes before a sample's path: film and
-/// lens positions.
-const CAMERA_DRAWS: u64 = 4;
-
 /// Moves `stream` (of the pixel with index `pixel` and key `key`) to
 /// sample `index`. The independent sampler restarts from a PCG32 generator
 /// of the sample's own (seeded by the pixel's key and `index`, on stream
-/// `pixel`), `skip` draws in: the numbers of a sample do not depend on
-/// which samples were rendered before it, so a chunk of samples draws what
-/// a whole render draws.
+/// `pixel`): the numbers of a sample do not depend on which samples were
+/// rendered before it, so a chunk of samples draws what a whole render
+/// draws.
 #[inline]
-fn start_sample(stream: &mut Stream, key: u64, pixel: u64, index: u64, skip: u64) {
+fn start_sample(stream: &mut Stream, key: u64, pixel: u64, index: u64) {
     // Other samplers index their patterns with it (their sequences have at
     // most u32::MAX samples, `Sampler::max_count`).
     stream.start(index as u32);
     if let Some(rng) = stream.independent() {
         *rng = Rng::new(mix(key, index), pixel);
-        rng.advance(skip);
     }
 }
 
@@ -151,11 +146,14 @@ struct Batch {
     radiance: Vec<[f32; 3]>,
     /// Film and lens positions of each sample.
     camera_u: Vec<[f32; 4]>,
+    /// The independent sampler's generator of each sample after its camera
+    /// draws.
+    resume: Vec<Rng>,
     rays: Vec<Ray>,
     /// Where each camera ray first meets the scene.
     hits: Vec<Option<Hit>>,
-    /// One pixel's sums at a time.
-    tree: Tree<Sums>,
+    /// One pixel's sums per block at a time.
+    block_sums: Vec<Sums>,
 }
 
 impl Batch {
@@ -179,11 +177,13 @@ impl Batch {
         self.escaped.clear();
         self.radiance.clear();
         self.camera_u.clear();
+        self.resume.clear();
         // Reserved up front (samples grow with spp): a batch too big for
         // memory is an error, not an abort.
         let n = pixels.len() * spp.max(1) as usize;
         const WHAT: &str = "a batch of samples";
         alloc::reserve(&mut self.camera_u, n, WHAT)?;
+        alloc::reserve(&mut self.resume, n, WHAT)?;
         alloc::reserve(&mut self.rays, n, WHAT)?;
         alloc::reserve(&mut self.hits, n, WHAT)?;
         alloc::reserve(&mut self.radiance, n, WHAT)?;
@@ -203,7 +203,7 @@ impl Batch {
             // whose draws come in order, must draw it.
             let lens_drawn = scene.camera().has_lens() || stream.independent().is_some();
             for i in 0..u64::from(spp) {
-                start_sample(&mut stream, key, pixel, samples.first + i, 0);
+                start_sample(&mut stream, key, pixel, samples.first + i);
                 let film = stream.get2::<f32>(dims::FILM);
                 let lens = if lens_drawn {
                     stream.get2(dims::LENS)
@@ -213,8 +213,11 @@ impl Batch {
                 let film_x = (x as f32 + film[0]) * inv_width;
                 let film_y = (y as f32 + film[1]) * inv_height;
                 self.camera_u.push([film_x, film_y, lens[0], lens[1]]);
+                if let Some(rng) = stream.independent() {
+                    self.resume.push(rng.clone());
+                }
             }
-            streams.push((stream, key, pixel));
+            streams.push(stream);
         }
         self.rays.resize(self.camera_u.len(), Ray::default());
         scene.camera().rays_into(&self.camera_u, &mut self.rays);
@@ -229,10 +232,15 @@ impl Batch {
         }));
         let spp = spp.max(1) as usize;
         let per_pixel = self.rays.chunks(spp).zip(self.hits.chunks(spp));
-        for ((mut stream, key, pixel), (rays, hits)) in streams.into_iter().zip(per_pixel) {
+        for (mut stream, (rays, hits)) in streams.into_iter().zip(per_pixel) {
             for (i, (ray, hit)) in (samples.first..).zip(rays.iter().zip(hits)) {
-                start_sample(&mut stream, key, pixel, i, CAMERA_DRAWS);
                 let slot = self.radiance.len() as u32;
+                // The path goes on from where the sample's camera draws
+                // left its numbers.
+                stream.start(i as u32);
+                if let Some(rng) = stream.independent() {
+                    rng.clone_from(&self.resume[slot as usize]);
+                }
                 let l = integrator::radiance(
                     scene,
                     *ray,
@@ -327,15 +335,18 @@ pub fn render(
                         }
                         let pixels = x0..(x0 + group).min(width);
                         batch.run(scene, settings, seed, samples, y, pixels.clone())?;
-                        let Batch { radiance, tree, .. } = batch;
+                        let Batch {
+                            radiance,
+                            block_sums,
+                            ..
+                        } = batch;
                         for (x, pixel_samples) in pixels.zip(radiance.chunks(spp)) {
-                            tree.clear();
-                            for (i, l) in (samples.first..).zip(pixel_samples) {
-                                tree.push(Block::sample(i), film::sums_of(*l), film::add)?;
-                            }
+                            block_sums.clear();
+                            film::block_sums(pixel_samples, &blocks, block_sums);
                             let sums_out = &mut sums_row[x * sums_per_pixel..][..sums_per_pixel];
                             film::finish_pixel(
-                                tree,
+                                block_sums,
+                                u64::from(samples.count),
                                 (
                                     &mut mean_row[3 * x..3 * x + 3],
                                     &mut var_row[3 * x..3 * x + 3],
