@@ -73,55 +73,165 @@ impl Raster {
     }
 }
 
-/// Reads the first RGB layer of an OpenEXR file (half, float or uint
-/// channels, converted to `f32`); the result has 4 channels when the file
-/// has an `A` channel, else 3.
+/// Reads an OpenEXR file (scanline or tiled, one part or several, half,
+/// float or uint channels converted to `f32`, every compression the exr
+/// crate decodes; the largest mip level). Channels are grouped by layer:
+/// the text before the last `.` of `part.channel` (`diffuse.R` is channel
+/// `R` of layer `diffuse`; channels without a dot, in unnamed parts, form
+/// the unnamed layer `""`). The image is `layer`'s, or else the unnamed
+/// layer's, or else the only layer with colour. A layer's colour is `R`,
+/// `G`, `B` (or `r`, `g`, `b`), else luminance `Y` repeated in R, G, B;
+/// with `A` (or `a`) the result has 4 channels, else 3.
 ///
 /// # Errors
 /// [`Error::Io`] if the file cannot be opened, is not OpenEXR, is truncated,
-/// or has no R, G and B channels; [`Error::Argument`] for an image of more
-/// than [`MAX_PIXELS`]; [`Error::Memory`].
-pub fn read_exr(path: &Path) -> Result<Raster> {
+/// uses a compression the exr crate cannot decode, or has no layer with
+/// colour; [`Error::Argument`] naming `layer` when it is not in the file,
+/// or when the file has several coloured layers and `layer` is `None`;
+/// [`Error::Argument`] for an image of more than [`MAX_PIXELS`];
+/// [`Error::Memory`].
+pub fn read_exr(path: &Path, layer: Option<&str>) -> Result<Raster> {
     use exr::prelude::*;
     let cannot = |e: exr::error::Error| io_error(path, format!("cannot read OpenEXR: {e}"));
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(cannot)?;
     for header in &meta.headers {
+        let size = header.layer_size;
         check_size(
             path,
-            header.layer_size.width(),
-            header.layer_size.height(),
-            4,
+            size.width(),
+            size.height(),
+            header.channels.list.len(),
         )?;
     }
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
-        .specific_channels()
-        .required("R")
-        .required("G")
-        .required("B")
-        .optional("A", 1.0f32)
-        .collect_pixels(
-            |size: Vec2<usize>, (_, _, _, alpha)| {
-                let channels = if alpha.is_some() { 4 } else { 3 };
-                Raster {
-                    width: size.width(),
-                    height: size.height(),
-                    channels,
-                    data: vec![0.0; size.area() * channels],
-                }
-            },
-            |raster: &mut Raster, pos: Vec2<usize>, (r, g, b, a): (f32, f32, f32, f32)| {
-                let start = (pos.y() * raster.width + pos.x()) * raster.channels;
-                let px = [r, g, b, a];
-                raster.data[start..start + raster.channels].copy_from_slice(&px[..raster.channels]);
-            },
-        )
-        .first_valid_layer()
+        .all_channels()
+        .all_layers()
         .all_attributes()
         .from_file(path)
         .map_err(cannot)?;
-    Ok(image.layer_data.channel_data.pixels)
+    // Every channel as (layer, name, samples, size), in the file's order.
+    let mut channels = Vec::new();
+    for part in &image.layer_data {
+        let part_name = part.attributes.layer_name.as_ref().map(|t| t.to_string());
+        for channel in &part.channel_data.list {
+            let full = match &part_name {
+                Some(p) => format!("{p}.{}", channel.name),
+                None => channel.name.to_string(),
+            };
+            let (group, name) = full.rsplit_once('.').unwrap_or(("", &full));
+            channels.push((
+                group.to_string(),
+                name.to_string(),
+                &channel.sample_data,
+                part.size,
+            ));
+        }
+    }
+    let mut layers: Vec<&str> = Vec::new();
+    for (group, ..) in &channels {
+        if !layers.contains(&group.as_str()) {
+            layers.push(group);
+        }
+    }
+    let find = |group: &str, names: &[&str]| {
+        names.iter().find_map(|n| {
+            channels
+                .iter()
+                .find(|(g, c, ..)| g == group && c == n)
+                .map(|(_, _, samples, size)| (*samples, *size))
+        })
+    };
+    let colour = |group: &str| {
+        let rgb = [["R", "r"], ["G", "g"], ["B", "b"]].map(|names| find(group, &names));
+        match rgb {
+            [Some(r), Some(g), Some(b)] => Some(vec![r, g, b]),
+            _ => find(group, &["Y", "y"]).map(|y| vec![y, y, y]),
+        }
+    };
+    let named = |list: &[&str]| {
+        list.iter()
+            .map(|l| format!("'{l}'"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let coloured: Vec<&str> = layers
+        .iter()
+        .copied()
+        .filter(|l| colour(l).is_some())
+        .collect();
+    let chosen = match layer {
+        Some(l) if layers.contains(&l) => l,
+        Some(l) => {
+            return Err(crate::error::Error::Argument {
+                arg: "layer",
+                message: format!(
+                    "layer = '{l}': {} has the layers {} ('' is the channels without a layer name)",
+                    path.display(),
+                    named(&layers)
+                ),
+            });
+        }
+        None if coloured.contains(&"") => "",
+        None if coloured.len() == 1 => coloured[0],
+        None if coloured.is_empty() => "",
+        None => {
+            return Err(crate::error::Error::Argument {
+                arg: "layer",
+                message: format!(
+                    "{} has several layers with colour, {}: choose one with layer=",
+                    path.display(),
+                    named(&coloured)
+                ),
+            });
+        }
+    };
+    let Some(mut planes) = colour(chosen) else {
+        let names: Vec<String> = channels
+            .iter()
+            .map(|(g, c, ..)| {
+                if g.is_empty() {
+                    c.clone()
+                } else {
+                    format!("{g}.{c}")
+                }
+            })
+            .collect();
+        return Err(io_error(
+            path,
+            format!(
+                "layer '{chosen}' has no R, G and B (or Y) channels; the file has: {}",
+                names.join(", ")
+            ),
+        ));
+    };
+    planes.extend(find(chosen, &["A", "a"]));
+    let size = planes[0].1;
+    if planes.iter().any(|(_, s)| *s != size) {
+        return Err(io_error(
+            path,
+            format!("layer '{chosen}': its channels differ in size"),
+        ));
+    }
+    let (width, height, count) = (size.width(), size.height(), planes.len());
+    let mut data = alloc::filled(width * height * count, 0.0f32, "the image")?;
+    for (c, (samples, _)) in planes.iter().enumerate() {
+        for (out, value) in data
+            .iter_mut()
+            .skip(c)
+            .step_by(count)
+            .zip(samples.values_as_f32())
+        {
+            *out = value;
+        }
+    }
+    Ok(Raster {
+        width,
+        height,
+        channels: count,
+        data,
+    })
 }
 
 /// Writes an RGB or RGBA OpenEXR file with `f32` channels, or `f16` when
@@ -190,6 +300,85 @@ pub fn read_hdr(path: &Path) -> Result<Raster> {
         channels: 3,
         data: rgb.into_raw(),
     })
+}
+
+/// Reads an 8- or 16-bit PNG as linear RGB (its sRGB values decoded, as
+/// Mitsuba's `Bitmap` decodes them for rendering), 4 channels with alpha.
+///
+/// # Errors
+/// [`Error::Io`] if the file cannot be opened or is not a PNG;
+/// [`Error::Argument`] for an image of more than [`MAX_PIXELS`];
+/// [`Error::Memory`].
+pub fn read_png(path: &Path) -> Result<Raster> {
+    use image::ImageDecoder;
+    let cannot = |e: image::ImageError| io_error(path, format!("cannot read PNG: {e}"));
+    let file = std::fs::File::open(path).map_err(|e| io_error(path, e))?;
+    let decoder =
+        image::codecs::png::PngDecoder::new(std::io::BufReader::new(file)).map_err(cannot)?;
+    let (width, height) = decoder.dimensions();
+    let alpha = decoder.color_type().has_alpha();
+    let channels = if alpha { 4 } else { 3 };
+    check_size(path, width as usize, height as usize, channels)?;
+    let decoded = image::DynamicImage::from_decoder(decoder).map_err(cannot)?;
+    let mut data = if alpha {
+        decoded.into_rgba32f().into_raw()
+    } else {
+        decoded.into_rgb32f().into_raw()
+    };
+    for (i, v) in data.iter_mut().enumerate() {
+        if !(alpha && i % 4 == 3) {
+            *v = srgb_decode(*v);
+        }
+    }
+    Ok(Raster {
+        width: width as usize,
+        height: height as usize,
+        channels,
+        data,
+    })
+}
+
+/// Reads an image file of any kind mcsample reads, told by its first bytes:
+/// OpenEXR ([`read_exr`], with `layer`), Radiance HDR ([`read_hdr`]) or PNG
+/// ([`read_png`]).
+///
+/// # Errors
+/// Those of the reader; [`Error::Io`] for a file of another kind, and
+/// [`Error::Argument`] naming `layer` when it is given for a file without
+/// layers.
+pub fn read_image(path: &Path, layer: Option<&str>) -> Result<Raster> {
+    use std::io::Read;
+    let mut magic = [0u8; 4];
+    let mut file = std::fs::File::open(path).map_err(|e| io_error(path, e))?;
+    let got = file.read(&mut magic).map_err(|e| io_error(path, e))?;
+    let exr = magic == [0x76, 0x2f, 0x31, 0x01];
+    if layer.is_some() && !exr {
+        return Err(Error::Argument {
+            arg: "layer",
+            message: format!(
+                "layer: {} is not an OpenEXR file, it has no layers",
+                path.display()
+            ),
+        });
+    }
+    match &magic[..got] {
+        _ if exr => read_exr(path, layer),
+        [b'#', b'?', ..] => read_hdr(path),
+        [0x89, b'P', b'N', b'G'] => read_png(path),
+        _ => Err(io_error(
+            path,
+            "not an OpenEXR, Radiance HDR or PNG file (by its first bytes)",
+        )),
+    }
+}
+
+/// The linear value of an sRGB-encoded one in `[0, 1]` (IEC 61966-2-1).
+pub fn srgb_decode(encoded: f32) -> f32 {
+    if encoded <= 0.04045 {
+        encoded / 12.92
+    } else {
+        ((encoded + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// The sRGB transfer curve (IEC 61966-2-1) of a linear value in `[0, 1]`.
@@ -289,7 +478,7 @@ mod tests {
                 let path = dir.path().join(format!("t{channels}{half}.exr"));
                 let image = gradient(channels);
                 write_exr(&path, &image, half).unwrap();
-                let back = read_exr(&path).unwrap();
+                let back = read_exr(&path, None).unwrap();
                 assert_eq!((back.width, back.height, back.channels), (7, 5, channels));
                 let tol = if half { 1e-2 } else { 0.0 };
                 for (a, b) in image.data.iter().zip(&back.data) {
@@ -306,7 +495,7 @@ mod tests {
         write_exr(&path, &gradient(3), false).unwrap();
         let bytes = std::fs::read(&path).unwrap();
         std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
-        let err = read_exr(&path).unwrap_err().to_string();
+        let err = read_exr(&path, None).unwrap_err().to_string();
         assert!(err.contains("t.exr"), "{err}");
         let err = read_hdr(&dir.path().join("nope.hdr"))
             .unwrap_err()

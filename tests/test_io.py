@@ -109,8 +109,10 @@ def test_unreadable_and_wrong_files(tmp_path):
     junk.write_bytes(b"not an image at all")
     with pytest.raises(OSError, match="junk.exr"):
         io.read_exr(junk)
-    with pytest.raises(OSError, match="unknown image type"):
-        io.read_image(tmp_path / "a.jpg")
+    jpeg = tmp_path / "a.jpg"
+    jpeg.write_bytes(b"\xff\xd8\xff\xe0 a JPEG")
+    with pytest.raises(OSError, match="a.jpg: not an OpenEXR, Radiance HDR or PNG file"):
+        io.read_image(jpeg)
 
 
 @pytest.mark.parametrize("bad", [np.zeros((4, 4)), np.zeros((4, 4, 2)), np.zeros((0, 4, 3))])

@@ -37,9 +37,35 @@ fn from_numpy(image: &Obj<'_>) -> PyResult<Raster> {
     }
 }
 
-/// Reads an OpenEXR file (first layer with R, G, B; half, float or uint
-/// channels; the compressions the exr crate decodes). At most 2**28
-/// pixels.
+/// Reads an OpenEXR file: scanline or tiled, one part or several, half,
+/// float or uint channels, compressed by NONE, RLE, ZIPS, ZIP, PIZ, PXR24,
+/// B44, B44A, DWAA or DWAB (ZSTD and HTJ2K raise OSError); the largest
+/// mip level. At most 2**28 pixels.
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+/// layer : str, optional
+///     The layer to read: the channels ``layer.R``, ``layer.G``, ... (a
+///     part's name counts as a layer name; ``""`` is the channels without
+///     one). Default: the channels without a layer name if they hold
+///     colour, else the only layer that does (ValueError, listing them,
+///     when several do).
+///
+/// Returns
+/// -------
+/// ndarray, shape (H, W, 3), or (H, W, 4) if the layer has alpha; float32
+/// linear RGB(A), row 0 at the top. Colour is R, G, B (or lowercase r, g,
+/// b), else luminance Y repeated in all three.
+#[pyfunction]
+#[pyo3(signature = (path, layer = None))]
+pub fn read_exr<'py>(py: Python<'py>, path: PathBuf, layer: Option<String>) -> PyResult<Obj<'py>> {
+    let raster = detached(py, || io::read_exr(&path, layer.as_deref()))?;
+    to_numpy(py, raster)
+}
+
+/// Reads an 8- or 16-bit PNG as linear RGB(A): sRGB values decoded, alpha
+/// kept as stored. At most 2**28 pixels.
 ///
 /// Parameters
 /// ----------
@@ -47,11 +73,33 @@ fn from_numpy(image: &Obj<'_>) -> PyResult<Raster> {
 ///
 /// Returns
 /// -------
-/// ndarray, shape (H, W, 3), or (H, W, 4) if the file has alpha; float32
-/// linear RGB(A), row 0 at the top.
+/// ndarray, shape (H, W, 3), or (H, W, 4) with alpha; float32.
 #[pyfunction]
-pub fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Obj<'py>> {
-    let raster = detached(py, || io::read_exr(&path))?;
+pub fn read_png<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Obj<'py>> {
+    let raster = detached(py, || io::read_png(&path))?;
+    to_numpy(py, raster)
+}
+
+/// Reads an OpenEXR, Radiance HDR or PNG file, told by its first bytes
+/// (``read_exr``, ``read_hdr``, ``read_png``).
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+/// layer : str, optional
+///     For OpenEXR files, as ``read_exr`` (ValueError for other files).
+///
+/// Returns
+/// -------
+/// ndarray, shape (H, W, 3) or (H, W, 4), float32 linear RGB(A).
+#[pyfunction]
+#[pyo3(signature = (path, layer = None))]
+pub fn read_image<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+    layer: Option<String>,
+) -> PyResult<Obj<'py>> {
+    let raster = detached(py, || io::read_image(&path, layer.as_deref()))?;
     to_numpy(py, raster)
 }
 
@@ -195,6 +243,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_exr, m)?)?;
     m.add_function(wrap_pyfunction!(write_exr, m)?)?;
     m.add_function(wrap_pyfunction!(read_hdr, m)?)?;
+    m.add_function(wrap_pyfunction!(read_png, m)?)?;
+    m.add_function(wrap_pyfunction!(read_image, m)?)?;
     m.add_function(wrap_pyfunction!(write_png, m)?)?;
     Ok(())
 }

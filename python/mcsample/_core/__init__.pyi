@@ -195,10 +195,10 @@ class EnvMap:
                 to_world: Any = None, scale: float = 1.0, sampling: _Sampling = "piecewise",
                 compensate: bool = False) -> EnvMap: ...
     @classmethod
-    def load(cls, path: str | os.PathLike[str], *, mapping: _Mapping = "latlong", to_world: Any = None,
-             scale: float = 1.0, sampling: _Sampling = "piecewise",
-             compensate: bool = False) -> EnvMap:
-        """Reads an OpenEXR or Radiance .hdr file."""
+    def load(cls, path: str | os.PathLike[str], *, layer: str | None = None,
+             mapping: _Mapping = "latlong", to_world: Any = None, scale: float = 1.0,
+             sampling: _Sampling = "piecewise", compensate: bool = False) -> EnvMap:
+        """Reads an OpenEXR (of ``layer``), Radiance .hdr or PNG file."""
     def eval(self, d: ArrayLike, *, out: NDArray[Any] | None = None) -> _Floats:
         """Radiance from world directions d, (N, 3)."""
     def pdf(self, d: ArrayLike, *, out: NDArray[Any] | None = None) -> _Floats:

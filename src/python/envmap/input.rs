@@ -106,18 +106,16 @@ pub fn image_arg<'py>(
     Ok((width, height, array))
 }
 
-/// A file's image for `mapping`: RGB(A) (alpha dropped); cube maps as a
-/// vertical strip of six faces (6R × R) or a horizontal one (R × 6R), in
-/// the order +x, -x, +y, -y, +z, -z.
-pub fn read_image(path: &Path, mapping: Mapping) -> crate::Result<(usize, usize, Vec<f32>)> {
-    let is_hdr = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("hdr") || e.eq_ignore_ascii_case("rgbe"));
-    let raster = if is_hdr {
-        io::read_hdr(path)?
-    } else {
-        io::read_exr(path)?
-    };
+/// A file's image for `mapping` ([`io::read_image`]: OpenEXR, of `layer`,
+/// Radiance HDR or PNG): RGB (alpha dropped); cube maps as a vertical strip
+/// of six faces (6R × R) or a horizontal one (R × 6R), in the order +x,
+/// -x, +y, -y, +z, -z.
+pub fn read_image(
+    path: &Path,
+    mapping: Mapping,
+    layer: Option<&str>,
+) -> crate::Result<(usize, usize, Vec<f32>)> {
+    let raster = io::read_image(path, layer)?;
     let rgb: Vec<f32> = if raster.channels == 3 {
         raster.data
     } else {

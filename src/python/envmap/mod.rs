@@ -231,7 +231,7 @@ impl PyEnvMap {
                 .import("mcsample.data")?
                 .call_method0("sky_path")?
                 .extract()?;
-            let (w, h, data) = detached(py, || read_image(&path, Mapping::LatLong))?;
+            let (w, h, data) = detached(py, || read_image(&path, Mapping::LatLong, None))?;
             return Self::build(py, w, h, &data, options);
         };
         let (w, h, array) = image_arg(image, options.mapping)?;
@@ -245,10 +245,12 @@ impl PyEnvMap {
         }
     }
 
-    /// Reads an environment map from an OpenEXR or Radiance .hdr file
-    /// (alpha is dropped). Cube maps are a strip of six square faces,
-    /// vertical (6R x R) or horizontal (R x 6R), in the order +x, -x, +y,
-    /// -y, +z, -z. The other parameters are as for ``EnvMap``, and
+    /// Reads an environment map from an OpenEXR, Radiance .hdr or PNG file
+    /// (told by its first bytes; alpha is dropped; PNG's sRGB values are
+    /// decoded to linear). ``layer`` picks an EXR layer (as
+    /// ``mcsample.io.read_exr``). Cube maps are a strip of six square
+    /// faces, vertical (6R x R) or horizontal (R x 6R), in the order +x,
+    /// -x, +y, -y, +z, -z. The other parameters are as for ``EnvMap``, and
     /// keyword-only (and checked as ``EnvMap`` checks them).
     ///
     /// Negative values (which compression and resampling leave in many
@@ -259,7 +261,7 @@ impl PyEnvMap {
     #[classmethod]
     #[pyo3(
         signature = (path, **options),
-        text_signature = "(path, *, mapping='latlong', to_world=None, scale=1.0, sampling='piecewise', compensate=False)"
+        text_signature = "(path, *, layer=None, mapping='latlong', to_world=None, scale=1.0, sampling='piecewise', compensate=False)"
     )]
     fn load<'py>(
         cls: &Bound<'py, PyType>,
@@ -275,7 +277,17 @@ impl PyEnvMap {
             Some(name) => mapping_arg(&name.extract::<String>()?)?,
             None => Mapping::LatLong,
         };
-        let (w, h, mut data) = detached(py, || read_image(&path, mapping))?;
+        let layer: Option<String> = match options {
+            Some(o) => match o.get_item("layer")? {
+                Some(l) => {
+                    o.del_item("layer")?;
+                    l.extract()?
+                }
+                None => None,
+            },
+            None => None,
+        };
+        let (w, h, mut data) = detached(py, || read_image(&path, mapping, layer.as_deref()))?;
         let (negative, lowest) =
             data.iter_mut()
                 .filter(|v| **v < 0.0)
