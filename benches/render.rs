@@ -44,7 +44,7 @@ fn rectangle(m: [[f64; 4]; 4], material: Material, emission: Option<[f64; 3]>) -
 }
 
 fn scene(with_plane: bool) -> Scene {
-    let sky = mcsample::io::read_exr(Path::new("python/mcsample/data/sky.exr")).expect("sky");
+    let sky = mcsample::io::read_exr(Path::new("python/mcsample/data/sky.exr"), None).expect("sky");
     let rgb: Vec<f32> = sky
         .data
         .chunks(sky.channels)

@@ -84,10 +84,36 @@ pub struct Plan {
     pub seed: u64,
     /// Where the numbers come from.
     pub sampler: Sampler,
+    /// The index of the first evaluation in the sequence: a chunk of a
+    /// longer run ([`merge`]). A multiple of [`PART`].
+    pub first: usize,
+    /// The sequence's length (at least `first + n`), which the samplers
+    /// other than the independent one lay their patterns over.
+    pub total: usize,
+    /// Whether the estimate keeps its [`Part`]s, for [`merge`].
+    pub keep_parts: bool,
+}
+
+/// Evaluations per partial sum: an estimate is the ordered merge of the
+/// moments of its blocks of `PART` evaluations (whatever the thread
+/// count), and a chunk of a run must start at a multiple of it.
+pub const PART: usize = parallel::CHUNK;
+
+/// The moments of the evaluations `start .. start + n` of a run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Part {
+    /// Index of the first evaluation.
+    pub start: usize,
+    /// Number of evaluations (`PART`, or fewer for a run's last part).
+    pub n: usize,
+    /// Their mean.
+    pub mean: V3<f64>,
+    /// Their sum of squared deviations from the mean.
+    pub m2: V3<f64>,
 }
 
 /// A Monte Carlo estimate of an RGB quantity.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Estimate {
     /// The mean of the evaluations.
     pub value: V3<f64>,
@@ -95,6 +121,75 @@ pub struct Estimate {
     pub stderr: V3<f64>,
     /// The number of evaluations.
     pub n: usize,
+    /// The moments of its blocks of [`PART`] evaluations, in order, when
+    /// [`Plan::keep_parts`] asked for them (else empty).
+    pub parts: Vec<Part>,
+}
+
+impl Estimate {
+    /// The estimate of `parts` (in order, following one another): their
+    /// moments merged one after another, from the first.
+    ///
+    /// # Errors
+    /// [`Error::Argument`] when there are none or they do not follow one
+    /// another.
+    pub fn from_parts(parts: Vec<Part>, keep_parts: bool) -> Result<Estimate> {
+        let not_following = parts.windows(2).find(|w| w[0].start + w[0].n != w[1].start);
+        if let Some(w) = not_following {
+            return Err(Error::Argument {
+                arg: "estimates",
+                message: format!(
+                    "the chunks do not follow one another: evaluations {} .. {} are followed \
+                     by evaluations from {}",
+                    w[0].start,
+                    w[0].start + w[0].n,
+                    w[1].start
+                ),
+            });
+        }
+        if parts.is_empty() {
+            return Err(Error::Argument {
+                arg: "estimates",
+                message: "estimates hold no evaluations: nothing to merge".into(),
+            });
+        }
+        let m = parts.iter().fold(Moments::default(), |acc, p| {
+            acc.merge(Moments {
+                n: p.n as f64,
+                mean: p.mean,
+                m2: p.m2,
+            })
+        });
+        let n = parts.iter().map(|p| p.n).sum();
+        let stderr = if n > 1 {
+            m.m2.map(|v| (v / (m.n - 1.0) / m.n).sqrt())
+        } else {
+            [f64::INFINITY; 3]
+        };
+        Ok(Estimate {
+            value: m.mean,
+            stderr,
+            n,
+            parts: if keep_parts { parts } else { Vec::new() },
+        })
+    }
+}
+
+/// Chunks of one run merged (their parts in order of their first
+/// evaluation): the bits of one run of all their evaluations.
+///
+/// # Errors
+/// As [`Estimate::from_parts`].
+pub fn merge(chunks: &[Estimate]) -> Result<Estimate> {
+    let mut parts: Vec<Part> = alloc::with_capacity(
+        chunks.iter().map(|c| c.parts.len()).sum(),
+        "the partial sums",
+    )?;
+    for c in chunks {
+        parts.extend_from_slice(&c.parts);
+    }
+    parts.sort_by_key(|p| p.start);
+    Estimate::from_parts(parts, true)
 }
 
 /// Running mean and sum of squared deviations (Welford), merged in a fixed
@@ -144,8 +239,8 @@ impl Plan {
     /// [`Error::Integer`] for `n = 0`, or `n` above the sampler's
     /// [`Sampler::max_count`]; [`Error::Memory`].
     fn estimate(self, draws: u64, f: impl Fn(&mut Stream) -> V3<f64> + Sync) -> Result<Estimate> {
-        let Plan { n, seed, .. } = self;
-        self.sampler.check_count("n", n as u64)?;
+        let Plan { n, seed, first, .. } = self;
+        self.sampler.check_count("n", self.total as u64)?;
         if n == 0 {
             return Err(Error::Integer {
                 arg: "n",
@@ -153,31 +248,48 @@ impl Plan {
                 requirement: "must be at least 1".into(),
             });
         }
+        if !first.is_multiple_of(PART) || first.saturating_add(n) > self.total {
+            return Err(Error::Integer {
+                arg: "first_sample",
+                value: first.to_string(),
+                requirement: format!(
+                    "must be a multiple of {PART} (the evaluations of a partial sum), with \
+                     first_sample + n at most the sequence's length ({})",
+                    self.total
+                ),
+            });
+        }
         let base = Stream::new(
             self.sampler,
             mix64(seed),
             Rng::new(seed, 0),
-            n as u64,
-            ZOrder::new((0, 0), (1, 1), n as u64, seed),
+            self.total as u64,
+            ZOrder::new((0, 0), (1, 1), self.total as u64, seed),
         );
-        // One partial sum per chunk, reserved up front (2^26 of them for the
-        // largest n): too many for memory is an error before any work.
-        let parts = Mutex::new(alloc::with_capacity(
-            n.div_ceil(parallel::CHUNK),
-            "the partial sums",
-        )?);
+        // One partial sum per block of PART evaluations, reserved up front
+        // (2^26 of them for the largest n): too many for memory is an
+        // error before any work.
+        let parts = Mutex::new(alloc::with_capacity(n.div_ceil(PART), "the partial sums")?);
         parallel::for_each_chunk(n, (), |range, ()| {
-            // One partial sum per block of CHUNK items, whatever the range a
-            // thread is handed: the same sums in the same order on any pool.
+            // Blocks of PART evaluations, whatever the range a thread is
+            // handed: the same sums in the same order on any pool. The
+            // evaluation at index i draws from i·draws on (positional, so
+            // that a chunk of a run draws what the whole run draws).
             let mut local = Vec::new();
-            for start in range.clone().step_by(parallel::CHUNK) {
+            for offset in range.clone().step_by(PART) {
+                let start = first + offset;
                 let mut stream = base.jumped(start as u64 * draws);
                 let mut m = Moments::default();
-                for i in start..(start + parallel::CHUNK).min(range.end) {
+                for i in start..start + PART.min(range.end - offset) {
                     stream.start(i as u32);
                     m.push(f(&mut stream));
                 }
-                local.push((start, m));
+                local.push(Part {
+                    start,
+                    n: m.n as usize,
+                    mean: m.mean,
+                    m2: m.m2,
+                });
             }
             parts
                 .lock()
@@ -186,20 +298,8 @@ impl Plan {
             true
         })?;
         let mut parts = parts.into_inner().unwrap_or_else(|p| p.into_inner());
-        parts.sort_by_key(|p| p.0);
-        let m = parts
-            .into_iter()
-            .fold(Moments::default(), |acc, (_, m)| acc.merge(m));
-        let stderr = if n > 1 {
-            m.m2.map(|v| (v / (m.n - 1.0) / m.n).sqrt())
-        } else {
-            [f64::INFINITY; 3]
-        };
-        Ok(Estimate {
-            value: m.mean,
-            stderr,
-            n,
-        })
+        parts.sort_by_key(|p| p.start);
+        Estimate::from_parts(parts, self.keep_parts)
     }
 }
 
@@ -349,6 +449,9 @@ mod tests {
             heuristic: Heuristic::Power,
             seed,
             sampler: Sampler::Independent,
+            first: 0,
+            total: n,
+            keep_parts: false,
         }
     }
 

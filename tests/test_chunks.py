@@ -143,3 +143,58 @@ def test_bad_chunk_arguments_are_refused(demo):
         mcs.render(demo, 4, first_sample=0, total_spp=2**40, sampler="sobol", progress=False)
     with pytest.raises(TypeError):
         mcs.render(demo, 4, first_sample=1.5, progress=False)
+
+
+# Estimators: chunks of evaluations, merged to the bits of one run.
+
+PART = 16384  # evaluations per partial sum
+
+
+@pytest.mark.parametrize("sampler", ["independent", "sobol", "stratified"])
+@pytest.mark.parametrize("kind", ["irradiance", "reflected"])
+def test_estimator_chunks_merge_to_one_run(sampler, kind):
+    env = mcs.EnvMap()
+    n = 3 * PART + 1000
+    if kind == "irradiance":
+        def run(**kw):
+            return mcs.estimators.irradiance(env, [0.2, 1, 0.1], seed=5, sampler=sampler,
+                                             strategy="mis", **kw)
+    else:
+        phong = mcs.Phong([0.2] * 3, [0.5] * 3, 30.0)
+
+        def run(**kw):
+            return mcs.estimators.reflected_radiance(env, phong, [0, 1, 0], [0.3, 0.9, 0],
+                                                     seed=5, sampler=sampler, **kw)
+    one = run(n=n)
+    assert not one.mergeable and one.first_sample == 0
+    for cuts in ([0, n], [0, PART, n], [0, PART, 3 * PART, n]):
+        parts = [run(n=b - a, first_sample=a, total_n=n) for a, b in zip(cuts[:-1], cuts[1:])]
+        merged = mcs.estimators.Estimate.merge(parts[::-1])
+        assert merged.n == n and merged.mergeable and merged.first_sample == 0
+        np.testing.assert_array_equal(merged.value, one.value)
+        np.testing.assert_array_equal(merged.stderr, one.stderr)
+    # Through pickle (as to a worker and back) and merged again.
+    head = pickle.loads(pickle.dumps(run(n=2 * PART, first_sample=0, total_n=n)))
+    tail = run(n=n - 2 * PART, first_sample=2 * PART, total_n=n)
+    both = mcs.estimators.Estimate.merge([mcs.estimators.Estimate.merge([head]), tail])
+    np.testing.assert_array_equal(both.value, one.value)
+
+
+def test_bad_estimator_chunks_are_refused():
+    env = mcs.EnvMap()
+    run = lambda n, k, **kw: mcs.estimators.irradiance(env, [0, 1, 0], n, first_sample=k,  # noqa: E731
+                                                       **kw)
+    with pytest.raises(ValueError, match="multiple of 16384"):
+        run(100, 10)
+    with pytest.raises(ValueError, match="total_n"):
+        run(PART, PART, total_n=PART)
+    a, c = run(PART, 0), run(PART, 2 * PART)
+    with pytest.raises(ValueError, match="do not follow one another"):
+        mcs.estimators.Estimate.merge([a, c])
+    with pytest.raises(ValueError, match="first_sample="):
+        mcs.estimators.Estimate.merge([a, mcs.estimators.irradiance(env, [0, 1, 0], PART)])
+    with pytest.raises(ValueError, match="one strategy"):
+        mcs.estimators.Estimate.merge(
+            [a, run(PART, PART, strategy="cosine")])
+    with pytest.raises(ValueError, match="empty"):
+        mcs.estimators.Estimate.merge([])

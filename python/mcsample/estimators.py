@@ -41,6 +41,14 @@ _COMMON_DOC = """heuristic : "power" (default) or "balance"
         converges faster, and ``.stderr`` (the error of independent
         sampling) usually overstates its error; at most 2**32 - 1
         evaluations ("stratified", "multijitter": 2**30).
+    first_sample : int, optional
+        Estimate evaluations ``first_sample .. first_sample + n - 1`` of the
+        run's sequence: a chunk of a longer run, whose partial sums the
+        result keeps for :meth:`Estimate.merge` (chunks merged have the bits
+        of one run). A multiple of 16384 (the evaluations of a partial sum).
+    total_n : int, optional
+        The length of that sequence (default ``first_sample + n``), which
+        the stratified and Sobol' samplers lay their patterns over.
 
     Everything after ``n`` is keyword-only.
 
@@ -53,7 +61,8 @@ _COMMON_DOC = """heuristic : "power" (default) or "balance"
 def irradiance(env: EnvMap, normal: ArrayLike, n: int, *,
                strategy: Literal["uniform", "cosine", "emitter", "envmap", "mis"] = "mis",
                seed: SeedLike = 0, heuristic: Literal["balance", "power"] = "power",
-               sampler: Sampler = "independent") -> Estimate:
+               sampler: Sampler = "independent", first_sample: int | None = None,
+               total_n: int | None = None) -> Estimate:
     """The irradiance E = integral of L(w) max(0, n.w) dw at a surface of
     normal ``normal`` under ``env``, by Monte Carlo.
 
@@ -73,13 +82,14 @@ def irradiance(env: EnvMap, normal: ArrayLike, n: int, *,
     COMMON
     """
     return _estimate(env, normal, n, strategy=strategy, seed=seed, heuristic=heuristic,
-                     sampler=sampler)
+                     sampler=sampler, first_sample=first_sample, total_n=total_n)
 
 
 def reflected_radiance(env: EnvMap, phong: Phong, normal: ArrayLike, wi: ArrayLike, n: int, *,
                        strategy: Literal["bsdf", "emitter", "envmap", "mis"] = "mis",
                        seed: SeedLike = 0, heuristic: Literal["balance", "power"] = "power",
-                       sampler: Sampler = "independent") -> Estimate:
+                       sampler: Sampler = "independent", first_sample: int | None = None,
+                       total_n: int | None = None) -> Estimate:
     """The radiance L_r(wi) = integral of L(w) f_r(wi, w) max(0, n.w) dw that
     a Phong surface of normal ``normal`` reflects toward ``wi`` under ``env``.
 
@@ -99,7 +109,8 @@ def reflected_radiance(env: EnvMap, phong: Phong, normal: ArrayLike, wi: ArrayLi
     if not isinstance(phong, Phong):
         raise TypeError(f"phong must be an mcsample.Phong, got {type(phong).__name__}")
     return _estimate(env, normal, n, phong=phong, wi=wi, strategy=strategy, seed=seed,
-                     heuristic=heuristic, sampler=sampler)
+                     heuristic=heuristic, sampler=sampler, first_sample=first_sample,
+                     total_n=total_n)
 
 
 for _f in (irradiance, reflected_radiance):

@@ -6,7 +6,8 @@ use super::envmap::PyEnvMap;
 use super::parallel::detached;
 use super::phong::PyPhong;
 use super::pickle::reduce;
-use crate::estimators::{self, Estimate, Plan, Strategy};
+use crate::error::Error;
+use crate::estimators::{self, Estimate, Part, Plan, Strategy};
 use crate::python::Obj;
 use crate::sampler::Sampler;
 use numpy::PyArray1;
@@ -46,13 +47,78 @@ impl PyEstimate {
         self.strategy.name()
     }
 
-    /// The estimate of these numbers (the unpickling constructor).
+    /// The index of its first evaluation in the run's sequence (0 unless
+    /// estimated with ``first_sample=``).
+    #[getter]
+    fn first_sample(&self) -> usize {
+        self.estimate.parts.first().map_or(0, |p| p.start)
+    }
+
+    /// Whether it keeps the partial sums ``Estimate.merge`` needs (estimates
+    /// made with ``first_sample=``, and merges, do).
+    #[getter]
+    fn mergeable(&self) -> bool {
+        !self.estimate.parts.is_empty()
+    }
+
+    /// The estimate of chunks of one run (``estimators.*`` with the same
+    /// arguments and ``first_sample=``), in any order, covering consecutive
+    /// evaluations: the bits of one run of all their evaluations. It can be
+    /// merged again with the chunks that follow.
+    ///
+    /// Raises ValueError for chunks with gaps or overlaps, of different
+    /// strategies, or made without ``first_sample``.
+    #[staticmethod]
+    fn merge(py: Python<'_>, estimates: Vec<Bound<'_, PyEstimate>>) -> PyResult<PyEstimate> {
+        let Some(first) = estimates.first() else {
+            return Err(Error::Argument {
+                arg: "estimates",
+                message: "estimates is empty: nothing to merge".into(),
+            }
+            .into());
+        };
+        let strategy = first.get().strategy;
+        let mut chunks = Vec::with_capacity(estimates.len());
+        for e in &estimates {
+            let e = e.get();
+            if e.estimate.parts.is_empty() || e.strategy != strategy {
+                return Err(Error::Argument {
+                    arg: "estimates",
+                    message: "estimates must be chunks of one run: made with first_sample= \
+                              (which keeps the partial sums a merge needs), by one strategy"
+                        .into(),
+                }
+                .into());
+            }
+            chunks.push(e.estimate.clone());
+        }
+        let estimate = detached(py, || estimators::merge(&chunks))?;
+        Ok(PyEstimate { estimate, strategy })
+    }
+
+    /// The estimate of these numbers (the unpickling constructor): parts as
+    /// (start, n, mean, m2).
     #[staticmethod]
     #[doc(hidden)]
-    fn _from_fields(value: [f64; 3], stderr: [f64; 3], n: usize, strategy: &str) -> PyResult<Self> {
+    fn _from_fields(
+        value: [f64; 3],
+        stderr: [f64; 3],
+        n: usize,
+        strategy: &str,
+        parts: Vec<(usize, usize, [f64; 3], [f64; 3])>,
+    ) -> PyResult<Self> {
         let strategy = choice("strategy", strategy, &[IRRADIANCE, REFLECTED].concat())?;
+        let parts = parts
+            .into_iter()
+            .map(|(start, n, mean, m2)| Part { start, n, mean, m2 })
+            .collect();
         Ok(PyEstimate {
-            estimate: Estimate { value, stderr, n },
+            estimate: Estimate {
+                value,
+                stderr,
+                n,
+                parts,
+            },
             strategy,
         })
     }
@@ -61,7 +127,12 @@ impl PyEstimate {
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Obj<'py>> {
         let this = slf.get();
         let e = &this.estimate;
-        let args = (e.value, e.stderr, e.n, this.strategy.name()).into_pyobject(slf.py())?;
+        let parts: Vec<_> = e
+            .parts
+            .iter()
+            .map(|p| (p.start, p.n, p.mean, p.m2))
+            .collect();
+        let args = (e.value, e.stderr, e.n, this.strategy.name(), parts).into_pyobject(slf.py())?;
         reduce(slf.as_any(), Some("_from_fields"), args, None)
     }
 
@@ -99,7 +170,7 @@ const REFLECTED: &[(&str, Strategy)] = &[
 /// ``mcsample.estimators.irradiance`` and ``reflected_radiance`` call it
 /// and document the arguments.
 #[pyfunction]
-#[pyo3(signature = (env, normal, n, *, phong = None, wi = None, strategy, seed, heuristic, sampler))]
+#[pyo3(signature = (env, normal, n, *, phong = None, wi = None, strategy, seed, heuristic, sampler, first_sample = None, total_n = None))]
 #[allow(clippy::too_many_arguments)] // the Python signature
 pub fn estimate(
     py: Python<'_>,
@@ -112,10 +183,24 @@ pub fn estimate(
     #[pyo3(from_py_with = seed)] seed: u64,
     heuristic: &str,
     sampler: &str,
+    first_sample: Option<Obj<'_>>,
+    total_n: Option<Obj<'_>>,
 ) -> PyResult<PyEstimate> {
     let normal = three_floats(normal, "normal", false)?;
+    let n = index_arg(n, "n", 1, 1 << 40)? as usize;
+    let first = match &first_sample {
+        Some(k) => index_arg(k, "first_sample", 0, 1 << 40)? as usize,
+        None => 0,
+    };
+    let total = match &total_n {
+        Some(t) => index_arg(t, "total_n", (first + n) as u64, 1 << 41)? as usize,
+        None => first + n,
+    };
     let plan = Plan {
-        n: index_arg(n, "n", 1, 1 << 40)? as usize,
+        n,
+        first,
+        total,
+        keep_parts: first_sample.is_some(),
         strategy: choice(
             "strategy",
             strategy,

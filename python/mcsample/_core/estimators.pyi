@@ -1,6 +1,6 @@
 """Estimators of irradiance and reflected radiance under an environment map."""
 
-from typing import Final, Literal, final
+from typing import Final, Literal, Sequence, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -17,11 +17,17 @@ class Estimate:
     stderr: Final[NDArray[np.float64]]
     n: Final[int]
     strategy: Final[str]
+    first_sample: Final[int]
+    mergeable: Final[bool]
+
+    @staticmethod
+    def merge(estimates: Sequence[Estimate]) -> Estimate:
+        """The estimate of chunks of one run: the bits of one run."""
 
 def estimate(env: EnvMap, normal: ArrayLike, n: int, *, phong: Phong | None = None,
              wi: ArrayLike | None = None, strategy: _Strategy,
              seed: int | np.random.Generator | None, heuristic: Literal["balance", "power"],
-             sampler: Literal["independent", "stratified", "multijitter", "sobol", "zsobol"]
-             ) -> Estimate:
+             sampler: Literal["independent", "stratified", "multijitter", "sobol", "zsobol"],
+             first_sample: int | None = None, total_n: int | None = None) -> Estimate:
     """The irradiance (without phong) or the reflected radiance (with phong
     and wi): see mcsample.estimators."""
