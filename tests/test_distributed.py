@@ -120,3 +120,33 @@ def test_bad_arguments(client, scene):
         mcs.distributed.render(scene, 0, client, progress=False)
     with pytest.raises(ValueError, match="strategy"):
         mcs.distributed.render(scene, 4, client, 2, strategy="nope", progress=False)
+
+
+@pytest.mark.parametrize("chunks", [None, 3, [16384, 32768, 1000]])
+def test_estimates_on_the_cluster_have_the_bits_of_one_run(client, chunks):
+    env = mcs.EnvMap()
+    n = 3 * 16384 + 1000
+    local = mcs.estimators.irradiance(env, [0, 1, 0.2], n, seed=4, sampler="sobol")
+    remote = mcs.distributed.estimate(mcs.estimators.irradiance, env, [0, 1, 0.2], n=n,
+                                      client=client, chunks=chunks, seed=4, sampler="sobol",
+                                      progress=False)
+    np.testing.assert_array_equal(remote.value, local.value)
+    np.testing.assert_array_equal(remote.stderr, local.stderr)
+    assert remote.n == n and remote.mergeable
+    phong = mcs.Phong([0.2] * 3, [0.5] * 3, 30.0)
+    args = (env, phong, [0, 1, 0], [0.3, 0.9, 0])
+    local = mcs.estimators.reflected_radiance(*args, 40000, seed=1)
+    remote = mcs.distributed.estimate(mcs.estimators.reflected_radiance, *args, n=40000,
+                                      client=client, chunks=2,
+                                      seed=1, progress=False)
+    np.testing.assert_array_equal(remote.value, local.value)
+
+
+def test_bad_estimate_chunks(client):
+    env = mcs.EnvMap()
+    with pytest.raises(ValueError, match="multiples of 16384"):
+        mcs.distributed.estimate(mcs.estimators.irradiance, env, [0, 1, 0], n=20000,
+                                 client=client, chunks=[10000, 10000], progress=False)
+    with pytest.raises(TypeError, match="total_n"):
+        mcs.distributed.estimate(mcs.estimators.irradiance, env, [0, 1, 0], n=20000,
+                                 client=client, total_n=5, progress=False)

@@ -1,5 +1,5 @@
-"""``mcsample.distributed``: renders split into chunks of samples and run on
-a Dask cluster (``dask.distributed``, an optional dependency: ``pip install
+"""``mcsample.distributed``: renders (and estimator runs) split into chunks
+of samples and run on a Dask cluster (``dask.distributed``, an optional dependency: ``pip install
 "dask[distributed]"``).
 
 Each chunk is ``mcsample.render(scene, n, first_sample=k, total_spp=spp,
@@ -16,12 +16,13 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-from typing import TYPE_CHECKING, Any, Iterator, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Sequence
 
 from ._args import integer
 from ._core import get_num_threads, set_num_threads
 from .rendering import _progress_bar
 from .rendering import render as _render_local
+from ._core.estimators import Estimate
 from .results import RenderResult
 from .scene import Scene
 from .seeds import SeedLike, resolve_seed
@@ -29,7 +30,7 @@ from .seeds import SeedLike, resolve_seed
 if TYPE_CHECKING:
     from distributed import Client
 
-__all__ = ["chunk_sizes", "render"]
+__all__ = ["chunk_sizes", "estimate", "render"]
 
 
 def chunk_sizes(spp: int, chunks: int) -> list[int]:
@@ -50,14 +51,19 @@ def chunk_sizes(spp: int, chunks: int) -> list[int]:
     return sizes
 
 
-def _render_chunk(scene: Scene, spp: int, first_sample: int, kw: dict[str, Any]) -> RenderResult:
-    """One chunk, on a worker: mcsample's threads are the worker's."""
+def _use_worker_threads() -> None:
+    """On a Dask worker, mcsample's threads are the worker's."""
     with contextlib.suppress(ValueError, ImportError):
         from distributed import get_worker
 
         threads = get_worker().state.nthreads
         if get_num_threads() != threads:
             set_num_threads(threads)
+
+
+def _render_chunk(scene: Scene, spp: int, first_sample: int, kw: dict[str, Any]) -> RenderResult:
+    """One chunk of a render, on a worker."""
+    _use_worker_threads()
     return _render_local(scene, spp, first_sample=first_sample, progress=False, **kw)
 
 
@@ -119,60 +125,145 @@ def render(scene: Scene, spp: int, client: Client | None = None,
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be an mcsample.Scene, got {type(scene).__name__}")
-    for name in ("first_sample", "total_spp"):
-        if name in kw:
-            raise TypeError(f"{name} is chosen per chunk by mcsample.distributed.render")
+    _refuse_chunk_options(kw, "first_sample", "total_spp")
     spp = integer(spp, "spp", 1)
     kw = {**kw, "seed": resolve_seed(seed), "total_spp": spp}
     start = time.perf_counter()
     with _client(client) as c:
         if chunks is None or isinstance(chunks, int):
-            threads = sum(c.nthreads().values()) or 1
-            count = 4 * threads if chunks is None else integer(chunks, "chunks", 1)
-            sizes = chunk_sizes(spp, count)
+            sizes = chunk_sizes(spp, _chunk_count(c, chunks))
         else:
-            sizes = [integer(n, "chunks", 1) for n in chunks]
-            if sum(sizes) != spp:
-                raise ValueError(f"chunks add up to {sum(sizes)} samples: they must add up to "
-                                 f"spp = {spp}")
-        firsts = [sum(sizes[:i]) for i in range(len(sizes))]
-        [remote] = c.scatter([scene], broadcast=True)
-        futures = [c.submit(_render_chunk, remote, n, k, kw, pure=False)
-                   for n, k in zip(sizes, firsts)]
+            sizes = _sizes(chunks, spp, "samples")
         height, width = scene.shape
-        callback, bar = _progress_bar(spp * width * height, progress)
-        try:
-            merged = _merge_as_completed(futures, callback, width * height)
-        except BaseException:
-            c.cancel([remote, *futures])
-            raise
-        finally:
-            if bar is not None:
-                bar.close()
+        merged = _run(c, scene, _render_chunk, sizes, kw, width * height, progress,
+                      lambda r: r.spp, RenderResult.merge)
     return RenderResult(merged.image, merged.variance, merged.luminance_variance, merged.spp,
                         time.perf_counter() - start, 0, merged.chunk)
 
 
-def _merge_as_completed(futures: list[Any], callback: Any, pixels: int) -> RenderResult:
-    """Merges the chunks in sample order as they arrive (a chunk that comes
-    early waits for those before it)."""
+def estimate(estimator: Callable[..., Estimate], *args: Any, n: int,
+             client: Client | None = None, chunks: int | Sequence[int] | None = None,
+             seed: SeedLike = 0, progress: bool = True, **kw: Any) -> Estimate:
+    """Runs ``estimator(*args, n=n, **kw)`` (``mcsample.estimators.irradiance``
+    or ``reflected_radiance``) in chunks of evaluations on a Dask cluster.
+
+    Parameters
+    ----------
+    estimator : callable
+        ``mcsample.estimators.irradiance`` or ``reflected_radiance``.
+    *args
+        Its positional arguments before ``n`` (``env, normal`` or ``env,
+        phong, normal, wi``), sent once to every worker.
+    n : int
+        Evaluations in all.
+    client, progress
+        As :func:`render`.
+    chunks : int or sequence of int, optional
+        The number of chunks, or the evaluations of each (all but the last
+        multiples of 16384, adding up to ``n``). Default: four per worker
+        thread, each a multiple of 16384.
+    seed : int, None or numpy.random.Generator
+        As the estimator's; None draws one seed here, for every chunk.
+    **kw
+        The estimator's other options (``strategy``, ``sampler``, ...).
+
+    Returns
+    -------
+    Estimate
+        The bits of ``estimator(*args, n, seed=seed, **kw)``, keeping its
+        partial sums (``Estimate.merge`` takes it).
+    """
+    _refuse_chunk_options(kw, "first_sample", "total_n")
+    n = integer(n, "n", 1)
+    kw = {**kw, "seed": resolve_seed(seed), "total_n": n}
+    with _client(client) as c:
+        if chunks is None or isinstance(chunks, int):
+            size = _PART * max(1, math.ceil(n / _chunk_count(c, chunks) / _PART))
+            sizes = [size] * (n // size) + ([n % size] if n % size else [])
+        else:
+            sizes = _sizes(chunks, n, "evaluations")
+            if any(k % _PART for k in sizes[:-1]):
+                raise ValueError(f"chunks = {sizes}: all but the last must be multiples of "
+                                 f"{_PART} (the evaluations of a partial sum)")
+        return _run(c, (estimator, args), _estimate_chunk, sizes, kw, 1, progress,
+                    lambda e: e.n, Estimate.merge)
+
+
+#: Evaluations per partial sum of an estimate (chunks start at multiples).
+_PART = 16384
+
+
+def _estimate_chunk(job: tuple[Callable[..., Estimate], tuple[Any, ...]], n: int,
+                    first_sample: int, kw: dict[str, Any]) -> Estimate:
+    """One chunk of an estimate, on a worker."""
+    _use_worker_threads()
+    estimator, args = job
+    return estimator(*args, n=n, first_sample=first_sample, **kw)
+
+
+def _refuse_chunk_options(kw: dict[str, Any], *names: str) -> None:
+    """TypeError for options that the chunking chooses."""
+    for name in names:
+        if name in kw:
+            raise TypeError(f"{name} is chosen per chunk by mcsample.distributed")
+
+
+def _chunk_count(c: Client, chunks: int | None) -> int:
+    """``chunks``, or four per thread of the cluster."""
+    if chunks is None:
+        return 4 * (sum(c.nthreads().values()) or 1)
+    return integer(chunks, "chunks", 1)
+
+
+def _sizes(chunks: Sequence[int], total: int, what: str) -> list[int]:
+    """The chunk sizes given, checked: positive, adding up to ``total``."""
+    sizes = [integer(k, "chunks", 1) for k in chunks]
+    if sum(sizes) != total:
+        raise ValueError(f"chunks add up to {sum(sizes)} {what}: they must add up to {total}")
+    return sizes
+
+
+def _run(c: Client, shared: Any, task: Callable[..., Any], sizes: list[int],
+         kw: dict[str, Any], scale: int, progress: bool, count: Callable[[Any], int],
+         merge: Callable[[list[Any]], Any]) -> Any:
+    """Sends ``shared`` to every worker once, runs ``task(shared, size,
+    first, kw)`` for each chunk, and merges the results as they arrive;
+    Ctrl-C (or any error) cancels what is left."""
+    firsts = [sum(sizes[:i]) for i in range(len(sizes))]
+    [remote] = c.scatter([shared], broadcast=True)
+    futures = [c.submit(task, remote, n, k, kw, pure=False) for n, k in zip(sizes, firsts)]
+    callback, bar = _progress_bar(sum(sizes) * scale, progress)
+    try:
+        return _merge_as_completed(futures, callback, scale, count, merge)
+    except BaseException:
+        c.cancel([remote, *futures])
+        raise
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _merge_as_completed(futures: list[Any], callback: Any, scale: int,
+                        count: Callable[[Any], int], merge: Callable[[list[Any]], Any]) -> Any:
+    """Merges the chunks in order as they arrive (a chunk that comes early
+    waits for those before it); ``count`` is a result's number of samples,
+    ``scale`` the progress units per sample."""
     from distributed import as_completed
 
-    waiting: dict[int, RenderResult] = {}
-    merged: RenderResult | None = None
+    waiting: dict[int, Any] = {}
+    merged: Any = None
     done = 0
     for future in as_completed(futures):
-        chunk: RenderResult = future.result()
+        chunk = future.result()
         future.release()
         waiting[chunk.first_sample] = chunk
-        done += chunk.spp
+        done += count(chunk)
         if callback is not None:
-            callback(done * pixels)
-        next_sample = 0 if merged is None else merged.spp
+            callback(done * scale)
+        next_sample = 0 if merged is None else count(merged)
         while next_sample in waiting:
             part = waiting.pop(next_sample)
-            merged = part if merged is None else RenderResult.merge([merged, part])
-            next_sample = merged.spp
+            merged = part if merged is None else merge([merged, part])
+            next_sample = count(merged)
     assert merged is not None and not waiting
     return merged
-

@@ -452,14 +452,7 @@ fn render_puts_each_sample_in_its_own_pixel() {
     ];
     let scene = Scene::new(wall, None, camera(), 4, 4).unwrap();
     let s = settings(Integrator::Direct, Strategy::Mis);
-    let image = super::render(
-        &scene,
-        super::Samples::all(8),
-        3,
-        &s,
-        &super::Progress::default(),
-    )
-    .unwrap();
+    let image = render_all(&scene, 8, 3, &s);
     assert_eq!((image.width, image.height), (4, 4));
     let red = |row: usize, col: usize| image.mean[(row * 4 + col) * 3];
     let mut seen = Vec::new();
@@ -496,16 +489,7 @@ fn render_reports_the_variance_of_each_pixels_mean() {
     };
     let seeds = 24;
     let images: Vec<_> = (0..seeds)
-        .map(|seed| {
-            super::render(
-                &scene,
-                super::Samples::all(16),
-                seed,
-                &s,
-                &super::Progress::default(),
-            )
-            .unwrap()
-        })
+        .map(|seed| render_all(&scene, 16, seed, &s))
         .collect();
     assert_ne!(
         images[0].mean, images[1].mean,
@@ -555,14 +539,7 @@ fn render_reports_the_variance_of_each_pixels_mean() {
             "{name}: {total} ± {se}"
         );
     }
-    let one = super::render(
-        &scene,
-        super::Samples::all(1),
-        0,
-        &s,
-        &super::Progress::default(),
-    )
-    .unwrap();
+    let one = render_all(&scene, 1, 0, &s);
     assert!(
         one.variance
             .iter()
@@ -613,4 +590,16 @@ fn mesh_faces_must_index_its_vertices() {
             "{bad:?}"
         );
     }
+}
+
+/// All `spp` samples of `scene` (nothing watching).
+fn render_all(scene: &Scene, spp: u32, seed: u64, s: &Settings) -> super::Image {
+    super::render(
+        scene,
+        super::Samples::all(spp),
+        seed,
+        s,
+        &super::Progress::default(),
+    )
+    .unwrap()
 }
