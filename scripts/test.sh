@@ -25,25 +25,32 @@ WHEEL=$(ls "$PWD"/target/wheels/mcsample_toolkit-*-cp39-abi3-*.whl)
 ls -l "$WHEEL"
 
 # Installed into fresh virtual environments with no Rust toolchain on PATH
-# (this Python, and 3.9 and 3.13 where pyenv has them): a smoke test, run
-# outside the source tree.
-NO_RUST_PATH=$(echo "$PATH" | tr ':' '\n' | grep -v -E '[.]cargo|rustup' | paste -sd:)
+# (the PATH entries holding cargo or rustc left out), by this Python and by
+# 3.9 and 3.13 where pyenv has them: a smoke test, run outside the source
+# tree.
+NO_RUST_PATH=""
+IFS=: read -ra entries <<<"$PATH"
+for dir in "${entries[@]}"; do
+  [ -x "$dir/cargo" ] || [ -x "$dir/rustc" ] || NO_RUST_PATH="${NO_RUST_PATH:+$NO_RUST_PATH:}$dir"
+done
 SMOKE=$(mktemp -d)
+trap 'rm -rf "$SMOKE"' EXIT
 i=0
-for py in python "$HOME"/.pyenv/versions/3.9*/bin/python "$HOME"/.pyenv/versions/3.13*/bin/python; do
-  command -v "$py" >/dev/null || continue
+for py in python "$HOME"/.pyenv/versions/3.9.[0-9]*/bin/python \
+    "$HOME"/.pyenv/versions/3.13.[0-9]*/bin/python; do
+  command -v "$py" >/dev/null || { echo "smoke test: no $py here"; continue; }
   i=$((i + 1))
   "$py" -m venv "$SMOKE/venv$i"
   (cd "$SMOKE" && export PATH="$NO_RUST_PATH" &&
     "$SMOKE/venv$i/bin/python" -m pip install --quiet "$WHEEL" &&
     "$SMOKE/venv$i/bin/python" "$ROOT/scripts/smoke.py")
 done
-rm -rf "$SMOKE"
 
-# The same wheel, with what the suite needs, into this Python (the
-# distribution was called "mcsample" before: that name on the package index
-# is another project's).
-python -m pip uninstall --quiet -y mcsample 2>/dev/null || true
+# The same wheel, with what the suite needs, into this Python, in place of
+# any earlier install (pip keeps one of the same version otherwise; the
+# distribution was called "mcsample" before: that name on the package
+# index is another project's).
+python -m pip uninstall --quiet -y mcsample mcsample-toolkit 2>/dev/null || true
 python -m pip install --quiet "$WHEEL[test,mitsuba,plot,distributed]"
 
 rustup component add rustfmt clippy >/dev/null 2>&1 || true

@@ -180,7 +180,7 @@ impl Estimate {
 ///
 /// # Errors
 /// As [`Estimate::from_parts`].
-pub fn merge(chunks: &[Estimate]) -> Result<Estimate> {
+pub fn merge(chunks: &[&Estimate]) -> Result<Estimate> {
     let mut parts: Vec<Part> = alloc::with_capacity(
         chunks.iter().map(|c| c.parts.len()).sum(),
         "the partial sums",

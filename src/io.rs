@@ -96,13 +96,14 @@ pub fn read_exr(path: &Path, layer: Option<&str>) -> Result<Raster> {
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(cannot)?;
     for header in &meta.headers {
         let size = header.layer_size;
-        check_size(
-            path,
-            size.width(),
-            size.height(),
-            header.channels.list.len(),
-        )?;
+        check_size(path, size.width(), size.height(), 1)?;
     }
+    // Every channel of every part is read: memory for all of them.
+    let floats = meta
+        .headers
+        .iter()
+        .map(|h| h.layer_size.area() * h.channels.list.len());
+    alloc::probe::<f32>(floats.sum(), "the image's channels")?;
     let image = read()
         .no_deep_data()
         .largest_resolution_level()
@@ -216,6 +217,15 @@ pub fn read_exr(path: &Path, layer: Option<&str>) -> Result<Raster> {
     }
     let (width, height, count) = (size.width(), size.height(), planes.len());
     let mut data = alloc::filled(width * height * count, 0.0f32, "the image")?;
+    if planes
+        .iter()
+        .any(|(samples, _)| samples.len() != width * height)
+    {
+        return Err(io_error(
+            path,
+            format!("layer '{chosen}': subsampled channels (x/y sampling above 1) are not read"),
+        ));
+    }
     for (c, (samples, _)) in planes.iter().enumerate() {
         for (out, value) in data
             .iter_mut()

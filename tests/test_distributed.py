@@ -82,13 +82,14 @@ def test_a_worker_lost_mid_run_changes_nothing(client, scene, monkeypatch):
     def progress_bar(total, enabled):
         def update(done):
             if not killed:
+                # Chunks queued or running on it: their work must be redone.
+                killed.append(len(client.processing(workers=[victim])[victim]))
                 os.kill(pids[victim], signal.SIGKILL)
-                killed.append(done)
         return update, None
 
     monkeypatch.setattr(mcs.distributed, "_progress_bar", progress_bar)
     remote = mcs.distributed.render(scene, 256, client, [8] * 32, **kw)
-    assert killed and killed[0] < 256 * 48 * 20
+    assert killed and killed[0] > 0
     assert_same_bits(remote, local)
     client.wait_for_workers(2, timeout=60)
     assert pids[victim] not in client.run(os.getpid).values()

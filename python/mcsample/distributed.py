@@ -117,8 +117,8 @@ def render(scene: Scene, spp: int, client: Client | None = None,
     RenderResult
         The bits of ``mcsample.render(scene, spp, seed=seed, **kw)``;
         ``seconds`` is the wall-clock time of this call, and the result
-        keeps its sums (``first_sample=0``), so more samples can be merged
-        into it later.
+        keeps its sums (``first_sample=0``): an independent render can be
+        continued by merging more samples into it.
 
     Ctrl-C cancels the chunks that are not done and raises
     KeyboardInterrupt.
@@ -129,11 +129,10 @@ def render(scene: Scene, spp: int, client: Client | None = None,
     spp = integer(spp, "spp", 1)
     kw = {**kw, "seed": resolve_seed(seed), "total_spp": spp}
     start = time.perf_counter()
+    count, sizes = _chunking(chunks, spp, "samples")
     with _client(client) as c:
-        if chunks is None or isinstance(chunks, int):
-            sizes = chunk_sizes(spp, _chunk_count(c, chunks))
-        else:
-            sizes = _sizes(chunks, spp, "samples")
+        if sizes is None:
+            sizes = chunk_sizes(spp, count or _default_count(c))
         height, width = scene.shape
         merged = _run(c, scene, _render_chunk, sizes, kw, width * height, progress,
                       lambda r: r.spp, RenderResult.merge)
@@ -176,15 +175,14 @@ def estimate(estimator: Callable[..., Estimate], *args: Any, n: int,
     _refuse_chunk_options(kw, "first_sample", "total_n")
     n = integer(n, "n", 1)
     kw = {**kw, "seed": resolve_seed(seed), "total_n": n}
+    count, sizes = _chunking(chunks, n, "evaluations")
+    if sizes is not None and any(k % _PART for k in sizes[:-1]):
+        raise ValueError(f"chunks = {sizes}: all but the last must be multiples of "
+                         f"{_PART} (the evaluations of a partial sum)")
     with _client(client) as c:
-        if chunks is None or isinstance(chunks, int):
-            size = _PART * max(1, math.ceil(n / _chunk_count(c, chunks) / _PART))
+        if sizes is None:
+            size = _PART * max(1, math.ceil(n / (count or _default_count(c)) / _PART))
             sizes = [size] * (n // size) + ([n % size] if n % size else [])
-        else:
-            sizes = _sizes(chunks, n, "evaluations")
-            if any(k % _PART for k in sizes[:-1]):
-                raise ValueError(f"chunks = {sizes}: all but the last must be multiples of "
-                                 f"{_PART} (the evaluations of a partial sum)")
         return _run(c, (estimator, args), _estimate_chunk, sizes, kw, 1, progress,
                     lambda e: e.n, Estimate.merge)
 
@@ -208,19 +206,23 @@ def _refuse_chunk_options(kw: dict[str, Any], *names: str) -> None:
             raise TypeError(f"{name} is chosen per chunk by mcsample.distributed")
 
 
-def _chunk_count(c: Client, chunks: int | None) -> int:
-    """``chunks``, or four per thread of the cluster."""
+def _default_count(c: Client) -> int:
+    """Four chunks per thread of the cluster."""
+    return 4 * (sum(c.nthreads().values()) or 1)
+
+
+def _chunking(chunks: int | Sequence[int] | None, total: int,
+              what: str) -> tuple[int | None, list[int] | None]:
+    """``chunks`` checked (before a cluster is started): a count, or the
+    sizes (positive, adding up to ``total``), or neither (the default)."""
     if chunks is None:
-        return 4 * (sum(c.nthreads().values()) or 1)
-    return integer(chunks, "chunks", 1)
-
-
-def _sizes(chunks: Sequence[int], total: int, what: str) -> list[int]:
-    """The chunk sizes given, checked: positive, adding up to ``total``."""
+        return None, None
+    if isinstance(chunks, int):
+        return integer(chunks, "chunks", 1), None
     sizes = [integer(k, "chunks", 1) for k in chunks]
     if sum(sizes) != total:
         raise ValueError(f"chunks add up to {sum(sizes)} {what}: they must add up to {total}")
-    return sizes
+    return None, sizes
 
 
 def _run(c: Client, shared: Any, task: Callable[..., Any], sizes: list[int],

@@ -123,7 +123,8 @@ def render(scene: Scene, spp: int | None = None, *,
     Returns
     -------
     RenderResult with ``.image`` and ``.variance`` (H, W, 3) float32,
-    ``.spp`` and ``.seconds``.
+    ``.luminance_variance`` (H, W), ``.spp``, ``.seconds``, ``.first_sample``
+    and, for a render given ``first_sample``, ``.chunk`` (its sums).
     """
     if not isinstance(scene, Scene):
         raise TypeError(f"scene must be an mcsample.Scene, got {type(scene).__name__}")
@@ -151,7 +152,8 @@ def render(scene: Scene, spp: int | None = None, *,
         # it: an independent render can be continued with more samples.
         total = None if sampler == "independent" else first + int(spp) \
             if total_spp is None else int(total_spp)
-        chunk = Chunk(blocks, sums, (scene.shape, seed, sampler, total, strategy, heuristic,
+        strategy_name = "emitter" if strategy == "envmap" else strategy
+        chunk = Chunk(blocks, sums, (scene.shape, seed, sampler, total, strategy_name, heuristic,
                                      tuple(sorted(settings.items()))))
     return RenderResult(image.reshape(height, width, 3), variance.reshape(height, width, 3),
                         lum_var.reshape(height, width), int(spp), seconds, first, chunk)

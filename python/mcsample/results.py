@@ -133,12 +133,14 @@ class RenderResult(Result):
         again with the chunks that follow it.
 
         Raises ValueError for chunks of different renders (shape, seed,
-        sampler, ``total_spp`` or settings), with gaps or overlaps, or
-        rendered without ``first_sample``.
+        sampler, settings, and ``total_spp`` for the samplers whose patterns
+        span it: an independent render can be continued with more samples),
+        with gaps or overlaps, or rendered without ``first_sample``. The
+        scene itself is not compared: merge chunks of one scene.
         """
         from ._core.render import merge
 
-        results = sorted(results, key=lambda r: r.first_sample)
+        results = list(results)
         if not results:
             raise ValueError("results is empty: nothing to merge")
         for r in results:
@@ -146,6 +148,7 @@ class RenderResult(Result):
                 raise ValueError(
                     "results must be RenderResults of renders given first_sample= (which keep "
                     "the sums a merge needs)")
+        results.sort(key=lambda r: r.first_sample)
         key = results[0].chunk.key  # type: ignore[union-attr]
         for r in results[1:]:
             if r.chunk.key != key:  # type: ignore[union-attr]

@@ -8,6 +8,7 @@ use super::phong::PyPhong;
 use super::pickle::reduce;
 use crate::error::Error;
 use crate::estimators::{self, Estimate, Part, Plan, Strategy};
+use crate::mis::Heuristic;
 use crate::python::Obj;
 use crate::sampler::Sampler;
 use numpy::PyArray1;
@@ -18,6 +19,43 @@ use pyo3::prelude::*;
 pub struct PyEstimate {
     estimate: Estimate,
     strategy: Strategy,
+    /// What chunks of one run share: seed, sampler, heuristic, and the
+    /// sequence's length for the samplers that depend on it (`None` for
+    /// estimates made without `first_sample`).
+    run: Option<Run>,
+}
+
+/// The settings that chunks of one run share.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Run {
+    seed: u64,
+    sampler: Sampler,
+    heuristic: Heuristic,
+    total: Option<usize>,
+}
+
+/// A run's settings as pickled: seed, sampler and heuristic by name, total.
+type RunFields = (u64, String, String, Option<usize>);
+
+impl Run {
+    fn fields(&self) -> RunFields {
+        let sampler = Sampler::NAMES.iter().find(|(_, s)| *s == self.sampler);
+        let heuristic = match self.heuristic {
+            Heuristic::Power => "power",
+            Heuristic::Balance => "balance",
+        };
+        let sampler = sampler.map_or("independent", |(name, _)| name);
+        (self.seed, sampler.into(), heuristic.into(), self.total)
+    }
+
+    fn from_fields((seed, sampler, heuristic, total): RunFields) -> PyResult<Self> {
+        Ok(Run {
+            seed,
+            sampler: choice("sampler", &sampler, Sampler::NAMES)?,
+            heuristic: heuristic_arg(&heuristic)?,
+            total,
+        })
+    }
 }
 
 #[pymethods]
@@ -90,10 +128,27 @@ impl PyEstimate {
                 }
                 .into());
             }
-            chunks.push(e.estimate.clone());
+            if e.run != first.get().run {
+                return Err(Error::Argument {
+                    arg: "estimates",
+                    message: format!(
+                        "estimates are chunks of different runs: seed, sampler, heuristic or \
+                         total_n differ ({:?} and {:?})",
+                        first.get().run,
+                        e.run
+                    ),
+                }
+                .into());
+            }
+            chunks.push(&e.estimate);
         }
         let estimate = detached(py, || estimators::merge(&chunks))?;
-        Ok(PyEstimate { estimate, strategy })
+        let run = first.get().run;
+        Ok(PyEstimate {
+            estimate,
+            strategy,
+            run,
+        })
     }
 
     /// The estimate of these numbers (the unpickling constructor): parts as
@@ -106,7 +161,9 @@ impl PyEstimate {
         n: usize,
         strategy: &str,
         parts: Vec<(usize, usize, [f64; 3], [f64; 3])>,
+        run: Option<RunFields>,
     ) -> PyResult<Self> {
+        let run = run.map(Run::from_fields).transpose()?;
         let strategy = choice("strategy", strategy, &[IRRADIANCE, REFLECTED].concat())?;
         let parts = parts
             .into_iter()
@@ -120,6 +177,7 @@ impl PyEstimate {
                 parts,
             },
             strategy,
+            run,
         })
     }
 
@@ -132,7 +190,9 @@ impl PyEstimate {
             .iter()
             .map(|p| (p.start, p.n, p.mean, p.m2))
             .collect();
-        let args = (e.value, e.stderr, e.n, this.strategy.name(), parts).into_pyobject(slf.py())?;
+        let run = this.run.map(|r| r.fields());
+        let args =
+            (e.value, e.stderr, e.n, this.strategy.name(), parts, run).into_pyobject(slf.py())?;
         reduce(slf.as_any(), Some("_from_fields"), args, None)
     }
 
@@ -232,9 +292,18 @@ pub fn estimate(
             })?
         }
     };
+    // Chunks of one run share these (the sequence's length only matters
+    // to the samplers that lay patterns over it).
+    let run = first_sample.is_some().then_some(Run {
+        seed: plan.seed,
+        sampler: plan.sampler,
+        heuristic: plan.heuristic,
+        total: (plan.sampler != Sampler::Independent).then_some(plan.total),
+    });
     Ok(PyEstimate {
         estimate,
         strategy: plan.strategy,
+        run,
     })
 }
 

@@ -323,11 +323,11 @@ pub fn render<'py>(
 ) -> PyResult<Film<'py>> {
     let spp = index_arg(spp, "spp", 1, u64::from(u32::MAX))? as u32;
     let first = match first_sample {
-        Some(k) => index_arg(&k, "first_sample", 0, u64::MAX - u64::from(spp))?,
+        Some(k) => index_arg(&k, "first_sample", 0, MAX_TOTAL - u64::from(spp))?,
         None => 0,
     };
     let total = match total_spp {
-        Some(t) => index_arg(&t, "total_spp", first + u64::from(spp), u64::MAX)?,
+        Some(t) => index_arg(&t, "total_spp", first + u64::from(spp), MAX_TOTAL)?,
         None => first + u64::from(spp),
     };
     let samples = Samples {
@@ -416,6 +416,9 @@ pub fn render<'py>(
         keep_sums.then_some(image.sums),
     ))
 }
+
+/// The longest sequence of samples a pixel may have (2^63).
+const MAX_TOTAL: u64 = 1 << 63;
 
 /// What [`render`] and [`merge`] return: image, variance, luminance
 /// variance, blocks, sums.

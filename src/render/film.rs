@@ -219,21 +219,19 @@ pub fn moments(s: &Sums, n: u64) -> Moments {
 pub fn block_sums(samples: &[[f32; 3]], blocks: &[Block], out: &mut Vec<Sums>) {
     let mut rest = samples;
     for block in blocks {
-        let (inside, after) = rest.split_at((block.len as usize).min(rest.len()));
+        let (inside, after) = rest.split_at(block.len as usize);
         out.push(pairwise(inside));
         rest = after;
     }
 }
 
-/// The tree sum of `samples` (a power-of-two count, or fewer when a render
-/// was stopped).
+/// The tree sum of `samples`, a power-of-two count of them.
 fn pairwise(samples: &[[f32; 3]]) -> Sums {
     match samples {
-        [] => Sums::default(),
         [a] => sums_of(*a),
         [a, b] => add(&sums_of(*a), &sums_of(*b)),
         _ => {
-            let (left, right) = samples.split_at(samples.len().next_power_of_two() / 2);
+            let (left, right) = samples.split_at(samples.len() / 2);
             add(&pairwise(left), &pairwise(right))
         }
     }
@@ -273,14 +271,15 @@ pub fn finish_pixel(
 /// [`Error::Memory`] when the result does not fit in memory.
 pub fn merge(chunks: &[(Vec<Block>, &[f64])], pixels: usize) -> Result<Merged> {
     for (blocks, sums) in chunks {
-        if sums.len() != pixels * blocks.len() * 8 {
+        let expected = pixels.checked_mul(blocks.len() * 8);
+        if expected != Some(sums.len()) {
             return Err(Error::Argument {
                 arg: "results",
                 message: format!(
                     "a chunk has {} sums for {} blocks of {pixels} pixels: expected {}",
                     sums.len(),
                     blocks.len(),
-                    pixels * blocks.len() * 8
+                    pixels as u128 * blocks.len() as u128 * 8
                 ),
             });
         }

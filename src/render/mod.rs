@@ -285,7 +285,12 @@ pub fn render(
     progress: &Progress,
 ) -> Result<Image> {
     let (width, height) = scene.film();
-    settings.sampler.check_count("spp", samples.total)?;
+    let arg = if samples.total == u64::from(samples.count) {
+        "spp"
+    } else {
+        "total_spp"
+    };
+    settings.sampler.check_count(arg, samples.total)?;
     if samples.first.saturating_add(u64::from(samples.count)) > samples.total {
         return Err(crate::Error::Integer {
             arg: "first_sample",
