@@ -198,3 +198,10 @@ def test_bad_estimator_chunks_are_refused():
             [a, run(PART, PART, strategy="cosine")])
     with pytest.raises(ValueError, match="empty"):
         mcs.estimators.Estimate.merge([])
+    with pytest.raises(ValueError, match="different runs"):
+        mcs.estimators.Estimate.merge([a, run(PART, PART, seed=9)])
+    with pytest.raises(ValueError, match="different runs"):
+        mcs.estimators.Estimate.merge([a, run(PART, PART, sampler="sobol", total_n=2 * PART)])
+    # Its settings travel with it.
+    assert mcs.estimators.Estimate.merge([pickle.loads(pickle.dumps(a)), run(PART, PART)]).n == \
+        2 * PART
