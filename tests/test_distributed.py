@@ -57,6 +57,21 @@ def test_the_bits_of_a_local_render(client, scene, chunks, kw):
                          mcs.render(scene, 32, seed=9, progress=False, **kw))
 
 
+def test_an_in_process_cluster_leaves_the_thread_count(scene):
+    """Workers in this process share its thread pool: its size stays."""
+    before = mcs.get_num_threads()
+    mcs.set_num_threads(2)
+    try:
+        with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                      dashboard_address=None) as cluster, \
+                distributed.Client(cluster) as c:
+            remote = mcs.distributed.render(scene, 8, c, 2, seed=5, progress=False)
+        assert mcs.get_num_threads() == 2
+        assert_same_bits(remote, mcs.render(scene, 8, seed=5, progress=False))
+    finally:
+        mcs.set_num_threads(before)
+
+
 def test_chunk_sizes_are_aligned_blocks():
     for spp in range(1, 200):
         for n in (1, 2, 3, 8, 50):

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import os
 import time
 from typing import TYPE_CHECKING, Any, Callable, Iterator, Sequence
 
@@ -51,8 +52,12 @@ def chunk_sizes(spp: int, chunks: int) -> list[int]:
     return sizes
 
 
-def _use_worker_threads() -> None:
-    """On a Dask worker, mcsample's threads are the worker's."""
+def _use_worker_threads(caller: int) -> None:
+    """On a Dask worker in a process of its own (not that of ``caller``, the
+    process that submitted the chunk), mcsample's threads are the worker's
+    (the count is per process: an in-process worker leaves it alone)."""
+    if os.getpid() == caller:
+        return
     with contextlib.suppress(ValueError, ImportError):
         from distributed import get_worker
 
@@ -61,9 +66,10 @@ def _use_worker_threads() -> None:
             set_num_threads(threads)
 
 
-def _render_chunk(scene: Scene, spp: int, first_sample: int, kw: dict[str, Any]) -> RenderResult:
+def _render_chunk(scene: Scene, spp: int, first_sample: int, kw: dict[str, Any],
+                  caller: int) -> RenderResult:
     """One chunk of a render, on a worker."""
-    _use_worker_threads()
+    _use_worker_threads(caller)
     return _render_local(scene, spp, first_sample=first_sample, progress=False, **kw)
 
 
@@ -192,9 +198,9 @@ _PART = 16384
 
 
 def _estimate_chunk(job: tuple[Callable[..., Estimate], tuple[Any, ...]], n: int,
-                    first_sample: int, kw: dict[str, Any]) -> Estimate:
+                    first_sample: int, kw: dict[str, Any], caller: int) -> Estimate:
     """One chunk of an estimate, on a worker."""
-    _use_worker_threads()
+    _use_worker_threads(caller)
     estimator, args = job
     return estimator(*args, n=n, first_sample=first_sample, **kw)
 
@@ -229,11 +235,12 @@ def _run(c: Client, shared: Any, task: Callable[..., Any], sizes: list[int],
          kw: dict[str, Any], scale: int, progress: bool, count: Callable[[Any], int],
          merge: Callable[[list[Any]], Any]) -> Any:
     """Sends ``shared`` to every worker once, runs ``task(shared, size,
-    first, kw)`` for each chunk, and merges the results as they arrive;
+    first, kw, this process's id)`` for each chunk, and merges the results as they arrive;
     Ctrl-C (or any error) cancels what is left."""
     firsts = [sum(sizes[:i]) for i in range(len(sizes))]
     [remote] = c.scatter([shared], broadcast=True)
-    futures = [c.submit(task, remote, n, k, kw, pure=False) for n, k in zip(sizes, firsts)]
+    futures = [c.submit(task, remote, n, k, kw, os.getpid(), pure=False)
+               for n, k in zip(sizes, firsts)]
     callback, bar = _progress_bar(sum(sizes) * scale, progress)
     try:
         return _merge_as_completed(futures, callback, scale, count, merge)
