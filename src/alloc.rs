@@ -35,6 +35,17 @@ pub fn reserve<T>(v: &mut Vec<T>, additional: usize, what: &'static str) -> Resu
         .map_err(|_| memory::<T>(v.len().saturating_add(additional), what))
 }
 
+/// Room for `additional` more values in each of the vectors named, for
+/// `what`: [`reserve`] of each in turn, stopping at the first error.
+macro_rules! reserve_each {
+    ($additional:expr, $what:expr; $($v:expr),+ $(,)?) => {{
+        let done: $crate::error::Result<()> = Ok(());
+        $(let done = done.and_then(|()| $crate::alloc::reserve(&mut $v, $additional, $what));)+
+        done
+    }};
+}
+pub(crate) use reserve_each;
+
 /// `len` copies of `value`.
 ///
 /// # Errors

@@ -1,5 +1,7 @@
 //! Warps from the unit square (or interval) to disks, spheres, hemispheres,
-//! lobes, triangles, tents and linear ramps: `square_to_X(u, ..)`, its density `square_to_X_pdf(x, ..)`
+//! lobes, triangles, tents, linear and bilinear ramps, the standard normal,
+//! lunes and tangent directions: `square_to_X(u, ..)`, its density
+//! `square_to_X_pdf(x, ..)`
 //! and its inverse `X_to_square(x, ..)`, with the names and point
 //! conventions of Mitsuba 3's `mi.warp` (same `u` → same point).
 //!
@@ -433,6 +435,26 @@ mod ramps;
 pub use ramps::{
     interval_to_linear, interval_to_nonuniform_tent, interval_to_tent, linear_to_interval,
     square_to_tent, square_to_tent_pdf, tent_to_interval, tent_to_square,
+};
+
+mod lobes;
+
+pub use lobes::{
+    beckmann_to_square, square_to_beckmann, square_to_beckmann_pdf, square_to_rough_fiber,
+    square_to_rough_fiber_pdf, square_to_std_normal, square_to_std_normal_pdf,
+    square_to_von_mises_fisher, square_to_von_mises_fisher_pdf, von_mises_fisher_to_square,
+};
+
+mod bilinear;
+
+pub use bilinear::{Corners, bilinear_to_square, square_to_bilinear, square_to_bilinear_pdf};
+
+mod frames;
+
+pub use frames::{
+    Lunes, interval_to_tangent_direction, square_to_uniform_spherical_lune,
+    square_to_uniform_spherical_lune_pdf, tangent_direction_to_interval,
+    uniform_spherical_lune_to_square,
 };
 
 #[cfg(test)]

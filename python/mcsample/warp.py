@@ -1,6 +1,8 @@
-"""Warps from the unit square to disks, spheres, hemispheres, lobes,
-triangles, tents and linear ramps, each with its density (``*_pdf``) and
-inverse (``*_to_square``) where Mitsuba has them.
+"""Warps from the unit square to disks, spheres, hemispheres, lobes
+(cosine power, Beckmann, von Mises-Fisher, rough fibre), lunes, tangent
+directions, triangles, tents, linear and bilinear ramps and the standard
+normal, each with its density (``*_pdf``) and inverse (``*_to_square``)
+where Mitsuba has them: all 48 functions of Mitsuba 3.9's ``mi.warp``.
 
 Names, argument order and point conventions follow Mitsuba 3's ``mi.warp``:
 the same ``u`` gives the same point. Densities are per unit area on planar
@@ -8,19 +10,30 @@ domains and per steradian on directions, and 0 off the support.
 """
 
 from ._core.warp import (
+    beckmann_to_square,
+    bilinear_to_square,
     cosine_hemisphere_to_square,
     cosine_power_hemisphere_to_square,
     interval_to_linear,
     interval_to_nonuniform_tent,
     interval_to_power,
     interval_to_power_pdf,
+    interval_to_tangent_direction,
     interval_to_tent,
     linear_to_interval,
     power_to_interval,
+    square_to_beckmann,
+    square_to_beckmann_pdf,
+    square_to_bilinear,
+    square_to_bilinear_pdf,
     square_to_cosine_hemisphere,
     square_to_cosine_hemisphere_pdf,
     square_to_cosine_power_hemisphere,
     square_to_cosine_power_hemisphere_pdf,
+    square_to_rough_fiber,
+    square_to_rough_fiber_pdf,
+    square_to_std_normal,
+    square_to_std_normal_pdf,
     square_to_tent,
     square_to_tent_pdf,
     square_to_uniform_cone,
@@ -33,9 +46,14 @@ from ._core.warp import (
     square_to_uniform_hemisphere_pdf,
     square_to_uniform_sphere,
     square_to_uniform_sphere_pdf,
+    square_to_uniform_spherical_lune,
+    square_to_uniform_spherical_lune_pdf,
     square_to_uniform_square_concentric,
     square_to_uniform_triangle,
     square_to_uniform_triangle_pdf,
+    square_to_von_mises_fisher,
+    square_to_von_mises_fisher_pdf,
+    tangent_direction_to_interval,
     tent_to_interval,
     tent_to_square,
     uniform_cone_to_square,
@@ -43,23 +61,36 @@ from ._core.warp import (
     uniform_disk_to_square_concentric,
     uniform_hemisphere_to_square,
     uniform_sphere_to_square,
+    uniform_spherical_lune_to_square,
     uniform_triangle_to_square,
+    von_mises_fisher_to_square,
 )
 
 __all__ = [
+    "beckmann_to_square",
+    "bilinear_to_square",
     "cosine_hemisphere_to_square",
     "cosine_power_hemisphere_to_square",
     "interval_to_linear",
     "interval_to_nonuniform_tent",
     "interval_to_power",
     "interval_to_power_pdf",
+    "interval_to_tangent_direction",
     "interval_to_tent",
     "linear_to_interval",
     "power_to_interval",
+    "square_to_beckmann",
+    "square_to_beckmann_pdf",
+    "square_to_bilinear",
+    "square_to_bilinear_pdf",
     "square_to_cosine_hemisphere",
     "square_to_cosine_hemisphere_pdf",
     "square_to_cosine_power_hemisphere",
     "square_to_cosine_power_hemisphere_pdf",
+    "square_to_rough_fiber",
+    "square_to_rough_fiber_pdf",
+    "square_to_std_normal",
+    "square_to_std_normal_pdf",
     "square_to_tent",
     "square_to_tent_pdf",
     "square_to_uniform_cone",
@@ -72,9 +103,14 @@ __all__ = [
     "square_to_uniform_hemisphere_pdf",
     "square_to_uniform_sphere",
     "square_to_uniform_sphere_pdf",
+    "square_to_uniform_spherical_lune",
+    "square_to_uniform_spherical_lune_pdf",
     "square_to_uniform_square_concentric",
     "square_to_uniform_triangle",
     "square_to_uniform_triangle_pdf",
+    "square_to_von_mises_fisher",
+    "square_to_von_mises_fisher_pdf",
+    "tangent_direction_to_interval",
     "tent_to_interval",
     "tent_to_square",
     "uniform_cone_to_square",
@@ -82,5 +118,7 @@ __all__ = [
     "uniform_disk_to_square_concentric",
     "uniform_hemisphere_to_square",
     "uniform_sphere_to_square",
+    "uniform_spherical_lune_to_square",
     "uniform_triangle_to_square",
+    "von_mises_fisher_to_square",
 ]

@@ -113,26 +113,9 @@ pub struct PyRng {
     drawn: u64,
 }
 
-#[pymethods]
 impl PyRng {
-    #[new]
-    #[pyo3(signature = (seed = 0, stream = 0))]
-    fn new(
-        #[pyo3(from_py_with = seed)] seed: u64,
-        #[pyo3(from_py_with = stream_arg)] stream: u64,
-    ) -> PyResult<Self> {
-        Ok(PyRng {
-            rng: Rng::new(seed, stream),
-            seed,
-            stream,
-            drawn: 0,
-        })
-    }
-
-    /// The generator of `seed` and `stream` after `drawn` outputs (the
-    /// unpickling constructor).
-    #[staticmethod]
-    fn _from_position(seed: u64, stream: u64, drawn: u64) -> Self {
+    /// The generator of `seed` and `stream` after `drawn` outputs.
+    fn at(seed: u64, stream: u64, drawn: u64) -> Self {
         let mut rng = Rng::new(seed, stream);
         rng.advance(drawn);
         PyRng {
@@ -141,6 +124,25 @@ impl PyRng {
             stream,
             drawn,
         }
+    }
+}
+
+#[pymethods]
+impl PyRng {
+    #[new]
+    #[pyo3(signature = (seed = 0, stream = 0))]
+    fn new(
+        #[pyo3(from_py_with = seed)] seed: u64,
+        #[pyo3(from_py_with = stream_arg)] stream: u64,
+    ) -> PyResult<Self> {
+        Ok(Self::at(seed, stream, 0))
+    }
+
+    /// The generator of `seed` and `stream` after `drawn` outputs (the
+    /// unpickling constructor).
+    #[staticmethod]
+    fn _from_position(seed: u64, stream: u64, drawn: u64) -> Self {
+        Self::at(seed, stream, drawn)
     }
 
     /// Pickles as its seed, stream and position.

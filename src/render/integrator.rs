@@ -201,13 +201,8 @@ impl Escaped {
     /// # Errors
     /// [`crate::Error::Memory`] when the memory cannot be had.
     pub fn reserve(&mut self, n: usize) -> crate::Result<()> {
-        const WHAT: &str = "the batch's escaped rays";
-        alloc::reserve(&mut self.slot, n, WHAT)?;
-        alloc::reserve(&mut self.dir, n, WHAT)?;
-        alloc::reserve(&mut self.beta, n, WHAT)?;
-        alloc::reserve(&mut self.bsdf_pdf, n, WHAT)?;
-        alloc::reserve(&mut self.radiance, n, WHAT)?;
-        alloc::reserve(&mut self.light_pdf, n, WHAT)
+        alloc::reserve_each!(n, "the batch's escaped rays";
+            self.slot, self.dir, self.beta, self.bsdf_pdf, self.radiance, self.light_pdf)
     }
 
     /// Forgets every ray (keeping the memory).

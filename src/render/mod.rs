@@ -182,11 +182,8 @@ impl Batch {
         // memory is an error, not an abort.
         let n = pixels.len() * spp.max(1) as usize;
         const WHAT: &str = "a batch of samples";
-        alloc::reserve(&mut self.camera_u, n, WHAT)?;
-        alloc::reserve(&mut self.resume, n, WHAT)?;
-        alloc::reserve(&mut self.rays, n, WHAT)?;
-        alloc::reserve(&mut self.hits, n, WHAT)?;
-        alloc::reserve(&mut self.radiance, n, WHAT)?;
+        alloc::reserve_each!(n, WHAT;
+            self.camera_u, self.resume, self.rays, self.hits, self.radiance)?;
         self.escaped.reserve(n)?;
         let mut streams = alloc::with_capacity(pixels.len(), WHAT)?;
         for x in pixels {

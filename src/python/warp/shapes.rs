@@ -1,142 +1,13 @@
-//! `mcsample.warp`: batched bindings of [`crate::warp`]. Every function
-//! takes an array-like of points (`(..., K)`, or any shape for the interval
-//! warps), keeps float32 input in float32, checks `u ∈ [0, 1]` (or
-//! finiteness of points) in the kernel's own pass, and runs on all cores
-//! with the GIL released.
+//! Warps onto disks, spheres, hemispheres, cones, triangles and intervals
+//! (power, tent and linear densities).
 
-use super::args::choice;
-use super::arrays::{Check, Points, PyFloat, with_precision};
-use super::batch::map_into;
-use crate::error::{Result, check_parameter};
-use crate::math::Real;
+use super::params::{cos_cutoff_arg, exponent_arg, linear_args, polar_arg, tent_args};
+use super::shaped;
+use crate::python::arrays::{Check, Points, PyFloat, with_precision};
+use crate::python::batch::map_into;
 use crate::python::{Obj, Out};
 use crate::warp;
 use pyo3::prelude::*;
-
-/// Defines one `#[pyfunction]` per entry, mapping `$x` (points of `$k`
-/// values, checked with `Check::$check`) to `$m` values through the kernel
-/// `$kernel` (built with the precision alias `$F` in scope; `?` may be used
-/// to validate parameters). The docstring is the entry's summary followed
-/// by Parameters and Returns sections made from the shapes and the
-/// phrases given (`$k` and `$m` are checked against the kernel's).
-/// Parameters in braces before the points come first in the signature (as
-/// Mitsuba orders `interval_to_linear(v0, v1, sample)`). Every function
-/// also takes a keyword `out`: an array to write into, as numpy's ufuncs
-/// do.
-macro_rules! warps {
-    ($(
-        $(#[doc = $summary:literal])*
-        fn $name:ident(
-            $({ $($q:ident: $qty:ty = $q_doc:literal),* })?
-            $x:ident: [$k:tt; $check:ident] $x_doc:literal
-            $(, $p:ident: $pty:ty = $p_doc:literal)*
-        ) -> [$m:tt] $result_doc:literal
-        = |$F:ident| $(let $bound:pat_param = $check_param:expr;)* $kernel:expr;
-    )*) => {$(
-        #[pyfunction]
-        #[pyo3(signature = ($($($q,)*)? $x $(, $p)*, *, out = None))]
-        $(#[doc = $summary])*
-        #[doc = ""]
-        #[doc = "Parameters"]
-        #[doc = "----------"]
-        $($(#[doc = concat!(stringify!($q), " : ", $q_doc)])*)?
-        #[doc = concat!(stringify!($x), " : ", points_doc!($k), ", ", $x_doc)]
-        $(#[doc = concat!(stringify!($p), " : ", $p_doc)])*
-        #[doc = "out : ndarray, optional, keyword only"]
-        #[doc = "     Written with the result and returned (its shape and dtype)."]
-        #[doc = ""]
-        #[doc = "Returns"]
-        #[doc = "-------"]
-        #[doc = concat!(result_doc!($m), ", ", $result_doc, ".")]
-        pub fn $name<'py>(
-            py: Python<'py>,
-            $($($q: $qty,)*)?
-            $x: &Obj<'py>
-            $(, $p: $pty)*,
-            out: Out<'_, 'py>,
-        ) -> PyResult<Obj<'py>> {
-            with_precision!($x, $F => {
-                let points = Points::<$F, $k>::extract($x, stringify!($x))?;
-                $(let $bound = $check_param;)*
-                let kernel = shaped::<$F, $k, $m, _>($kernel);
-                map_into(py, &points, Check::$check, out, kernel)
-            })
-        }
-    )*};
-}
-
-/// The input line of a warp's docstring for points of `$k` values.
-macro_rules! points_doc {
-    (1) => {
-        "float or array_like, any shape (one value a point)"
-    };
-    ($k:tt) => {
-        concat!("array_like, shape (..., ", $k, ")")
-    };
-}
-
-/// The result line of a warp's docstring for `$m` values per point.
-macro_rules! result_doc {
-    (1) => {
-        "ndarray, the points' batch shape (a scalar for one point)"
-    };
-    ($m:tt) => {
-        concat!("ndarray, shape (..., ", $m, ")")
-    };
-}
-
-/// `kernel`, with the point and result sizes a [`warps!`] entry states.
-fn shaped<F, const K: usize, const M: usize, G: Fn([F; K]) -> [F; M]>(kernel: G) -> G {
-    kernel
-}
-
-/// `exponent`, checked: finite and >= 0.
-fn exponent_arg<F: Real>(exponent: f64) -> Result<F> {
-    let ok = exponent.is_finite() && exponent >= 0.0;
-    check_parameter("exponent", exponent, ok, "must be finite and >= 0")?;
-    Ok(F::c(exponent))
-}
-
-/// `cos_cutoff`, checked: in [-1, 1).
-fn cos_cutoff_arg<F: Real>(cos_cutoff: f64) -> Result<F> {
-    let ok = (-1.0..1.0).contains(&cos_cutoff);
-    check_parameter("cos_cutoff", cos_cutoff, ok, "must lie in [-1, 1)")?;
-    Ok(F::c(cos_cutoff))
-}
-
-/// `(a, b, c)` of the nonuniform tent, checked: finite, `a ≤ b ≤ c`, `a < c`,
-/// and `c − a` finite in the kernel's precision.
-fn tent_args<F: Real>(a: f64, b: f64, c: f64) -> Result<(F, F, F)> {
-    for (arg, value) in [("a", a), ("b", b), ("c", c)] {
-        check_parameter(arg, value, value.is_finite(), "must be finite")?;
-    }
-    check_parameter("c", c, c > a, "must be greater than a")?;
-    check_parameter("b", b, (a..=c).contains(&b), "must lie in [a, c]")?;
-    let (a, b, c) = (F::c(a), F::c(b), F::c(c));
-    let width = c - a;
-    let requirement = "c - a must be a finite number in the input's precision";
-    check_parameter("c", c.f64(), width.is_finite(), requirement)?;
-    Ok((a, b, c))
-}
-
-/// `(v0, v1)` of the linear warps, checked (finite, `>= 0`, not both 0)
-/// and divided by the larger (the density depends only on their ratio, and
-/// their squares then cannot overflow).
-fn linear_args<F: Real>(v0: f64, v1: f64) -> Result<(F, F)> {
-    for (arg, value) in [("v0", v0), ("v1", v1)] {
-        let ok = value.is_finite() && value >= 0.0;
-        check_parameter(arg, value, ok, "must be finite and >= 0")?;
-    }
-    let larger = v0.max(v1);
-    check_parameter("v1", v1, larger > 0.0, "v0 and v1 must not both be 0")?;
-    Ok((F::c(v0 / larger), F::c(v1 / larger)))
-}
-
-/// `method` of the cosine-hemisphere warps: true for "polar", false for
-/// "concentric".
-fn polar_arg(method: &str) -> PyResult<bool> {
-    choice("method", method, &[("concentric", false), ("polar", true)])
-}
 
 warps! {
     /// Uniform points on the unit disk by the polar map r = sqrt(u[..., 1]),
@@ -364,6 +235,7 @@ warps! {
     fn square_to_uniform_square_concentric(sample: [2; Unit] "values in [0, 1]")
         -> [2] "in [0, 1]^2; density 1; the centre gives (0, 0)"
         = |F| warp::square_to_uniform_square_concentric::<F>;
+
 }
 
 /// Cosine-weighted directions on the +z hemisphere (Malley's method).
@@ -451,12 +323,10 @@ pub fn cosine_hemisphere_to_square<'py>(
     ))
 }
 
-/// Registers the warp functions in module `m`.
+/// Registers the warps onto shapes and intervals in module `m`.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    macro_rules! add {
-        ($($f:ident),* $(,)?) => { $(m.add_function(wrap_pyfunction!($f, m)?)?;)* };
-    }
-    add!(
+    add_functions!(
+        m,
         square_to_uniform_disk,
         square_to_uniform_disk_pdf,
         uniform_disk_to_square,
@@ -492,7 +362,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
         interval_to_nonuniform_tent,
         interval_to_linear,
         linear_to_interval,
-        square_to_uniform_square_concentric,
+        square_to_uniform_square_concentric
     );
     Ok(())
 }
