@@ -2,6 +2,7 @@
 //! digit permutations.
 
 use super::{Rows, below, check_dims, check_range, scramble_rng};
+use crate::alloc;
 use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::parallel;
@@ -11,9 +12,9 @@ use crate::rng::Rng;
 /// scramble holds `base` entries per digit and dimension.
 pub const MAX_DIMENSIONS: usize = 1 << 16;
 
-/// Entries a scrambled [`Halton`]'s permutation tables may hold in all
-/// (`2^26`, 256 MiB): `d ≤ 2191` dimensions (scipy builds the same
-/// tables, in 64-bit integers).
+/// Entries a scrambled [`Halton`]'s digit tables may hold in all (`2^26`
+/// values of 8 bytes, 512 MiB): `d ≤ 2191` dimensions (scipy builds the
+/// same tables, in 64-bit integers).
 pub const MAX_PERMUTATION_ENTRIES: usize = 1 << 26;
 
 /// Indices [`Halton`] accepts: below `2^53`, where every index is an exact
@@ -30,12 +31,129 @@ pub const MAX_INDEX: u64 = 1 << 53;
 /// of the digits per digit position and dimension, as scipy's
 /// `scramble=True` (Owen 2017), over all the positions a double resolves
 /// (so that the leading zeros are permuted too).
+///
+/// Consecutive points update their digits by adding one (an odometer), so
+/// a value costs a sum over its digits and no division.
 #[derive(Clone, Debug)]
 pub struct Halton {
-    bases: Vec<u32>,
-    /// Per dimension, the permutations of each digit position, one after
-    /// the other (`base` entries each); empty when plain.
-    permutations: Vec<Vec<u32>>,
+    radices: Vec<Radix>,
+}
+
+/// One dimension's base and the terms of its sums.
+#[derive(Clone, Debug)]
+struct Radix {
+    base: u32,
+    /// `b^−(k+1)` as scipy computes it: `1/b` divided by `b` `k` times.
+    scales: Vec<f64>,
+    /// Scrambled: `π_k(a)·b^−(k+1)` at `k·b + a`, for the digit positions
+    /// a double resolves; empty when plain.
+    terms: Vec<f64>,
+    /// Scrambled: `tail[m] = Σ_{k ≥ m} π_k(0)·b^−(k+1)`, the positions above
+    /// an index's `m` digits; empty when plain.
+    tail: Vec<f64>,
+}
+
+/// The digits of an index in one base, lowest first, and how many are
+/// significant (the highest nonzero's position + 1).
+#[derive(Clone, Debug)]
+struct Digits {
+    digits: Vec<u32>,
+    len: usize,
+}
+
+impl Digits {
+    /// The digits of `index` in `base`.
+    fn new(mut index: u64, base: u32) -> Self {
+        let base = u64::from(base);
+        let mut digits = Vec::with_capacity(64);
+        while index > 0 {
+            digits.push((index % base) as u32);
+            index /= base;
+        }
+        let len = digits.len();
+        Digits { digits, len }
+    }
+
+    /// The digits of the next index.
+    #[inline(always)]
+    fn increment(&mut self, base: u32) {
+        for digit in &mut self.digits {
+            *digit += 1;
+            if *digit < base {
+                return;
+            }
+            *digit = 0;
+        }
+        self.digits.push(1);
+        self.len = self.digits.len();
+    }
+}
+
+impl Radix {
+    /// Base `base`, scrambled by permutations from `rng` or plain.
+    fn new(base: u32, rng: Option<&mut Rng>) -> Result<Self> {
+        let positions = positions(base);
+        // Every digit of an index below MAX_INDEX has its scale.
+        let digits = Digits::new(MAX_INDEX - 1, base).len.max(positions);
+        let mut scales = alloc::with_capacity(digits, "the Halton scales")?;
+        let mut scale = 1.0 / f64::from(base);
+        for _ in 0..digits {
+            scales.push(scale);
+            scale /= f64::from(base);
+        }
+        let Some(rng) = rng else {
+            return Ok(Radix {
+                base,
+                scales,
+                terms: Vec::new(),
+                tail: Vec::new(),
+            });
+        };
+        let b = base as usize;
+        let mut terms = alloc::with_capacity(positions * b, "the Halton digit permutations")?;
+        let mut digits: Vec<u32> = (0..base).collect();
+        for &scale in &scales[..positions] {
+            for k in (1..b).rev() {
+                digits.swap(k, below(rng, k as u32 + 1) as usize);
+            }
+            terms.extend(digits.iter().map(|&a| f64::from(a) * scale));
+            digits.sort_unstable();
+        }
+        let mut tail = vec![0.0; positions + 1];
+        for k in (0..positions).rev() {
+            tail[k] = tail[k + 1] + terms[k * b];
+        }
+        Ok(Radix {
+            base,
+            scales,
+            terms,
+            tail,
+        })
+    }
+
+    /// The coordinate of the index whose digits are `d`: plain, scipy's
+    /// sum from the lowest digit; scrambled, the permuted digits' terms up
+    /// to the positions a double resolves, then the permuted zeros above.
+    #[inline(always)]
+    fn value(&self, d: &Digits) -> f64 {
+        let sum = if self.terms.is_empty() {
+            let mut sum = 0.0;
+            for (&a, &scale) in d.digits[..d.len].iter().zip(&self.scales) {
+                sum += f64::from(a) * scale;
+            }
+            sum
+        } else {
+            let b = self.base as usize;
+            let m = d.len.min(self.tail.len() - 1);
+            let mut sum = 0.0;
+            for (k, &a) in d.digits[..m].iter().enumerate() {
+                sum += self.terms[k * b + a as usize];
+            }
+            sum + self.tail[m]
+        };
+        // A scrambled sum may round up to 1.
+        sum.min(f64::ONE_MINUS_EPSILON)
+    }
 }
 
 impl Halton {
@@ -45,7 +163,8 @@ impl Halton {
     /// # Errors
     /// [`crate::Error::Integer`] unless `1 ≤ dims ≤` [`MAX_DIMENSIONS`],
     /// or, scrambled, if the permutations would pass
-    /// [`MAX_PERMUTATION_ENTRIES`].
+    /// [`MAX_PERMUTATION_ENTRIES`]; [`crate::Error::Memory`] if their
+    /// tables cannot be had.
     pub fn new(dims: usize, scramble: bool, seed: u64) -> Result<Self> {
         check_dims(dims, MAX_DIMENSIONS)?;
         let bases = primes(dims);
@@ -62,50 +181,27 @@ impl Halton {
             });
         }
         let mut rng = scramble_rng(seed);
-        let permutations = if scramble {
-            bases.iter().map(|&b| permutations(b, &mut rng)).collect()
-        } else {
-            Vec::new()
-        };
-        Ok(Halton {
-            bases,
-            permutations,
-        })
+        let radices = bases
+            .into_iter()
+            .map(|b| Radix::new(b, scramble.then_some(&mut rng)))
+            .collect::<Result<_>>()?;
+        Ok(Halton { radices })
     }
 
     /// Number of dimensions.
     pub fn dims(&self) -> usize {
-        self.bases.len()
+        self.radices.len()
     }
 
     /// The bases, the first `dims` primes.
-    pub fn bases(&self) -> &[u32] {
-        &self.bases
+    pub fn bases(&self) -> impl Iterator<Item = u32> + '_ {
+        self.radices.iter().map(|r| r.base)
     }
 
     /// Coordinate `dim` of point `index`.
     pub fn value(&self, index: u64, dim: usize) -> f64 {
-        let base = u64::from(self.bases[dim]);
-        let step = 1.0 / base as f64;
-        let (mut sum, mut scale, mut q) = (0.0, step, index);
-        match self.permutations.get(dim) {
-            None => {
-                while q > 0 {
-                    sum += (q % base) as f64 * scale;
-                    scale /= base as f64;
-                    q /= base;
-                }
-            }
-            Some(table) => {
-                for digits in table.chunks_exact(base as usize) {
-                    sum += f64::from(digits[(q % base) as usize]) * scale;
-                    scale /= base as f64;
-                    q /= base;
-                }
-            }
-        }
-        // A scrambled sum may round up to 1.
-        sum.min(f64::ONE_MINUS_EPSILON)
+        let radix = &self.radices[dim];
+        radix.value(&Digits::new(index, radix.base))
     }
 
     /// Points `first ..` into `out` (row-major, `dims` values a row, as many
@@ -118,9 +214,12 @@ impl Halton {
         let d = self.dims();
         let n = check_range(out.len(), d, first, MAX_INDEX)?;
         parallel::for_each_chunk(n, Rows::new(out, d), |range, rows| {
-            for (i, row) in (first + range.start as u64..).zip(rows.chunks_mut()) {
-                for (j, value) in row.iter_mut().enumerate() {
-                    *value = F::c(self.value(i, j)).min(F::ONE_MINUS_EPSILON);
+            let start = first + range.start as u64;
+            let mut digits: Vec<Digits> = self.bases().map(|b| Digits::new(start, b)).collect();
+            for row in rows.chunks_mut() {
+                for ((value, radix), digits) in row.iter_mut().zip(&self.radices).zip(&mut digits) {
+                    *value = F::c(radix.value(digits)).min(F::ONE_MINUS_EPSILON);
+                    digits.increment(radix.base);
                 }
             }
             true
@@ -133,22 +232,6 @@ impl Halton {
 /// (as scipy), enough for a double.
 fn positions(base: u32) -> usize {
     (54.0 / f64::from(base).log2()).ceil() as usize - 1
-}
-
-/// The digit permutations of one base, one per position, each a uniform
-/// random permutation of `0 .. b` (Fisher–Yates).
-fn permutations(base: u32, rng: &mut Rng) -> Vec<u32> {
-    let positions = positions(base);
-    let mut table = Vec::with_capacity(positions * base as usize);
-    for _ in 0..positions {
-        let start = table.len();
-        table.extend(0..base);
-        let digits = &mut table[start..];
-        for k in (1..digits.len()).rev() {
-            digits.swap(k, below(rng, k as u32 + 1) as usize);
-        }
-    }
-    table
 }
 
 /// The first `n` primes, by a sieve of Eratosthenes up to a bound above
@@ -214,7 +297,7 @@ mod tests {
     #[test]
     fn scrambled_points_keep_their_strata() {
         let h = Halton::new(3, true, 11).unwrap();
-        for (dim, &b) in h.bases().iter().enumerate() {
+        for (dim, b) in h.bases().enumerate() {
             let n = b.pow(4 - dim as u32) as u64;
             let mut seen = vec![false; n as usize];
             for i in 0..n {

@@ -135,13 +135,18 @@ impl Sobol {
                 for (r, row_bits) in bits.chunks_exact_mut(d).enumerate() {
                     let r = (b * block_rows + r) as u32;
                     if r > 0 {
-                        // g(i) ⊕ g(i − 1) is the lowest set bit of i.
+                        // g(i) ⊕ g(i − 1) is the lowest set bit of i. (One
+                        // pass that steps and stores: a separate copy of a
+                        // short row is a call to memmove.)
                         let bit = (start + r).trailing_zeros() as usize;
-                        for (x, v) in x.iter_mut().zip(self.column(bit)) {
+                        let step = x.iter_mut().zip(self.column(bit));
+                        for ((x, v), out) in step.zip(row_bits.iter_mut()) {
                             *x ^= v;
+                            *out = *x;
                         }
+                    } else {
+                        row_bits.copy_from_slice(&x);
                     }
-                    row_bits.copy_from_slice(&x);
                 }
                 match self.scramble {
                     Scramble::Owen => finish(block, bits, &keys, owen),
