@@ -1,7 +1,8 @@
 """Scenes described by the Mitsuba 3 scene dictionary.
 
 ``Scene.from_mitsuba(d)`` reads the subset of Mitsuba's dictionary format
-that mcsample renders; ``scene.to_mitsuba()`` gives back a dictionary that
+that mcsample renders, and ``Scene.from_mitsuba("scene.xml")`` the same
+subset from a Mitsuba 3 XML file (:func:`read_xml`); ``scene.to_mitsuba()`` gives back a dictionary that
 ``mi.load_dict`` renders to the same image (with mcsample's Phong registered
 as the ``"mcsample_phong"`` plugin, see :func:`mcsample.mitsuba.register_phong`).
 
@@ -9,13 +10,14 @@ The subset (anything else raises ValueError naming the key):
 
 - shapes: ``sphere`` (center, radius, to_world, flip_normals), ``rectangle``,
   ``disk``, ``cube``, ``ply`` and ``obj`` (filename, face_normals,
-  flip_normals, to_world), and ``mesh`` — mcsample's own type for numpy
+  flip_normals, to_world), ``serialized`` (also shape_index; Mitsuba's
+  compressed meshes, read by :func:`read_serialized`), and ``mesh`` — mcsample's own type for numpy
   arrays: ``vertices`` (N, 3), ``faces`` (M, 3) and optional ``normals``
   (N, 3). Each may hold a ``bsdf`` and an ``area`` emitter (``radiance``).
 - bsdfs: ``diffuse`` (reflectance), ``mcsample_phong`` (diffuse_reflectance,
   specular_reflectance, exponent), ``twosided`` around either, and
   ``{"type": "ref", "id": ...}`` to a top-level bsdf. A shape without one
-  gets Mitsuba's default, diffuse 0.5.
+  gets Mitsuba's default: diffuse 0.5, or black diffuse if it emits.
 - emitters: ``envmap`` (filename, scale, to_world; or an :class:`EnvMap`
   given directly as the value, in any mapping) and ``constant`` (radiance).
 - sensors: ``perspective`` (fov, fov_axis, near_clip, far_clip, to_world)
@@ -28,7 +30,9 @@ The subset (anything else raises ValueError naming the key):
 - ``integrator``: ``path`` or ``direct`` (max_depth, rr_depth, hide_emitters): the
   defaults of :func:`mcsample.render`.
 
-Colours are a float, an RGB triple or ``{"type": "rgb", "value": ...}``.
+Colours are a float, an RGB triple, ``{"type": "rgb", "value": ...}`` or
+``{"type": "spectrum", "value": v}`` (constant: on an emitter, as Mitsuba's
+RGB variants take it, the equal-energy spectrum's colour times v).
 ``to_world`` is a Mitsuba transform, a 4×4 array-like, or (handy in JSON)
 ``{"look_at": {"origin": ..., "target": ..., "up": ...}}``.
 """
@@ -36,6 +40,7 @@ Colours are a float, an RGB triple or ``{"type": "rgb", "value": ...}``.
 from __future__ import annotations
 
 import copy
+import os
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
@@ -45,8 +50,10 @@ from .._core.render import CompiledScene, SceneBuilder
 from ..results import EmitterSample
 from .meshes import icosphere
 from .parse import Camera, ShapeRecord, look_at, parse_scene
+from .serialized import read_serialized
+from .xml import read_xml, read_xml_located
 
-__all__ = ["EmitterSample", "Scene", "icosphere", "look_at"]
+__all__ = ["EmitterSample", "Scene", "icosphere", "look_at", "read_serialized", "read_xml"]
 
 
 @dataclass
@@ -85,13 +92,31 @@ class Scene:
         return {**self.__dict__, "_compiled": None}
 
     @classmethod
-    def from_mitsuba(cls, d: Mapping[str, Any]) -> "Scene":
-        """Reads a Mitsuba 3 scene dict (the subset in this module's doc).
+    def from_mitsuba(cls, d: Mapping[str, Any] | str | os.PathLike[str],
+                     **parameters: Any) -> "Scene":
+        """Reads a Mitsuba 3 scene dict (the subset in this module's doc), or
+        a Mitsuba 3 XML scene file (a path; see :func:`read_xml`), with
+        ``parameters`` for its ``$name`` references as ``mi.load_file``
+        takes them.
 
         Raises ValueError naming the first key outside that subset or with a
-        bad value, OSError for a mesh or image file that cannot be read.
+        bad value (for a file, with the file and line it was read from),
+        OSError for a scene, mesh or image file that cannot be read.
         """
-        p = parse_scene(d)
+        if isinstance(d, (str, os.PathLike)):
+            d, where = read_xml_located(d, **parameters)
+            try:
+                p = parse_scene(d)
+            except ValueError as e:
+                key = next((k for k in where if str(e).startswith(k)), None)
+                if key is None:
+                    raise
+                raise ValueError(f"{where[key]}: {e}") from None
+        elif parameters:
+            raise ValueError("parameters are for a scene file; a dict has none: "
+                             f"{', '.join(parameters)}")
+        else:
+            p = parse_scene(d)
         return cls(p.shapes, p.environment, p.camera, p.integrator, source=dict(d))
 
     @property

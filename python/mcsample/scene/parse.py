@@ -13,6 +13,7 @@ import numpy as np
 
 from .._core import EnvMap, Phong
 from .._core.io import read_mesh
+from .serialized import read_serialized
 
 __all__ = ["Camera", "Material", "ParsedScene", "ShapeRecord", "look_at", "parse_scene"]
 
@@ -64,12 +65,25 @@ def _matrix(value: Any, key: str) -> np.ndarray:
     return m
 
 
-def _rgb(value: Any, key: str) -> list[float]:
+#: Linear sRGB of the equal-energy spectrum of luminance 1 (the rows of the
+#: XYZ → sRGB matrix, summed): what Mitsuba's RGB variants make of an
+#: emitter's ``{"type": "spectrum", "value": v}`` (v times this; a
+#: reflectance's is v in every channel).
+EQUAL_ENERGY_SRGB = (1.2047843, 0.9483008, 0.9088427)
+
+
+def _rgb(value: Any, key: str, emission: bool = False) -> list[float]:
     if isinstance(value, Mapping):
-        if value.get("type") != "rgb" or set(value) - {"type", "value"}:
-            raise ValueError(f"{key}: only constant colours are supported "
-                             "(a float, an RGB triple or {'type': 'rgb', 'value': ...})")
-        value = value["value"]
+        kind = value.get("type")
+        if kind not in ("rgb", "spectrum") or set(value) - {"type", "value"}:
+            raise ValueError(f"{key}: only constant colours are supported (a float, an RGB "
+                             "triple, {'type': 'rgb', 'value': ...} or {'type': 'spectrum', "
+                             "'value': float})")
+        if kind == "spectrum":
+            v = _float(value.get("value", 1.0), f"{key}.value")
+            value = [v * c for c in EQUAL_ENERGY_SRGB] if emission else v
+        else:
+            value = value["value"]
     try:
         rgb = np.broadcast_to(np.asarray(value, dtype=np.float64), (3,))
     except (TypeError, ValueError):
@@ -110,6 +124,7 @@ class Material:
 
 
 DEFAULT_MATERIAL = Material([0.5] * 3, [0.0] * 3, 0.0, False, "diffuse")
+EMITTER_MATERIAL = Material([0.0] * 3, [0.0] * 3, 0.0, False, "diffuse")
 
 
 @dataclass
@@ -224,6 +239,7 @@ _SHAPE_KEYS = {
     "cube": {"to_world", "flip_normals"},
     "ply": {"filename", "to_world", "face_normals", "flip_normals"},
     "obj": {"filename", "to_world", "face_normals", "flip_normals"},
+    "serialized": {"filename", "shape_index", "to_world", "face_normals", "flip_normals"},
     "mesh": {"vertices", "faces", "normals", "to_world", "face_normals", "flip_normals"},
 }
 
@@ -231,7 +247,11 @@ _SHAPE_KEYS = {
 def _shape(d: Mapping[str, Any], key: str, refs: Mapping[str, Material]) -> ShapeRecord:
     kind = d["type"]
     _check_keys(d, _SHAPE_KEYS[kind] | {"bsdf", "emitter"}, key)
-    material = _material(d["bsdf"], f"{key}.bsdf", refs) if "bsdf" in d else DEFAULT_MATERIAL
+    if "bsdf" in d:
+        material = _material(d["bsdf"], f"{key}.bsdf", refs)
+    else:
+        # Mitsuba's default: diffuse 0.5, black on a shape that emits.
+        material = EMITTER_MATERIAL if "emitter" in d else DEFAULT_MATERIAL
     emission = None
     if "emitter" in d:
         e = d["emitter"]
@@ -239,7 +259,7 @@ def _shape(d: Mapping[str, Any], key: str, refs: Mapping[str, Material]) -> Shap
             raise ValueError(f"{key}.emitter: only {{'type': 'area', 'radiance': ...}} "
                              "emitters can sit on a shape")
         _check_keys(e, {"radiance"}, f"{key}.emitter")
-        emission = _rgb(e.get("radiance", 1.0), f"{key}.emitter.radiance")
+        emission = _rgb(e.get("radiance", 1.0), f"{key}.emitter.radiance", emission=True)
     m = _matrix(d["to_world"], f"{key}.to_world") if "to_world" in d else None
     flip = bool(d.get("flip_normals", False))
     rec = ShapeRecord(kind="mesh", material=material, emission=emission, flip_normals=flip)
@@ -280,8 +300,13 @@ def _shape(d: Mapping[str, Any], key: str, refs: Mapping[str, Material]) -> Shap
     else:
         if "filename" not in d:
             raise ValueError(f"{key}: a {kind} shape needs a 'filename'")
-        v, f, n = read_mesh(os.fspath(d["filename"]))
-        rec.face_normals = bool(d.get("face_normals", False))
+        if kind == "serialized":
+            index = d.get("shape_index", 0)
+            v, f, n, flat = read_serialized(os.fspath(d["filename"]), index)
+            rec.face_normals = bool(d.get("face_normals", flat))
+        else:
+            v, f, n = read_mesh(os.fspath(d["filename"]))
+            rec.face_normals = bool(d.get("face_normals", False))
     if flip:
         f = f[:, ::-1].copy()
         n = None if n is None else -n
@@ -296,7 +321,7 @@ def _environment(d: Any, key: str) -> tuple[str, Any]:
     kind = d["type"]
     if kind == "constant":
         _check_keys(d, {"radiance"}, key)
-        return "constant", _rgb(d.get("radiance", 1.0), f"{key}.radiance")
+        return "constant", _rgb(d.get("radiance", 1.0), f"{key}.radiance", emission=True)
     _check_keys(d, {"filename", "scale", "to_world"}, key)
     if "filename" not in d:
         raise ValueError(f"{key}: an envmap needs a 'filename' (or give an mcsample.EnvMap)")

@@ -1,0 +1,295 @@
+"""Mitsuba 3 XML scene files and serialized meshes: every XML feature the
+reader takes, read from files written here, against Mitsuba's own
+``mi.load_file`` (geometry, camera, and a per-pixel z-test of the renders),
+and the errors that name the file and line."""
+
+import struct
+import zlib
+
+import numpy as np
+import pytest
+
+import mcsample as mcs
+from mcsample import stats
+from mcsample.scene import read_serialized, read_xml
+
+
+def serialized_mesh(vertices, faces, normals=None, version=4, double=False,
+                    face_normals=False):
+    """One mesh of Mitsuba's serialized format (written from its layout)."""
+    flags = (0x2000 if double else 0x1000) | (0x1 if normals is not None else 0) \
+        | (0x10 if face_normals else 0)
+    real = "<f8" if double else "<f4"
+    body = struct.pack("<I", flags) + (b"mesh\0" if version >= 4 else b"")
+    body += struct.pack("<QQ", len(vertices), len(faces)) + np.asarray(vertices, real).tobytes()
+    if normals is not None:
+        body += np.asarray(normals, real).tobytes()
+    body += np.asarray(faces, "<u4").tobytes()
+    return struct.pack("<HH", 0x041C, version) + zlib.compress(body)
+
+
+def write_serialized(path, meshes, version=4, double=False):
+    """A serialized file of several meshes with its table of offsets."""
+    data, offsets = b"", []
+    for mesh in meshes:
+        offsets.append(len(data))
+        data += serialized_mesh(*mesh, version=version, double=double)
+    data += b"".join(struct.pack("<Q" if version >= 4 else "<I", o) for o in offsets)
+    path.write_bytes(data + struct.pack("<I", len(meshes)))
+
+
+V0 = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=np.float64)
+F0 = [[0, 1, 2]]
+V1 = np.array([[-1, -1, 0], [1, -1, 0], [-1, 1, 0], [1, 1, 0.2]], dtype=np.float64)
+F1 = [[0, 1, 2], [1, 3, 2]]
+N1 = np.tile([0.0, 0.0, 1.0], (4, 1))
+
+
+@pytest.mark.parametrize("version", [3, 4])
+@pytest.mark.parametrize("double", [False, True])
+def test_serialized_meshes_read_as_written(tmp_path, version, double):
+    path = tmp_path / "two.serialized"
+    write_serialized(path, [(V0, F0), (V1, F1, N1)], version=version, double=double)
+    v, f, n, flat = read_serialized(path)
+    assert np.array_equal(v, V0) and f.tolist() == F0 and n is None and not flat
+    v, f, n, flat = read_serialized(path, 1)
+    assert np.allclose(v, V1, atol=1e-7) and f.tolist() == F1 and np.array_equal(n, N1)
+    with pytest.raises(ValueError, match="shape_index = 2"):
+        read_serialized(path, 2)
+
+
+@pytest.mark.mitsuba
+def test_serialized_meshes_agree_with_mitsuba(mi, tmp_path):
+    path = tmp_path / "two.serialized"
+    write_serialized(path, [(V0, F0), (V1, F1, N1)])
+    for index, expected in [(0, V0), (1, V1)]:
+        shape = mi.load_dict({"type": "serialized", "filename": str(path),
+                              "shape_index": index})
+        theirs = np.array(mi.traverse(shape)["vertex_positions"]).reshape(-1, 3)
+        ours = read_serialized(path, index)[0]
+        assert np.allclose(ours, theirs, atol=1e-6) and np.allclose(ours, expected, atol=1e-6)
+
+
+def test_bad_serialized_files(tmp_path):
+    bad = tmp_path / "bad.serialized"
+    bad.write_bytes(b"\x1c\x04\x04\x00" + b"not zlib")
+    with pytest.raises(ValueError, match="bad.serialized: the mesh's zlib stream"):
+        read_serialized(bad)
+    bad.write_bytes(b"PLY!")
+    with pytest.raises(ValueError, match="not a Mitsuba serialized mesh"):
+        read_serialized(bad)
+    short = serialized_mesh(V1, F1)
+    body = zlib.decompress(short[4:])[:-8]  # one index short
+    bad.write_bytes(short[:4] + zlib.compress(body))
+    with pytest.raises(ValueError, match="ends early"):
+        read_serialized(bad)
+    with pytest.raises(OSError):
+        read_serialized(tmp_path / "missing.serialized")
+
+
+# A closed box lit by a small area light near the ceiling and a dim
+# constant environment through the open front, written with every feature
+# of the reader: <default> and $name, <include>, id and <ref>, all the
+# transform operations, rgb / spectrum / float / integer / boolean / string
+# values, and a serialized mesh.
+SCENE = """<?xml version="1.0"?>
+<scene version="3.0.0">
+    <default name="spp" value="16"/>
+    <default name="res" value="48"/>
+    <default name="light" value="12"/>
+    <include filename="materials.xml"/>
+    <integrator type="path">
+        <integer name="max_depth" value="4"/>
+        <boolean name="hide_emitters" value="false"/>
+    </integrator>
+    <sensor type="perspective">
+        <float name="fov" value="50"/>
+        <string name="fov_axis" value="x"/>
+        <transform name="to_world">
+            <lookat origin="0, 0.2, 3.6" target="0 0 0" up="0 1 0"/>
+        </transform>
+        <film type="hdrfilm">
+            <integer name="width" value="$res"/>
+            <integer name="height" value="$res"/>
+            <rfilter type="box"/>
+        </film>
+        <sampler type="independent">
+            <integer name="sample_count" value="$spp"/>
+        </sampler>
+    </sensor>
+    <emitter type="constant">
+        <spectrum name="radiance" value="0.2"/>
+    </emitter>
+    <shape type="rectangle" id="floor">
+        <transform name="to_world">
+            <rotate x="1" angle="-90"/>
+            <translate y="-1"/>
+        </transform>
+        <ref id="white"/>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world">
+            <rotate value="0 1 0" angle="90"/>
+            <translate value="-1 0 0"/>
+        </transform>
+        <ref name="bsdf" id="red"/>
+    </shape>
+    <shape type="serialized">
+        <string name="filename" value="wall.serialized"/>
+        <integer name="shape_index" value="1"/>
+        <transform name="to_world">
+            <matrix value="0 0 -1 1  0 1 0 0  1 0 0 0  0 0 0 1"/>
+        </transform>
+        <ref id="white"/>
+    </shape>
+    <shape type="cube">
+        <transform name="to_world">
+            <scale value="0.3"/>
+            <rotate y="1" angle="30"/>
+            <translate x="0.3" y="-0.7" z="0.1"/>
+        </transform>
+        <bsdf type="twosided">
+            <bsdf type="diffuse">
+                <rgb name="reflectance" value="0.3, 0.6, 0.3"/>
+            </bsdf>
+        </bsdf>
+    </shape>
+    <shape type="sphere">
+        <point name="center" x="-0.4" y="-0.6" z="-0.2"/>
+        <float name="radius" value="0.35"/>
+        <ref id="white"/>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world">
+            <scale x="0.15" y="0.15"/>
+            <rotate x="1" angle="90"/>
+            <translate y="0.95"/>
+        </transform>
+        <emitter type="area">
+            <rgb name="radiance" value="$light"/>
+        </emitter>
+    </shape>
+</scene>
+"""
+
+MATERIALS = """<scene version="3.0.0">
+    <bsdf type="diffuse" id="white">
+        <rgb name="reflectance" value="0.7"/>
+    </bsdf>
+    <bsdf type="diffuse" id="red">
+        <rgb name="reflectance" value="0.6 0.1 0.1"/>
+    </bsdf>
+</scene>
+"""
+
+
+@pytest.fixture
+def scene_file(tmp_path):
+    (tmp_path / "scene.xml").write_text(SCENE)
+    (tmp_path / "materials.xml").write_text(MATERIALS)
+    # The back wall: a unit square in x = 0 facing +x, mapped by the matrix
+    # to z = -1 facing +z.
+    wall = np.array([[0, -1, -1], [0, 1, -1], [0, 1, 1], [0, -1, 1]], dtype=np.float64)
+    write_serialized(tmp_path / "wall.serialized",
+                     [(V0, F0), (wall, [[0, 1, 2], [2, 3, 0]])])
+    return tmp_path / "scene.xml"
+
+
+def test_every_feature_is_read(scene_file):
+    d = read_xml(scene_file, res=32)
+    assert d["sensor_1"]["film"]["width"] == 32  # the call's value wins
+    assert d["sensor_1"]["sampler"]["sample_count"] == 16  # the <default>
+    assert d["white"] == {"type": "diffuse", "id": "white",
+                          "reflectance": {"type": "rgb", "value": [0.7] * 3}}
+    assert d["floor"]["bsdf"] == {"type": "ref", "id": "white"}
+    assert d["shape_2"]["bsdf"] == {"type": "ref", "id": "red"}
+    assert d["emitter_1"]["radiance"] == {"type": "spectrum", "value": 0.2}
+    assert d["shape_5"]["center"] == [-0.4, -0.6, -0.2]
+    assert d["integrator_1"] == {"type": "path", "max_depth": 4, "hide_emitters": False}
+    # rotate, then translate: the floor's normal (+z) turned to +y, at y = -1.
+    floor = d["floor"]["to_world"]
+    assert np.allclose(floor @ [0, 0, 1, 0], [0, 1, 0, 0], atol=1e-12)
+    assert np.allclose(floor @ [0, 0, 0, 1], [0, -1, 0, 1])
+    scene = mcs.Scene.from_mitsuba(scene_file)
+    assert len(scene.shapes) == 6 and scene.camera.width == 48
+    assert sum(s.emission is not None for s in scene.shapes) == 1
+
+
+@pytest.mark.mitsuba
+def test_geometry_and_camera_agree_with_mitsuba(mi, scene_file):
+    ours = mcs.Scene.from_mitsuba(scene_file)
+    theirs = mi.load_file(str(scene_file))
+    cam = np.array(theirs.sensors()[0].world_transform().matrix, dtype=np.float64).reshape(4, 4)
+    assert np.allclose(ours.camera.to_world, cam, atol=1e-5)
+
+    def boxes(shapes):
+        return sorted(tuple(np.round(b, 4).ravel()) for b in shapes)
+
+    our_boxes = []
+    for s in ours.shapes:
+        if s.kind == "sphere":
+            c = np.array(s.center)
+            our_boxes.append(np.array([c - s.radius, c + s.radius]))
+        else:
+            our_boxes.append(np.array([s.vertices.min(axis=0), s.vertices.max(axis=0)]))
+    their_boxes = [np.array([np.ravel(s.bbox().min), np.ravel(s.bbox().max)])
+                   for s in theirs.shapes()]
+    assert np.allclose(boxes(our_boxes), boxes(their_boxes), atol=2e-4)
+
+
+@pytest.mark.mitsuba
+def test_render_agrees_with_mitsubas_load_file(mi, scene_file):
+    """Per-pixel z-test of mcsample's render of the file against Mitsuba's
+    render of the same file, whose per-pixel variance comes from 16
+    independent renders (an unbiased reference, no moment integrator
+    needed)."""
+    spp, runs = 16, 16
+    ours = mcs.render(mcs.Scene.from_mitsuba(scene_file), 256, seed=3)
+    theirs = mi.load_file(str(scene_file), spp=spp)
+    images = np.stack([np.asarray(mi.render(theirs, seed=k), dtype=np.float64)[..., :3]
+                       for k in range(runs)])
+    y = images @ np.array([0.2126, 0.7152, 0.0722])
+    ref = mcs.RenderResult(images.mean(axis=0).astype(np.float32), None,
+                           (y.var(axis=0, ddof=1) / runs).astype(np.float32), spp * runs, 0.0)
+    result = stats.render_ztest(ours, ref)
+    assert result.passed, result
+    # Power: a light 20 % brighter in one of them (it lights a sixth of the
+    # image) is seen.
+    brighter = mcs.render(mcs.Scene.from_mitsuba(scene_file, light=14.4), 256, seed=3)
+    assert not stats.render_ztest(brighter, ref).passed
+
+
+def test_errors_name_the_file_and_line(tmp_path, scene_file):
+    def write(text, name="bad.xml"):
+        path = tmp_path / name
+        path.write_text(text)
+        return path
+
+    cases = [
+        ('<scene version="3.0.0">\n<shape type="sphere">\n</scene>', "bad.xml:3: not well-formed"),
+        ('<scene version="3.0.0">\n\n<shape type="sphere"><float name="radius" value="$r"/>'
+         '</shape></scene>', r"bad.xml:3: <float>: \$r is not a parameter"),
+        ('<scene version="3.0.0">\n<shape type="sphere"><transform name="to_world">'
+         '<scale value="0"/></transform></shape></scene>', "bad.xml:2: <transform>: .*singular"),
+        ('<scene version="3.0.0">\n<shapes type="sphere"/></scene>',
+         "bad.xml:2: <shapes>: not a tag"),
+        ('<scene version="3.0.0">\n<include filename="bad.xml"/></scene>', "cyclic <include>"),
+        ('<scene version="3.0.0">\n\n\n<shape type="sphere"><bsdf type="conductor"/></shape>'
+         '</scene>', r"bad.xml:4: shape_1.bsdf.type = 'conductor'"),
+        ('<scene version="3.0.0">\n<shape type="sphere"><float name="radius" value="x"/>'
+         '</shape></scene>', "bad.xml:2: <float>: 'x' is not a list of numbers"),
+    ]
+    for text, match in cases:
+        with pytest.raises(ValueError, match=match):
+            mcs.Scene.from_mitsuba(write(text))
+    with pytest.raises(OSError, match="missing.xml"):
+        mcs.Scene.from_mitsuba(tmp_path / "missing.xml")
+    with pytest.raises(OSError, match="nothing.xml"):
+        mcs.Scene.from_mitsuba(write('<scene version="3.0.0"><include filename="nothing.xml"/>'
+                                     '</scene>'))
+    mesh = write('<scene version="3.0.0"><shape type="serialized">'
+                 '<string name="filename" value="none.serialized"/></shape></scene>')
+    with pytest.raises(OSError, match="none.serialized"):
+        mcs.Scene.from_mitsuba(mesh)
+    with pytest.raises(ValueError, match="parameters are for a scene file"):
+        mcs.Scene.from_mitsuba({"type": "scene"}, spp=4)
