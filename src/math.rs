@@ -180,14 +180,7 @@ fn pow_unit(x: f64, y: f64) -> f64 {
     /// `2⁵²`: adding it to a whole number `n` in `[0, 2⁵²)` leaves `n` in the
     /// low mantissa bits.
     const SHIFTER: f64 = (1u64 << MANTISSA_BITS) as f64;
-    let bits = x.to_bits();
-    let field = f64::from_bits((bits >> MANTISSA_BITS) | SHIFTER.to_bits()) - SHIFTER;
-    let m = f64::from_bits((bits & ((1 << MANTISSA_BITS) - 1)) | 1.0f64.to_bits());
-    let big = m > std::f64::consts::SQRT_2;
-    let (m, e) = (
-        if big { 0.5 * m } else { m },
-        field - BIAS + if big { 1.0 } else { 0.0 },
-    );
+    let (m, e) = mantissa_exponent(x);
     let s = (m - 1.0) / (m + 1.0);
     let log2_m = s * estrin(s * s, &ATANH_OVER_S) * (2.0 * std::f64::consts::LOG2_E);
     let t = (y * (e + log2_m)).max(1.0 - BIAS);
@@ -207,6 +200,56 @@ fn pow_unit(x: f64, y: f64) -> f64 {
     } else {
         result
     }
+}
+
+/// `x = m·2ᵉ` for a positive normal `x`, with `m ∈ [√½, √2)` and the whole
+/// number `e` as a float (read from the exponent field by way of the
+/// mantissa of `2⁵²`, as [`pow_unit`] explains).
+#[inline(always)]
+fn mantissa_exponent(x: f64) -> (f64, f64) {
+    const MANTISSA_BITS: u32 = 52;
+    const SHIFTER: f64 = (1u64 << MANTISSA_BITS) as f64;
+    let bits = x.to_bits();
+    let field = f64::from_bits((bits >> MANTISSA_BITS) | SHIFTER.to_bits()) - SHIFTER;
+    let m = f64::from_bits((bits & ((1 << MANTISSA_BITS) - 1)) | 1.0f64.to_bits());
+    let big = m > std::f64::consts::SQRT_2;
+    (
+        if big { 0.5 * m } else { m },
+        field - 1023.0 + if big { 1.0 } else { 0.0 },
+    )
+}
+
+/// `e·ln 2 + ln m` with `ln m = 2 atanh(s)`, `s = (m − 1)/(m + 1)`.
+#[inline(always)]
+fn ln_from_parts(e: f64, s: f64) -> f64 {
+    e * std::f64::consts::LN_2 + 2.0 * s * estrin(s * s, &ATANH_OVER_S)
+}
+
+/// `ln x` for `x > 0` (normal) in `f64`, `−∞` for `x = 0`: `x = m·2ᵉ`,
+/// `ln x = e·ln 2 + 2 atanh((m − 1)/(m + 1))` (the series of
+/// [`pow_unit`]), without library calls, so loops over it vectorise.
+#[inline(always)]
+pub fn ln_positive(x: f64) -> f64 {
+    let (m, e) = mantissa_exponent(x);
+    let ln = ln_from_parts(e, (m - 1.0) / (m + 1.0));
+    if x > 0.0 { ln } else { f64::NEG_INFINITY }
+}
+
+/// `ln(1 − u)` for `u ∈ [0, 1]` in `f64` (`−∞` at 1), as [`ln_positive`] but keeping
+/// the relative precision near `u = 0` that `1 − u` loses: there
+/// (`u < 1 − √½`, where `1 − u` is its own mantissa) `s = −u/(2 − u)`
+/// directly.
+#[inline(always)]
+pub fn ln_one_minus(u: f64) -> f64 {
+    let (m, e) = mantissa_exponent(1.0 - u);
+    let near = u < 1.0 - std::f64::consts::FRAC_1_SQRT_2;
+    let s = if near {
+        -u / (2.0 - u)
+    } else {
+        (m - 1.0) / (m + 1.0)
+    };
+    let ln = ln_from_parts(if near { 0.0 } else { e }, s);
+    if u < 1.0 { ln } else { f64::NEG_INFINITY }
 }
 
 /// `1/(2k + 1)`: the series of `atanh(s)/s` in `s²`.
@@ -410,6 +453,32 @@ mod tests {
     fn one_minus_epsilon_is_the_float_below_one() {
         assert_eq!(f32::ONE_MINUS_EPSILON.to_bits() + 1, 1.0f32.to_bits());
         assert_eq!(f64::ONE_MINUS_EPSILON.to_bits() + 1, 1.0f64.to_bits());
+    }
+
+    /// The logarithms agree with the library's `ln` and `ln_1p` to a few
+    /// ulp, relatively, from 1e-300 to 1 (and `ln_one_minus` near 0, where
+    /// `ln(1 − u)` would lose it all).
+    #[test]
+    fn logarithms_match_the_library() {
+        let mut u = 1e-300f64;
+        while u < 1.0 {
+            for v in [u, 1.0 - u, 0.5 * u + 0.25] {
+                let (got, want) = (ln_positive(v), v.ln());
+                assert!(
+                    (got - want).abs() <= 4e-16 * want.abs().max(1e-300),
+                    "ln {v}"
+                );
+                if v < 1.0 {
+                    let (got, want) = (ln_one_minus(v), (-v).ln_1p());
+                    assert!((got - want).abs() <= 4e-16 * want.abs(), "ln(1 - {v})");
+                }
+            }
+            u *= 1.37;
+        }
+        assert_eq!(ln_positive(0.0), f64::NEG_INFINITY);
+        assert_eq!(ln_one_minus(0.0), 0.0);
+        assert_eq!(ln_one_minus(1.0), f64::NEG_INFINITY);
+        assert_eq!(ln_positive(1.0), 0.0);
     }
 
     #[test]

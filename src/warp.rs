@@ -440,9 +440,10 @@ pub use ramps::{
 mod lobes;
 
 pub use lobes::{
-    beckmann_to_square, square_to_beckmann, square_to_beckmann_pdf, square_to_rough_fiber,
-    square_to_rough_fiber_pdf, square_to_std_normal, square_to_std_normal_pdf,
-    square_to_von_mises_fisher, square_to_von_mises_fisher_pdf, von_mises_fisher_to_square,
+    VonMisesFisher, beckmann_to_square, square_to_beckmann, square_to_beckmann_pdf,
+    square_to_rough_fiber, square_to_rough_fiber_pdf, square_to_std_normal,
+    square_to_std_normal_pdf, square_to_von_mises_fisher, square_to_von_mises_fisher_pdf,
+    von_mises_fisher_to_square,
 };
 
 mod bilinear;

@@ -32,7 +32,10 @@ ROWS = 10**9
 
 #: Scalar parameters of the warps that take them, valid values.
 WARP_PARAMETERS = {"exponent": 2.0, "cos_cutoff": 0.5, "v0": 1.0, "v1": 2.0,
-                   "a": 0.0, "b": 0.5, "c": 1.0, "method": "concentric"}
+                   "a": 0.0, "b": 0.5, "c": 1.0, "method": "concentric", "alpha": 0.5,
+                   "kappa": 2.0, "wi": [0.0, 0.0, 1.0], "tangent": [1.0, 0.0, 0.0],
+                   "n1": [0.0, 0.6, 0.8], "n2": [0.8, 0.6, 0.0], "n": [0.0, 0.0, 1.0],
+                   "v00": 1.0, "v10": 2.0, "v01": 3.0, "v11": 4.0}
 
 
 def _warp_calls() -> list[str]:

@@ -293,3 +293,25 @@ def test_errors_name_the_file_and_line(tmp_path, scene_file):
         mcs.Scene.from_mitsuba(mesh)
     with pytest.raises(ValueError, match="parameters are for a scene file"):
         mcs.Scene.from_mitsuba({"type": "scene"}, spp=4)
+
+
+@pytest.mark.mitsuba
+def test_defaults_and_spectra_as_mitsuba_reads_them(mi):
+    """A shape without a bsdf is diffuse 0.5, black if it emits; an
+    emitter's constant spectrum is the equal-energy colour, a bsdf's is
+    grey: each compared with what Mitsuba loads from the same dict."""
+    light = {"type": "rectangle", "emitter": {"type": "area", "radiance": 3.0}}
+    plain = {"type": "rectangle"}
+    sky = {"type": "constant", "radiance": {"type": "spectrum", "value": 0.2}}
+    grey = {"type": "rectangle",
+            "bsdf": {"type": "diffuse", "reflectance": {"type": "spectrum", "value": 0.3}}}
+    sensor = {"type": "perspective", "fov": 40}
+    scene = mcs.Scene.from_mitsuba({"type": "scene", "light": light, "plain": plain,
+                                    "sky": sky, "grey": grey, "sensor": sensor})
+    ours = {k: s.material.diffuse for k, s in zip(("light", "plain", "grey"), scene.shapes)}
+    for key, d in (("light", light), ("plain", plain), ("grey", grey)):
+        params = mi.traverse(mi.load_dict(d))
+        theirs = np.ravel(params["bsdf.reflectance.value"])
+        assert np.allclose(ours[key], np.broadcast_to(theirs, 3), atol=1e-6), key
+    theirs = np.ravel(mi.traverse(mi.load_dict(sky))["radiance.value"])
+    assert np.allclose(scene.environment[1], theirs, rtol=1e-4)

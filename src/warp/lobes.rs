@@ -8,18 +8,19 @@ use super::{
     uniform_disk_to_square_concentric,
 };
 use crate::frame::Frame;
-use crate::math::{Real, dot, safe_sqrt, sin_cos_turn};
+use crate::math::{Real, dot, ln_one_minus, ln_positive, safe_sqrt, sin_cos_turn};
 
 /// The standard normal on the plane by the Box–Muller map:
 /// `r = √(−2 ln(1 − u_x))`, `φ = 2π u_y`, the point `(r cos φ, r sin φ)`
-/// (`u_x` is clamped below 1, so `u = 1` gives a finite point). Density
+/// (`u_x` is clamped below 1, so `u = 1` gives a finite point; the
+/// logarithm by [`ln_one_minus`], precise near 0 and vectorised). Density
 /// per unit area.
 ///
 /// # Density
 /// [`square_to_std_normal_pdf`]: `exp(−|x|²/2)/(2π)`.
 #[inline(always)]
 pub fn square_to_std_normal<F: Real>(u: P2<F>) -> P2<F> {
-    let r = (F::c(-2.0) * (-u[0].min(F::ONE_MINUS_EPSILON)).ln_1p()).sqrt();
+    let r = F::c(-2.0 * ln_one_minus(u[0].min(F::ONE_MINUS_EPSILON).f64())).sqrt();
     let (s, c) = sin_cos_turn(u[1]);
     [c * r, s * r]
 }
@@ -50,7 +51,7 @@ pub fn square_to_beckmann<F: Real>(u: P2<F>, alpha: F) -> V3<F> {
     let edge = F::c(2.0) * u[0].min(F::one() - u[0]).min(u[1].min(F::one() - u[1]));
     let edge = edge.max(F::zero());
     let r = F::one() - edge;
-    let tan2 = -alpha * alpha * (edge * (F::c(2.0) - edge)).ln();
+    let tan2 = -alpha * alpha * F::c(ln_positive((edge * (F::c(2.0) - edge)).f64()));
     // sin²θ = tan²θ/(1 + tan²θ), accurate at the pole where 1 − cos²θ is not.
     let sin2 = if tan2.is_finite() {
         tan2 / (F::one() + tan2)
@@ -93,30 +94,37 @@ pub fn beckmann_to_square<F: Real>(m: V3<F>, alpha: F) -> P2<F> {
     uniform_disk_to_square_concentric([m[0] * scale, m[1] * scale])
 }
 
-/// Below this concentration the vMF lobe is the uniform sphere to the
-/// type's precision (its density differs by a factor `1 ± 2κ`).
-#[inline(always)]
-fn flat<F: Real>(kappa: F) -> bool {
-    kappa <= F::epsilon()
+/// The von Mises–Fisher lobe around `+z` with concentration `κ ≥ 0`, and
+/// the constants its maps share (computed once, not per point).
+#[derive(Clone, Copy, Debug)]
+pub struct VonMisesFisher<F> {
+    kappa: F,
+    /// `1 − e^{−2κ}`; 0 for a lobe flat to the type's precision (`κ ≤ ε`:
+    /// its density differs from the uniform sphere's by a factor `1 ± 2κ`).
+    mass: F,
+    /// `κ/(1 − e^{−2κ})`, ½ for a flat lobe: `2π` times the density's
+    /// constant, without cancellation for small `κ`.
+    scale: F,
 }
 
-/// `κ / (1 − e^{−2κ})` (½ for a flat lobe): the vMF density's constant
-/// times 2π, without cancellation for small `κ`.
-#[inline(always)]
-fn vmf_scale<F: Real>(kappa: F) -> F {
-    if flat(kappa) {
-        F::c(0.5)
-    } else {
-        kappa / -(F::c(-2.0) * kappa).exp_m1()
+impl<F: Real> VonMisesFisher<F> {
+    /// The lobe of concentration `kappa` (finite, `≥ 0`).
+    pub fn new(kappa: F) -> Self {
+        let mass = -(F::c(-2.0) * kappa).exp_m1();
+        let flat = kappa <= F::epsilon();
+        VonMisesFisher {
+            kappa,
+            mass: if flat { F::zero() } else { mass },
+            scale: if flat { F::c(0.5) } else { kappa / mass },
+        }
     }
 }
 
-/// Directions of the von Mises–Fisher lobe around `+z` with concentration
-/// `κ ≥ 0` (Mitsuba's polar map): `φ = 2π u_x`,
-/// `1 − cos θ = −ln(1 − u_y (1 − e^{−2κ}))/κ` (`2u_y` for `κ = 0`: the
-/// uniform sphere, `z = 1 − 2u_y`), computed with `ln(1 + x)` and
-/// `e^x − 1` so that neither small nor large `κ` loses precision. Density
-/// per steradian.
+/// Directions of the von Mises–Fisher lobe around `+z` (Mitsuba's polar
+/// map): `φ = 2π u_x`, `1 − cos θ = −ln(1 − u_y (1 − e^{−2κ}))/κ` (`2u_y`
+/// for `κ = 0`: the uniform sphere, `z = 1 − 2u_y`), the logarithm by
+/// [`ln_one_minus`] (precise near `u_y = 0` for every `κ`, and free of
+/// library calls, so the loop vectorises). Density per steradian.
 ///
 /// # Density
 /// [`square_to_von_mises_fisher_pdf`]:
@@ -126,11 +134,11 @@ fn vmf_scale<F: Real>(kappa: F) -> F {
 /// [`von_mises_fisher_to_square`]:
 /// `(φ/2π, (1 − e^{κ(cos θ − 1)})/(1 − e^{−2κ}))`.
 #[inline(always)]
-pub fn square_to_von_mises_fisher<F: Real>(u: P2<F>, kappa: F) -> V3<F> {
-    let w = if flat(kappa) {
-        F::c(2.0) * u[1]
+pub fn square_to_von_mises_fisher<F: Real>(u: P2<F>, lobe: &VonMisesFisher<F>) -> V3<F> {
+    let w = if lobe.mass > F::zero() {
+        F::c(-ln_one_minus((u[1] * lobe.mass).f64())) / lobe.kappa
     } else {
-        -(-u[1] * -(F::c(-2.0) * kappa).exp_m1()).ln_1p() / kappa
+        F::c(2.0) * u[1]
     };
     // w = 1 − cos θ in [0, 2]; sin²θ = w (2 − w) keeps the pole's precision.
     let w = w.min(F::c(2.0));
@@ -141,22 +149,22 @@ pub fn square_to_von_mises_fisher<F: Real>(u: P2<F>, kappa: F) -> V3<F> {
 
 /// Density of [`square_to_von_mises_fisher`] per steradian.
 #[inline(always)]
-pub fn square_to_von_mises_fisher_pdf<F: Real>(d: V3<F>, kappa: F) -> F {
-    let falloff = if flat(kappa) {
-        F::one()
+pub fn square_to_von_mises_fisher_pdf<F: Real>(d: V3<F>, lobe: &VonMisesFisher<F>) -> F {
+    let falloff = if lobe.mass > F::zero() {
+        (lobe.kappa * (d[2] - F::one())).exp()
     } else {
-        (kappa * (d[2] - F::one())).exp()
+        F::one()
     };
-    vmf_scale(kappa) * falloff / two_pi::<F>()
+    lobe.scale * falloff / two_pi::<F>()
 }
 
 /// Inverse of [`square_to_von_mises_fisher`].
 #[inline(always)]
-pub fn von_mises_fisher_to_square<F: Real>(d: V3<F>, kappa: F) -> P2<F> {
-    let v = if flat(kappa) {
-        (F::one() - d[2]) * F::c(0.5)
+pub fn von_mises_fisher_to_square<F: Real>(d: V3<F>, lobe: &VonMisesFisher<F>) -> P2<F> {
+    let v = if lobe.mass > F::zero() {
+        -(lobe.kappa * (d[2] - F::one())).exp_m1() / lobe.mass
     } else {
-        (kappa * (d[2] - F::one())).exp_m1() / (F::c(-2.0) * kappa).exp_m1()
+        (F::one() - d[2]) * F::c(0.5)
     };
     [turn_fraction(d[0], d[1]), v.max(F::zero()).min(F::one())]
 }
@@ -172,12 +180,17 @@ pub fn von_mises_fisher_to_square<F: Real>(d: V3<F>, kappa: F) -> P2<F> {
 /// # Density
 /// [`square_to_rough_fiber_pdf`].
 #[inline(always)]
-pub fn square_to_rough_fiber<F: Real>(u: V3<F>, wi: V3<F>, tangent: V3<F>, kappa: F) -> V3<F> {
+pub fn square_to_rough_fiber<F: Real>(
+    u: V3<F>,
+    wi: V3<F>,
+    tangent: V3<F>,
+    lobe: &VonMisesFisher<F>,
+) -> V3<F> {
     let cos_i = dot(wi, tangent);
     let sin_i = safe_sqrt(F::one() - cos_i * cos_i);
     let (s, c) = sin_cos_turn(u[0]);
     let cone = [c * sin_i, s * sin_i, -cos_i];
-    let perturbation = square_to_von_mises_fisher([u[1], u[2]], kappa);
+    let perturbation = square_to_von_mises_fisher([u[1], u[2]], lobe);
     let local = Frame::from_normal(cone).to_world(perturbation);
     Frame::from_normal(tangent).to_world(local)
 }
@@ -189,12 +202,18 @@ pub fn square_to_rough_fiber<F: Real>(u: V3<F>, wi: V3<F>, tangent: V3<F>, kappa
 /// modified Bessel function ([`ln_i0`], exact to the type's precision where
 /// Mitsuba truncates its series, which is 0.6 % low at `c = 12`).
 #[inline(always)]
-pub fn square_to_rough_fiber_pdf<F: Real>(v: V3<F>, wi: V3<F>, tangent: V3<F>, kappa: F) -> F {
+pub fn square_to_rough_fiber_pdf<F: Real>(
+    v: V3<F>,
+    wi: V3<F>,
+    tangent: V3<F>,
+    lobe: &VonMisesFisher<F>,
+) -> F {
+    let kappa = lobe.kappa;
     let (sin_i, sin_o) = (dot(wi, tangent), dot(v, tangent));
     let cos_i = safe_sqrt(F::one() - sin_i * sin_i);
     let cos_o = safe_sqrt(F::one() - sin_o * sin_o);
     let exponent = F::c(ln_i0((kappa * cos_i * cos_o).f64())) - kappa * sin_i * sin_o - kappa;
-    exponent.exp() * vmf_scale(kappa) / two_pi::<F>()
+    exponent.exp() * lobe.scale / two_pi::<F>()
 }
 
 /// `ln I₀(x)` for `x ≥ 0`, to f64 precision: the power series

@@ -127,9 +127,9 @@ fn cases() -> Vec<Case> {
         },
         Case {
             name: "von_mises_fisher(3)",
-            sample: |u| square_to_von_mises_fisher(u, 3.0).to_vec(),
-            pdf: |d| square_to_von_mises_fisher_pdf([d[0], d[1], d[2]], 3.0),
-            invert: |d| von_mises_fisher_to_square([d[0], d[1], d[2]], 3.0),
+            sample: |u| square_to_von_mises_fisher(u, &VonMisesFisher::new(3.0)).to_vec(),
+            pdf: |d| square_to_von_mises_fisher_pdf([d[0], d[1], d[2]], &VonMisesFisher::new(3.0)),
+            invert: |d| von_mises_fisher_to_square([d[0], d[1], d[2]], &VonMisesFisher::new(3.0)),
             integrate: integrate_sphere,
         },
         Case {

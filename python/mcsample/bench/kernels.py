@@ -92,6 +92,12 @@ def _numpy_uniform_triangle(u: np.ndarray) -> np.ndarray:
     return np.stack([1 - t, t * u[:, 1]], axis=1)
 
 
+def _numpy_std_normal(u: np.ndarray) -> np.ndarray:
+    r = np.sqrt(-2.0 * np.log1p(-u[:, 0]))
+    phi = 2.0 * np.pi * u[:, 1]
+    return np.stack([r * np.cos(phi), r * np.sin(phi)], axis=1)
+
+
 def suite_warps(n: int, repeat: int, mi) -> list[Timing]:
     """Every forward warp, float64 and float32, beside numpy (where a
     numpy version is written here) and Mitsuba 3 llvm (float32)."""
@@ -112,6 +118,9 @@ def suite_warps(n: int, repeat: int, mi) -> list[Timing]:
          _numpy_uniform_triangle, ()),
         ("square_to_cosine_power_hemisphere", w.square_to_cosine_power_hemisphere,
          _numpy_cosine_power_hemisphere, (10.0,)),
+        ("square_to_std_normal", w.square_to_std_normal, _numpy_std_normal, ()),
+        ("square_to_beckmann", w.square_to_beckmann, None, (0.3,)),
+        ("square_to_von_mises_fisher", w.square_to_von_mises_fisher, None, (5.0,)),
     ]
     out = []
     for name, ours, numpy_impl, args in cases:

@@ -2,7 +2,7 @@
 //! Mises–Fisher, rough fibre), the spherical lunes, tangent directions and
 //! the bilinear density.
 
-use super::params::{alpha_arg, corners_arg, kappa_arg, lunes_arg, unit_arg};
+use super::params::{alpha_arg, corners_arg, lobe_arg, lunes_arg, unit_arg};
 use super::shaped;
 use crate::python::arrays::{Check, Points, PyFloat, with_precision};
 use crate::python::batch::{map_into, map2};
@@ -29,8 +29,7 @@ warps! {
         sample: [2; Unit] "values in [0, 1]",
         alpha: f64 = "float > 0, the roughness"
     ) -> [3] "unit vectors with z >= 0; density exp(-tan^2 theta / alpha^2) / (pi alpha^2 cos^3 theta) per sr"
-        = |F| let alpha = alpha_arg(alpha)?;
-            move |u| warp::square_to_beckmann(u, alpha);
+        = |F| let alpha = alpha_arg(alpha)?; move |u| warp::square_to_beckmann(u, alpha);
 
     /// Density of ``square_to_beckmann``: exp(-tan^2 theta / alpha^2) /
     /// (pi alpha^2 cos^3 theta) per steradian for z > 0, else 0.
@@ -38,16 +37,14 @@ warps! {
         v: [3; Finite] "unit vectors",
         alpha: f64 = "float > 0, the roughness"
     ) -> [1] "per steradian"
-        = |F| let alpha = alpha_arg(alpha)?;
-            move |m| [warp::square_to_beckmann_pdf(m, alpha)];
+        = |F| let alpha = alpha_arg(alpha)?; move |m| [warp::square_to_beckmann_pdf(m, alpha)];
 
     /// Inverse of ``square_to_beckmann``.
     fn beckmann_to_square(
         v: [3; Finite] "unit vectors with z >= 0",
         alpha: f64 = "float > 0, the roughness"
     ) -> [2] "in [0, 1]^2"
-        = |F| let alpha = alpha_arg(alpha)?;
-            move |m| warp::beckmann_to_square(m, alpha);
+        = |F| let alpha = alpha_arg(alpha)?; move |m| warp::beckmann_to_square(m, alpha);
 
     /// Directions of the von Mises-Fisher lobe around +z: phi = 2 pi
     /// sample[..., 0], 1 - cos theta = -ln(1 - sample[..., 1] (1 -
@@ -56,8 +53,7 @@ warps! {
         sample: [2; Unit] "values in [0, 1]",
         kappa: f64 = "float >= 0, the concentration"
     ) -> [3] "unit vectors; density kappa exp(kappa (cos theta - 1)) / (2 pi (1 - exp(-2 kappa))) per sr"
-        = |F| let kappa = kappa_arg(kappa)?;
-            move |u| warp::square_to_von_mises_fisher(u, kappa);
+        = |F| let lobe = lobe_arg(kappa)?; move |u| warp::square_to_von_mises_fisher(u, &lobe);
 
     /// Density of ``square_to_von_mises_fisher``: kappa exp(kappa (cos
     /// theta - 1)) / (2 pi (1 - exp(-2 kappa))) per steradian (1 / (4 pi)
@@ -66,8 +62,8 @@ warps! {
         v: [3; Finite] "unit vectors",
         kappa: f64 = "float >= 0, the concentration"
     ) -> [1] "per steradian"
-        = |F| let kappa = kappa_arg(kappa)?;
-            move |d| [warp::square_to_von_mises_fisher_pdf(d, kappa)];
+        = |F| let lobe = lobe_arg(kappa)?;
+            move |d| [warp::square_to_von_mises_fisher_pdf(d, &lobe)];
 
     /// Inverse of ``square_to_von_mises_fisher``: (phi / 2 pi, (1 -
     /// exp(kappa (cos theta - 1))) / (1 - exp(-2 kappa))).
@@ -75,8 +71,7 @@ warps! {
         v: [3; Finite] "unit vectors",
         kappa: f64 = "float >= 0, the concentration"
     ) -> [2] "in [0, 1]^2"
-        = |F| let kappa = kappa_arg(kappa)?;
-            move |d| warp::von_mises_fisher_to_square(d, kappa);
+        = |F| let lobe = lobe_arg(kappa)?; move |d| warp::von_mises_fisher_to_square(d, &lobe);
 
     /// Directions of the rough-fibre lobe: sample[..., 0] picks a direction
     /// on the fibre's specular cone of wi, sample[..., 1:] perturbs it by the
@@ -88,8 +83,8 @@ warps! {
         kappa: f64 = "float >= 0, the concentration"
     ) -> [3] "unit vectors"
         = |F| let (wi, t) = (unit_arg("wi", wi)?, unit_arg("tangent", tangent)?);
-            let kappa = kappa_arg(kappa)?;
-            move |u| warp::square_to_rough_fiber(u, wi, t, kappa);
+            let lobe = lobe_arg(kappa)?;
+            move |u| warp::square_to_rough_fiber(u, wi, t, &lobe);
 
     /// Density of ``square_to_rough_fiber`` per steradian: exp(-s) I0(c)
     /// kappa exp(-kappa) / (2 pi (1 - exp(-2 kappa))) with s = kappa (wi.t)
@@ -102,8 +97,8 @@ warps! {
         kappa: f64 = "float >= 0, the concentration"
     ) -> [1] "per steradian"
         = |F| let (wi, t) = (unit_arg("wi", wi)?, unit_arg("tangent", tangent)?);
-            let kappa = kappa_arg(kappa)?;
-            move |d| [warp::square_to_rough_fiber_pdf(d, wi, t, kappa)];
+            let lobe = lobe_arg(kappa)?;
+            move |d| [warp::square_to_rough_fiber_pdf(d, wi, t, &lobe)];
 
     /// Uniform directions in the two spherical lunes between the faces of
     /// normals n1 and n2: azimuth within theta = acos(n1.n2) / 2 of either
@@ -150,8 +145,7 @@ warps! {
         { n: [f64; 3] = "3 floats, the normal (normalised)" }
         dir: [3; Finite] "directions orthogonal to n"
     ) -> [1] "in [0, 1)"
-        = |F| let n = unit_arg("n", n)?;
-            move |d| [warp::tangent_direction_to_interval(n, d)];
+        = |F| let n = unit_arg("n", n)?; move |d| [warp::tangent_direction_to_interval(n, d)];
 
     /// Density of ``square_to_bilinear``: the bilinear interpolant of the
     /// corners divided by their mean, on [0, 1]^2, else 0 (Mitsuba returns

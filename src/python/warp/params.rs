@@ -56,12 +56,12 @@ pub fn alpha_arg<F: Real>(alpha: f64) -> Result<F> {
     Ok(F::c(alpha))
 }
 
-/// `kappa` of the von Mises–Fisher and rough-fibre warps, checked: finite
-/// and >= 0.
-pub fn kappa_arg<F: Real>(kappa: f64) -> Result<F> {
+/// The von Mises–Fisher lobe of `kappa` (of the vMF and rough-fibre
+/// warps), checked: finite and >= 0.
+pub fn lobe_arg<F: Real>(kappa: f64) -> Result<warp::VonMisesFisher<F>> {
     let ok = kappa.is_finite() && kappa >= 0.0;
     check_parameter("kappa", kappa, ok, "must be finite and >= 0")?;
-    Ok(F::c(kappa))
+    Ok(warp::VonMisesFisher::new(F::c(kappa)))
 }
 
 /// A direction argument, checked (finite, not zero) and normalised in f64.

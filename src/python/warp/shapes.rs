@@ -113,8 +113,7 @@ warps! {
         u: [2; Unit] "values in [0, 1]",
         cos_cutoff: f64 = "float in [-1, 1)"
     ) -> [3] "unit vectors; density 1 / (2 pi (1 - cos_cutoff)) per sr"
-        = |F| let c = cos_cutoff_arg(cos_cutoff)?;
-            move |u| warp::square_to_uniform_cone(u, c);
+        = |F| let c = cos_cutoff_arg(cos_cutoff)?; move |u| warp::square_to_uniform_cone(u, c);
 
     /// Density of ``square_to_uniform_cone``: 1 / (2 pi (1 - cos_cutoff))
     /// per steradian inside the cone, else 0.
@@ -130,8 +129,7 @@ warps! {
         x: [3; Finite] "unit vectors inside the cone",
         cos_cutoff: f64 = "float in [-1, 1)"
     ) -> [2] "in [0, 1]^2"
-        = |F| let c = cos_cutoff_arg(cos_cutoff)?;
-            move |d| warp::uniform_cone_to_square(d, c);
+        = |F| let c = cos_cutoff_arg(cos_cutoff)?; move |d| warp::uniform_cone_to_square(d, c);
 
     /// Uniform points on the triangle (0, 0), (1, 0), (0, 1):
     /// t = sqrt(1 - u0), point (1 - t, t u1).
@@ -154,8 +152,7 @@ warps! {
     /// x = u^(1/(n+1)).
     fn interval_to_power(u: [1; Unit] "values in [0, 1]", exponent: f64 = "float >= 0")
         -> [1] "in [0, 1]"
-        = |F| let n = exponent_arg(exponent)?;
-            move |u: [F; 1]| [warp::interval_to_power(u[0], n)];
+        = |F| let n = exponent_arg(exponent)?; move |u: [F; 1]| [warp::interval_to_power(u[0], n)];
 
     /// Density of ``interval_to_power``: (n + 1) x^n on [0, 1], else 0.
     fn interval_to_power_pdf(x: [1; Finite] "finite", exponent: f64 = "float >= 0")
@@ -166,8 +163,7 @@ warps! {
     /// Inverse of ``interval_to_power``: u = x^(n+1).
     fn power_to_interval(x: [1; Finite] "values in [0, 1]", exponent: f64 = "float >= 0")
         -> [1] "in [0, 1]"
-        = |F| let n = exponent_arg(exponent)?;
-            move |x: [F; 1]| [warp::power_to_interval(x[0], n)];
+        = |F| let n = exponent_arg(exponent)?; move |x: [F; 1]| [warp::power_to_interval(x[0], n)];
 
     /// The tent 1 - |x| on [-1, 1] by inversion (Mitsuba's
     /// ``interval_to_tent``): s = u - 1/2, x = sign(s) (1 - sqrt(1 - 2|s|)).
