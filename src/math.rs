@@ -204,7 +204,7 @@ fn pow_unit(x: f64, y: f64) -> f64 {
 
 /// `x = m·2ᵉ` for a positive normal `x`, with `m ∈ [√½, √2)` and the whole
 /// number `e` as a float (read from the exponent field by way of the
-/// mantissa of `2⁵²`, as [`pow_unit`] explains).
+/// mantissa of `2⁵²`, as `pow_unit` explains).
 #[inline(always)]
 fn mantissa_exponent(x: f64) -> (f64, f64) {
     const MANTISSA_BITS: u32 = 52;
@@ -227,7 +227,7 @@ fn ln_from_parts(e: f64, s: f64) -> f64 {
 
 /// `ln x` for `x > 0` (normal) in `f64`, `−∞` for `x = 0`: `x = m·2ᵉ`,
 /// `ln x = e·ln 2 + 2 atanh((m − 1)/(m + 1))` (the series of
-/// [`pow_unit`]), without library calls, so loops over it vectorise.
+/// `pow_positive`), without library calls, so loops over it vectorise.
 #[inline(always)]
 pub fn ln_positive(x: f64) -> f64 {
     let (m, e) = mantissa_exponent(x);

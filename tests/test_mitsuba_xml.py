@@ -50,9 +50,9 @@ N1 = np.tile([0.0, 0.0, 1.0], (4, 1))
 def test_serialized_meshes_read_as_written(tmp_path, version, double):
     path = tmp_path / "two.serialized"
     write_serialized(path, [(V0, F0), (V1, F1, N1)], version=version, double=double)
-    v, f, n, flat = read_serialized(path)
-    assert np.array_equal(v, V0) and f.tolist() == F0 and n is None and not flat
-    v, f, n, flat = read_serialized(path, 1)
+    v, f, n = read_serialized(path)
+    assert np.array_equal(v, V0) and f.tolist() == F0 and n is None
+    v, f, n = read_serialized(path, 1)
     assert np.allclose(v, V1, atol=1e-7) and f.tolist() == F1 and np.array_equal(n, N1)
     with pytest.raises(ValueError, match="shape_index = 2"):
         read_serialized(path, 2)
@@ -89,15 +89,16 @@ def test_bad_serialized_files(tmp_path):
 
 # A closed box lit by a small area light near the ceiling and a dim
 # constant environment through the open front, written with every feature
-# of the reader: <default> and $name, <include>, id and <ref>, all the
-# transform operations, rgb / spectrum / float / integer / boolean / string
-# values, and a serialized mesh.
+# of the reader: <default> and $name (also in a transform), <include> (the
+# materials after the references to them, a shape from a subfolder), id and
+# <ref>, all the transform operations, rgb / spectrum / float / integer /
+# boolean / string values, and a serialized mesh.
 SCENE = """<?xml version="1.0"?>
 <scene version="3.0.0">
     <default name="spp" value="16"/>
     <default name="res" value="48"/>
     <default name="light" value="12"/>
-    <include filename="materials.xml"/>
+    <default name="cube_x" value="0.3"/>
     <integrator type="path">
         <integer name="max_depth" value="4"/>
         <boolean name="hide_emitters" value="false"/>
@@ -134,19 +135,12 @@ SCENE = """<?xml version="1.0"?>
         </transform>
         <ref name="bsdf" id="red"/>
     </shape>
-    <shape type="serialized">
-        <string name="filename" value="wall.serialized"/>
-        <integer name="shape_index" value="1"/>
-        <transform name="to_world">
-            <matrix value="0 0 -1 1  0 1 0 0  1 0 0 0  0 0 0 1"/>
-        </transform>
-        <ref id="white"/>
-    </shape>
+    <include filename="parts/wall.xml"/>
     <shape type="cube">
         <transform name="to_world">
             <scale value="0.3"/>
             <rotate y="1" angle="30"/>
-            <translate x="0.3" y="-0.7" z="0.1"/>
+            <translate x="$cube_x" y="-0.7" z="0.1"/>
         </transform>
         <bsdf type="twosided">
             <bsdf type="diffuse">
@@ -169,6 +163,21 @@ SCENE = """<?xml version="1.0"?>
             <rgb name="radiance" value="$light"/>
         </emitter>
     </shape>
+    <include filename="materials.xml"/>
+</scene>
+"""
+
+# Included from a subfolder; its mesh's file name is relative to the main
+# scene's folder, as Mitsuba resolves it.
+WALL = """<scene version="3.0.0">
+    <shape type="serialized">
+        <string name="filename" value="wall.serialized"/>
+        <integer name="shape_index" value="1"/>
+        <transform name="to_world">
+            <matrix value="0 0 -1 1  0 1 0 0  1 0 0 0  0 0 0 1"/>
+        </transform>
+        <ref id="white"/>
+    </shape>
 </scene>
 """
 
@@ -187,6 +196,8 @@ MATERIALS = """<scene version="3.0.0">
 def scene_file(tmp_path):
     (tmp_path / "scene.xml").write_text(SCENE)
     (tmp_path / "materials.xml").write_text(MATERIALS)
+    (tmp_path / "parts").mkdir()
+    (tmp_path / "parts" / "wall.xml").write_text(WALL)
     # The back wall: a unit square in x = 0 facing +x, mapped by the matrix
     # to z = -1 facing +z.
     wall = np.array([[0, -1, -1], [0, 1, -1], [0, 1, 1], [0, -1, 1]], dtype=np.float64)
@@ -205,6 +216,9 @@ def test_every_feature_is_read(scene_file):
     assert d["shape_2"]["bsdf"] == {"type": "ref", "id": "red"}
     assert d["emitter_1"]["radiance"] == {"type": "spectrum", "value": 0.2}
     assert d["shape_5"]["center"] == [-0.4, -0.6, -0.2]
+    assert d["shape_3"]["filename"] == str(scene_file.parent / "wall.serialized")
+    assert d["shape_3"]["bsdf"] == {"type": "ref", "id": "white"}
+    assert np.allclose(d["shape_4"]["to_world"][:3, 3], [0.3, -0.7, 0.1])
     assert d["integrator_1"] == {"type": "path", "max_depth": 4, "hide_emitters": False}
     # rotate, then translate: the floor's normal (+z) turned to +y, at y = -1.
     floor = d["floor"]["to_world"]
@@ -315,3 +329,60 @@ def test_defaults_and_spectra_as_mitsuba_reads_them(mi):
         assert np.allclose(ours[key], np.broadcast_to(theirs, 3), atol=1e-6), key
     theirs = np.ravel(mi.traverse(mi.load_dict(sky))["radiance.value"])
     assert np.allclose(scene.environment[1], theirs, rtol=1e-4)
+
+
+@pytest.mark.mitsuba
+def test_transforms_as_mitsuba_builds_them(mi, tmp_path):
+    """A rotation about an axis that is not a unit vector (Mitsuba does not
+    normalise it) and a lookat without ``up``, against Mitsuba's matrices."""
+    path = tmp_path / "t.xml"
+    path.write_text("""<scene version="3.0.0">
+    <shape type="rectangle" id="r">
+        <transform name="to_world">
+            <rotate value="0, 2, 0.5" angle="30"/>
+            <scale x="2"/>
+            <translate value="1 2 3"/>
+        </transform>
+    </shape>
+    <sensor type="perspective">
+        <float name="fov" value="45"/>
+        <transform name="to_world"><lookat origin="1 2 3" target="0 0 0"/></transform>
+    </sensor>
+</scene>""")
+    d = read_xml(path)
+    theirs = mi.load_file(str(path))
+    shape = next(s for s in theirs.shapes() if s.id() == "r")
+    matrix = np.array(mi.traverse(shape)["to_world"].matrix, dtype=np.float64).reshape(4, 4)
+    assert np.allclose(d["r"]["to_world"], matrix, atol=1e-5)
+    cam = np.array(theirs.sensors()[0].world_transform().matrix, dtype=np.float64).reshape(4, 4)
+    assert np.allclose(d["sensor_1"]["to_world"], cam, atol=1e-5)
+
+
+def test_error_lines_name_the_right_object(tmp_path):
+    """Ten unnamed shapes: an error in the tenth names its line, not the
+    first's ("shape_10" starts with "shape_1")."""
+    spheres = "\n".join('<shape type="sphere"/>' for _ in range(9))
+    path = tmp_path / "ten.xml"
+    path.write_text(f"""<scene version="3.0.0">
+{spheres}
+<shape type="sphere"><bsdf type="conductor"/></shape>
+<sensor type="perspective"><float name="fov" value="40"/></sensor>
+</scene>""")
+    with pytest.raises(ValueError, match=r"ten.xml:11: shape_10.bsdf.type = 'conductor'"):
+        mcs.Scene.from_mitsuba(path)
+    path.write_text('<scene version="3.0.0"><shape type="sphere"><ref id="nothing"/></shape>'
+                    '</scene>')
+    with pytest.raises(ValueError, match="ten.xml:1: <ref>: no object with id 'nothing'"):
+        read_xml(path)
+    path.write_text('<scene version="3.0.0"><shape type="sphere"><float value="1"/></shape>'
+                    '</scene>')
+    with pytest.raises(ValueError, match="ten.xml:1: <float>: needs the attribute 'name'"):
+        read_xml(path)
+
+
+def test_a_single_mesh_file_has_no_second_mesh(tmp_path):
+    path = tmp_path / "one.serialized"
+    path.write_bytes(serialized_mesh(V1, F1))  # no table of offsets
+    assert np.allclose(read_serialized(path)[0], V1, atol=1e-7)
+    with pytest.raises(ValueError, match="shape_index = 1, but the file holds 1 mesh"):
+        read_serialized(path, 1)

@@ -66,6 +66,21 @@ def test_plain_halton_is_scipys(d, n):
 
 
 def test_plain_halton_continues_as_scipys():
+    # Near the last index, every digit summed as scipy's van der Corput loop
+    # sums them (written out here: scipy's fast_forward that far allocates
+    # 2**53 values).
+    def van_der_corput(i, base):
+        total, scale = 0.0, 1.0 / base
+        while i > 0:
+            total += (i % base) * scale
+            scale /= base
+            i //= base
+        return total
+
+    far = 2**53 - 5
+    points = qmc.Halton(8, scramble=False).fast_forward(far).random(4)
+    bases = [2, 3, 5, 7, 11, 13, 17, 19]
+    assert points.tolist() == [[van_der_corput(far + k, b) for b in bases] for k in range(4)]
     ours, theirs = qmc.Halton(4, scramble=False), scipy_qmc.Halton(4, scramble=False)
     ours.random(1000)
     theirs.random(1000)

@@ -216,6 +216,14 @@ def test_bad_parameters_name_themselves():
             call()
     with pytest.raises(ValueError, match="n1"):
         warp.square_to_uniform_spherical_lune(u, [0, 1], N2)
+    u32 = np.float32(u)
+    with pytest.raises(ValueError, match=r"alpha\^2 must be a positive finite"):
+        warp.square_to_beckmann(u32, 1e20)
+    with pytest.raises(ValueError, match="kappa = 10+: must be finite in the input's"):
+        warp.square_to_von_mises_fisher(u32, 1e39)
+    # Nearly parallel normals: a thin lune, finite density.
+    thin = warp.square_to_uniform_spherical_lune_pdf([0, 0, 1.0], [1, 0, 0], [1, 1e-9, 0])
+    assert np.isfinite(thin) and thin > 1e7
 
 
 # ---------------------------------------------------------------- Mitsuba 3

@@ -131,7 +131,7 @@ fn filled<'py, F: Element + Real>(
 ///     Mitsuba's ``multijitter``).
 /// d : int
 ///     Dimensions: 1 to 21201 for Sobol', 1 to 65536 for the rest (permuted
-///     Halton: while the digit permutations fit in 2**26 entries, d <= 2191).
+///     Halton: while the digit permutations fit in 2**26 entries, d <= 1946).
 /// seed : int, None or numpy.random.Generator
 ///     The scramble's or pattern's random bits (default 0).
 #[pyclass(module = "mcsample._core.qmc", name = "Points", frozen)]

@@ -13,8 +13,7 @@ use crate::rng::Rng;
 pub const MAX_DIMENSIONS: usize = 1 << 16;
 
 /// Entries a scrambled [`Halton`]'s digit tables may hold in all (`2^26`
-/// values of 8 bytes, 512 MiB): `d ≤ 2191` dimensions (scipy builds the
-/// same tables, in 64-bit integers).
+/// values of 8 bytes, 512 MiB): `d ≤ 1946` dimensions.
 pub const MAX_PERMUTATION_ENTRIES: usize = 1 << 26;
 
 /// Indices [`Halton`] accepts: below `2^53`, where every index is an exact
@@ -29,8 +28,9 @@ pub const MAX_INDEX: u64 = 1 << 53;
 /// with `π_k` the identity (plain: scipy's `Halton(d, scramble=False)`,
 /// bit for bit, summed in its order) or, scrambled, a random permutation
 /// of the digits per digit position and dimension, as scipy's
-/// `scramble=True` (Owen 2017), over all the positions a double resolves
-/// (so that the leading zeros are permuted too).
+/// `scramble=True` (Owen 2017), over every digit position of an index and
+/// down to a double's resolution (so that the leading zeros are permuted
+/// too).
 ///
 /// Consecutive points update their digits by adding one (an odometer), so
 /// a value costs a sum over its digits and no division.
@@ -93,11 +93,9 @@ impl Radix {
     /// Base `base`, scrambled by permutations from `rng` or plain.
     fn new(base: u32, rng: Option<&mut Rng>) -> Result<Self> {
         let positions = positions(base);
-        // Every digit of an index below MAX_INDEX has its scale.
-        let digits = Digits::new(MAX_INDEX - 1, base).len.max(positions);
-        let mut scales = alloc::with_capacity(digits, "the Halton scales")?;
+        let mut scales = alloc::with_capacity(positions, "the Halton scales")?;
         let mut scale = 1.0 / f64::from(base);
-        for _ in 0..digits {
+        for _ in 0..positions {
             scales.push(scale);
             scale /= f64::from(base);
         }
@@ -112,7 +110,7 @@ impl Radix {
         let b = base as usize;
         let mut terms = alloc::with_capacity(positions * b, "the Halton digit permutations")?;
         let mut digits: Vec<u32> = (0..base).collect();
-        for &scale in &scales[..positions] {
+        for &scale in &scales {
             for k in (1..b).rev() {
                 digits.swap(k, below(rng, k as u32 + 1) as usize);
             }
@@ -176,7 +174,7 @@ impl Halton {
                 requirement: format!(
                     "a scrambled Halton sequence in {dims} dimensions needs {entries} digit \
                      permutation entries, more than the {MAX_PERMUTATION_ENTRIES} allowed \
-                     (d <= 2191)"
+                     (d <= 1946)"
                 ),
             });
         }
@@ -198,7 +196,7 @@ impl Halton {
         self.radices.iter().map(|r| r.base)
     }
 
-    /// Coordinate `dim` of point `index`.
+    /// Coordinate `dim` of point `index` (`< MAX_INDEX`).
     pub fn value(&self, index: u64, dim: usize) -> f64 {
         let radix = &self.radices[dim];
         radix.value(&Digits::new(index, radix.base))
@@ -228,10 +226,13 @@ impl Halton {
     }
 }
 
-/// Digit positions a scramble permutes in base `b`: `⌈54 / log2 b⌉ − 1`
-/// (as scipy), enough for a double.
+/// Digit positions in base `b`: the digits of the largest index
+/// (`MAX_INDEX − 1`), so that every index's digits are summed and a
+/// scramble permutes down to `b^−positions ≤ 2^−53` (a double's
+/// resolution). (scipy's `⌈54 / log2 b⌉ − 1` is a digit short for most
+/// bases from 11 on.)
 fn positions(base: u32) -> usize {
-    (54.0 / f64::from(base).log2()).ceil() as usize - 1
+    Digits::new(MAX_INDEX - 1, base).len
 }
 
 /// The first `n` primes, by a sieve of Eratosthenes up to a bound above
@@ -307,5 +308,18 @@ mod tests {
             }
         }
         assert!(Halton::new(0, true, 0).is_err());
+    }
+
+    /// A scramble permutes every digit an index can have: in base 11,
+    /// indices 11^15 apart (both below 2^53) differ in their 16th digit,
+    /// which scipy's `⌈54 / log2 b⌉ − 1 = 15` positions would drop.
+    #[test]
+    fn scrambles_see_every_digit() {
+        let h = Halton::new(5, true, 3).unwrap();
+        let far = 11u64.pow(15);
+        assert!(far + 7 < MAX_INDEX);
+        assert_ne!(h.value(7, 4), h.value(7 + far, 4));
+        assert_eq!(positions(11), 16);
+        assert_eq!(positions(2), 53);
     }
 }

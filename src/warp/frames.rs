@@ -30,7 +30,8 @@ pub fn tangent_direction_to_interval<F: Real>(n: V3<F>, d: V3<F>) -> F {
 /// The two spherical lunes between the faces of unit normals `n1` and `n2`
 /// (not parallel): in the frame `ẑ = n1 × n2 / |n1 × n2|`,
 /// `ŷ = (n1 + n2)/|n1 + n2|`, `x̂ = ẑ × ŷ`, the directions whose azimuth lies
-/// within `θ = acos(n1·n2)/2` of `+x̂` or of `−x̂`. Their solid angle is `8θ`.
+/// within `θ = ½ atan2(|n1 × n2|, n1·n2)` (half the normals' angle) of `+x̂`
+/// or of `−x̂`. Their solid angle is `8θ`.
 #[derive(Clone, Copy, Debug)]
 pub struct Lunes<F> {
     x: V3<F>,
@@ -61,9 +62,16 @@ impl<F: Real> Lunes<F> {
     /// or opposite (the lunes are then empty or their frame undefined).
     pub fn new(n1: [f64; 3], n2: [f64; 3]) -> Option<Self> {
         let (n1, n2) = (normalized(n1)?, normalized(n2)?);
-        let z = normalized(cross(n1, n2))?;
+        let normal = cross(n1, n2);
+        let z = normalized(normal)?;
         let y = normalized(std::array::from_fn(|k| n1[k] + n2[k]))?;
-        let theta = 0.5 * dot(n1, n2).clamp(-1.0, 1.0).acos();
+        // atan2 keeps the angle of nearly parallel normals, where acos of
+        // their dot product rounds to 0.
+        let theta = 0.5 * dot(normal, normal).sqrt().atan2(dot(n1, n2));
+        // Positive (finite normals of a nonzero cross product).
+        if theta <= 0.0 {
+            return None;
+        }
         Some(Lunes {
             x: cross(z, y).map(F::c),
             y: y.map(F::c),

@@ -100,7 +100,7 @@ pub fn beckmann_to_square<F: Real>(m: V3<F>, alpha: F) -> P2<F> {
 pub struct VonMisesFisher<F> {
     kappa: F,
     /// `1 − e^{−2κ}`; 0 for a lobe flat to the type's precision (`κ ≤ ε`:
-    /// its density differs from the uniform sphere's by a factor `1 ± 2κ`).
+    /// its density differs from the uniform sphere's by a factor `1 ± κ`).
     mass: F,
     /// `κ/(1 − e^{−2κ})`, ½ for a flat lobe: `2π` times the density's
     /// constant, without cancellation for small `κ`.
@@ -199,7 +199,7 @@ pub fn square_to_rough_fiber<F: Real>(
 /// averaged over the cone's azimuth (d'Eon et al. 2011),
 /// `p(v) = e^{−s} I₀(c) · κ e^{−κ} / (2π (1 − e^{−2κ}))` with
 /// `s = κ (ω_i·t)(v·t)` and `c = κ √(1 − (ω_i·t)²) √(1 − (v·t)²)`, `I₀` the
-/// modified Bessel function ([`ln_i0`], exact to the type's precision where
+/// modified Bessel function (`ln_i0`, exact to the type's precision where
 /// Mitsuba truncates its series, which is 0.6 % low at `c = 12`).
 #[inline(always)]
 pub fn square_to_rough_fiber_pdf<F: Real>(

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import copy
 import os
+import re
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
@@ -108,10 +109,12 @@ class Scene:
             try:
                 p = parse_scene(d)
             except ValueError as e:
-                key = next((k for k in where if str(e).startswith(k)), None)
-                if key is None:
+                # The top-level key the message starts with (the longest:
+                # "shape_10." is not "shape_1").
+                keys = [k for k in where if re.match(re.escape(k) + r"[.:\s]", str(e))]
+                if not keys:
                     raise
-                raise ValueError(f"{where[key]}: {e}") from None
+                raise ValueError(f"{where[max(keys, key=len)]}: {e}") from None
         elif parameters:
             raise ValueError("parameters are for a scene file; a dict has none: "
                              f"{', '.join(parameters)}")

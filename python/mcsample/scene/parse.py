@@ -302,11 +302,10 @@ def _shape(d: Mapping[str, Any], key: str, refs: Mapping[str, Material]) -> Shap
             raise ValueError(f"{key}: a {kind} shape needs a 'filename'")
         if kind == "serialized":
             index = d.get("shape_index", 0)
-            v, f, n, flat = read_serialized(os.fspath(d["filename"]), index)
-            rec.face_normals = bool(d.get("face_normals", flat))
+            v, f, n = read_serialized(os.fspath(d["filename"]), index)
         else:
             v, f, n = read_mesh(os.fspath(d["filename"]))
-            rec.face_normals = bool(d.get("face_normals", False))
+        rec.face_normals = bool(d.get("face_normals", False))
     if flip:
         f = f[:, ::-1].copy()
         n = None if n is None else -n

@@ -3,7 +3,7 @@
 A file holds one or more meshes, each a little-endian header (``u16``
 0x041C, ``u16`` version 3 or 4) and a zlib stream: ``u32`` flags (0x0001
 vertex normals, 0x0002 texture coordinates, 0x0008 vertex colours, 0x0010
-face normals, 0x2000 double precision), in version 4 the mesh's name (UTF-8,
+face normals (ignored, as by Mitsuba 3), 0x2000 double precision), in version 4 the mesh's name (UTF-8,
 NUL-terminated), ``u64`` vertex and triangle counts, then positions,
 normals, texture coordinates and colours (float32, or float64), and the
 triangles' vertex indices (``u32``, ``u64`` above 2**32 vertices). Several
@@ -22,7 +22,7 @@ import numpy as np
 __all__ = ["read_serialized"]
 
 MAGIC = 0x041C
-VERTEX_NORMALS, TEXCOORDS, COLORS, FACE_NORMALS, DOUBLE = 0x1, 0x2, 0x8, 0x10, 0x2000
+VERTEX_NORMALS, TEXCOORDS, COLORS, DOUBLE = 0x1, 0x2, 0x8, 0x2000
 
 
 class _Reader:
@@ -49,23 +49,26 @@ def _offset(data: bytes, path: str, shape_index: int, version: int) -> int:
     """Where mesh ``shape_index`` starts: 0, or by the table at the end."""
     if shape_index == 0:
         return 0
-    count = struct.unpack_from("<I", data, len(data) - 4)[0] if len(data) >= 4 else 0
-    if shape_index >= count:
-        raise ValueError(f"{path}: shape_index = {shape_index}, but the file holds "
-                         f"{max(count, 1)} mesh{'es' if count > 1 else ''}")
+    count = struct.unpack_from("<I", data, len(data) - 4)[0] if len(data) >= 8 else 0
     width = 8 if version >= 4 else 4
     table = len(data) - 4 - count * width
+    if table < 0:
+        count = 1  # no table of offsets: a file of one mesh
+    if shape_index >= count:
+        raise ValueError(f"{path}: shape_index = {shape_index}, but the file holds "
+                         f"{count} mesh{'es' if count > 1 else ''}")
     return struct.unpack_from("<Q" if width == 8 else "<I", data, table + shape_index * width)[0]
 
 
 def read_serialized(path: str | os.PathLike[str], shape_index: int = 0
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, bool]:
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """Mesh ``shape_index`` of a Mitsuba ``.serialized`` file.
 
     Returns
     -------
     (vertices (N, 3) float64, faces (M, 3) int64, normals (N, 3) float64 or
-    None, face_normals: bool — the file asks for flat shading)
+    None). The file's face-normals flag is ignored, as Mitsuba 3 does (the
+    shape's ``face_normals`` key decides).
 
     Raises OSError when the file cannot be read and ValueError naming the
     file when it is not a serialized mesh (or ends early, or has no mesh
@@ -109,4 +112,4 @@ def read_serialized(path: str | os.PathLike[str], shape_index: int = 0
     if faces.size and faces.max() >= n_vertices:
         raise ValueError(f"{path}: mesh {shape_index} has a vertex index {int(faces.max())} "
                          f"past its {n_vertices} vertices")
-    return vertices, faces, normals, bool(flags & FACE_NORMALS)
+    return vertices, faces, normals

@@ -9,7 +9,8 @@ their ``id``, else ``"<tag>_<n>"``); properties (``float``, ``integer``,
 ``vector``) become values; ``<transform>`` (``translate``, ``rotate``, ``scale``,
 ``matrix``, ``lookat``, applied in order) a 4x4 matrix; ``<ref id=...>`` a
 ``{"type": "ref", "id": ...}`` (keyed by its name, else by the referenced
-object's tag); a ``filename`` string is taken relative to the file. ``<default name=... value=...>`` and
+object's tag); a ``filename`` string is taken relative to the main file's
+folder (as Mitsuba's file resolver, also in an included file). ``<default name=... value=...>`` and
 ``$name`` substitute parameters (given ones win, as in ``mi.load_file(path,
 name=value)``), and ``<include filename=...>`` reads another file (relative
 to the including one) in place. Errors name the file and line.
@@ -107,13 +108,24 @@ def _xyz(e: _Element, default: float) -> list[float]:
 
 
 def _rotation(axis: np.ndarray, degrees: float) -> np.ndarray:
-    """Rotation by ``degrees`` about ``axis`` (Rodrigues), 4x4."""
-    a = axis / np.linalg.norm(axis)
+    """Mitsuba's rotation by ``degrees`` about ``axis``, 4x4:
+    ``cos·I + sin·[a]× + (1 − cos)·a aᵀ`` with the axis as given (Mitsuba
+    does not normalise it)."""
+    a = np.asarray(axis, dtype=np.float64)
     t = math.radians(degrees)
     k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
     m = np.eye(4)
-    m[:3, :3] = np.eye(3) + math.sin(t) * k + (1 - math.cos(t)) * (k @ k)
+    m[:3, :3] = math.cos(t) * np.eye(3) + math.sin(t) * k + (1 - math.cos(t)) * np.outer(a, a)
     return m
+
+
+def _up(direction: np.ndarray) -> np.ndarray:
+    """Mitsuba's ``up`` when a ``lookat`` gives none: the first tangent of
+    its orthonormal basis around the viewing direction (Duff et al.)."""
+    n = direction / np.linalg.norm(direction)
+    sign = math.copysign(1.0, n[2])
+    a = -1.0 / (sign + n[2])
+    return np.array([1.0 + sign * n[0] * n[0] * a, sign * n[0] * n[1] * a, -sign * n[0]])
 
 
 def _transform(e: _Element) -> np.ndarray:
@@ -131,8 +143,6 @@ def _transform(e: _Element) -> np.ndarray:
         elif op.tag == "rotate":
             axis = np.array(_numbers(op, op.attrs["value"], (3,)) if "value" in op.attrs
                             else _xyz(op, 0.0))
-            if not np.linalg.norm(axis) > 0:
-                raise op.error('needs a non-zero axis (x, y, z or value="x y z")')
             step = _rotation(axis, _numbers(op, op.attr("angle"), (1,))[0])
         elif op.tag == "matrix":
             values = _numbers(op, op.attr("value"), (9, 16))
@@ -141,11 +151,13 @@ def _transform(e: _Element) -> np.ndarray:
             else:
                 step = np.reshape(values, (4, 4))
         elif op.tag == "lookat":
+            origin, target = (np.array(_numbers(op, op.attr(k), (3,))) for k in ("origin", "target"))
             try:
-                step = look_at(*(_numbers(op, op.attr(k), (3,))
-                                 for k in ("origin", "target", "up")))
-            except ValueError as err:
-                raise op.error(str(err)) from None
+                up = (np.array(_numbers(op, op.attrs["up"], (3,))) if "up" in op.attrs
+                      else _up(target - origin))
+                step = look_at(origin, target, up)
+            except (ValueError, ZeroDivisionError) as err:
+                raise op.error(str(err) or "origin and target must differ") from None
         else:
             raise op.error("not a transform operation (translate, rotate, scale, "
                            "matrix, lookat)")
@@ -199,6 +211,26 @@ class _Reader:
         #: The tag of each object with an id, so that an unnamed <ref> to
         #: a bsdf is the referrer's "bsdf".
         self.tags: dict[str, str] = {}
+        #: Unnamed <ref>s: their placeholder key, the dict holding them and
+        #: the element, renamed by :meth:`resolve` once every id is known.
+        self.refs: list[tuple[str, dict[str, Any], _Element]] = []
+        #: The main scene file's folder: file names are relative to it.
+        self.folder = ""
+
+    def pending(self, e: _Element) -> str:
+        """A placeholder key for the unnamed reference ``e``."""
+        return f"\0ref{len(self.refs)}"
+
+    def resolve(self) -> None:
+        """Keys each unnamed reference by the tag of the object it names."""
+        for placeholder, entries, e in self.refs:
+            target = entries[placeholder]["id"]
+            if target not in self.tags:
+                raise e.error(f"no object with id {target!r} in the scene")
+            key = self.tags[target]
+            if key in entries:
+                raise e.error(f"a second {key!r} in the same object")
+            entries[key] = entries.pop(placeholder)
 
     def substitute(self, e: _Element) -> None:
         def replace(match: re.Match[str]) -> str:
@@ -226,9 +258,11 @@ class _Reader:
             raise root.error("the file's root element must be <scene>")
         return root.children
 
-    def fill(self, entries: dict[str, Any], children: list[_Element], top: bool) -> None:
-        """Adds the entries of ``children`` to ``entries``."""
-        counts: dict[str, int] = {}
+    def fill(self, entries: dict[str, Any], children: list[_Element], top: bool,
+             counts: dict[str, int] | None = None) -> None:
+        """Adds the entries of ``children`` to ``entries``; ``counts``: the
+        objects of each tag so far (shared with the files it includes)."""
+        counts = {} if counts is None else counts
         for e in children:
             self.substitute(e)
             if e.tag == "default":
@@ -237,37 +271,40 @@ class _Reader:
                 path = os.path.join(os.path.dirname(e.file), e.attr("filename"))
                 included = self.read_file(path, e)
                 self.reading.append(os.path.abspath(path))
-                self.fill(entries, included, top)
+                self.fill(entries, included, top, counts)
                 self.reading.pop()
             elif e.tag in PROPERTIES:
+                name = e.attr("name")
+                for op in e.children:  # a transform's steps
+                    self.substitute(op)
                 value = _value(e)
-                if e.tag == "string" and e.attrs["name"] == "filename":
-                    # Relative to the scene file, as Mitsuba's file resolver.
-                    value = os.path.join(os.path.dirname(e.file), value)
-                entries[e.attr("name")] = value
+                if e.tag == "string" and name == "filename":
+                    # Relative to the main scene file's folder, as Mitsuba's
+                    # file resolver (also from an included file).
+                    value = os.path.join(self.folder, value)
+                entries[name] = value
                 if top:
-                    self.where[e.attrs["name"]] = e.where
+                    self.where[name] = e.where
             elif e.tag == "ref":
-                target = e.attr("id")
-                if target not in self.tags:
-                    raise e.error(f"no object with id {target!r} before it")
-                key = e.attrs.get("name", self.tags[target])
-                if key in entries:
-                    raise e.error(f"a second {key!r} in the same object")
-                entries[key] = {"type": "ref", "id": target}
+                # Unnamed: keyed by the referenced object's tag, known when
+                # the whole file is read (a reference may come first).
+                key = e.attrs.get("name") or self.pending(e)
+                entries[key] = {"type": "ref", "id": e.attr("id")}
+                if "name" not in e.attrs:
+                    self.refs.append((key, entries, e))
             elif e.tag in OBJECTS:
                 obj: dict[str, Any] = {"type": e.attr("type")}
                 if "id" in e.attrs:
                     obj["id"] = e.attrs["id"]
                     self.tags[e.attrs["id"]] = e.tag
                 self.fill(obj, e.children, top=False)
+                counts[e.tag] = counts.get(e.tag, 0) + 1
                 if "name" in e.attrs:
                     key = e.attrs["name"]
                 elif top:
-                    counts[e.tag] = counts.get(e.tag, 0) + 1
                     key = e.attrs.get("id", f"{e.tag}_{counts[e.tag]}")
-                else:
-                    key = e.tag
+                else:  # "bsdf", then "bsdf_2", ... as nested objects come
+                    key = e.tag if counts[e.tag] == 1 else f"{e.tag}_{counts[e.tag]}"
                 if key in entries:
                     raise e.error(f"a second {key!r} in the same object")
                 entries[key] = obj
@@ -310,6 +347,8 @@ def read_xml_located(path: str | os.PathLike[str], **parameters: Any
     path = os.fspath(path)
     children = reader.read_file(path, None)
     reader.reading.append(os.path.abspath(path))
+    reader.folder = os.path.dirname(os.path.abspath(path))
     scene: dict[str, Any] = {"type": "scene"}
     reader.fill(scene, children, top=True)
+    reader.resolve()
     return scene, reader.where

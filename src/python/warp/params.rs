@@ -49,11 +49,16 @@ pub fn linear_args<F: Real>(v0: f64, v1: f64) -> Result<(F, F)> {
     Ok((F::c(v0 / larger), F::c(v1 / larger)))
 }
 
-/// `alpha` of the Beckmann warps, checked: finite and > 0.
+/// `alpha` of the Beckmann warps, checked: finite and > 0, with `alpha²`
+/// a positive finite number in the kernel's precision.
 pub fn alpha_arg<F: Real>(alpha: f64) -> Result<F> {
+    let a = F::c(alpha);
     let ok = alpha.is_finite() && alpha > 0.0;
     check_parameter("alpha", alpha, ok, "must be finite and > 0")?;
-    Ok(F::c(alpha))
+    let fits = (a * a).is_finite() && a * a > F::zero();
+    let requirement = "alpha^2 must be a positive finite number in the input's precision";
+    check_parameter("alpha", alpha, fits, requirement)?;
+    Ok(a)
 }
 
 /// The von Mises–Fisher lobe of `kappa` (of the vMF and rough-fibre
@@ -61,6 +66,8 @@ pub fn alpha_arg<F: Real>(alpha: f64) -> Result<F> {
 pub fn lobe_arg<F: Real>(kappa: f64) -> Result<warp::VonMisesFisher<F>> {
     let ok = kappa.is_finite() && kappa >= 0.0;
     check_parameter("kappa", kappa, ok, "must be finite and >= 0")?;
+    let requirement = "must be finite in the input's precision";
+    check_parameter("kappa", kappa, F::c(kappa).is_finite(), requirement)?;
     Ok(warp::VonMisesFisher::new(F::c(kappa)))
 }
 
