@@ -20,9 +20,12 @@ The subset (anything else raises ValueError naming the key):
   gets Mitsuba's default: diffuse 0.5, or black diffuse if it emits.
 - emitters: ``envmap`` (filename, scale, to_world; or an :class:`EnvMap`
   given directly as the value, in any mapping) and ``constant`` (radiance).
-- sensors: ``perspective`` (fov, fov_axis, near_clip, far_clip, to_world)
-  and ``thinlens`` (also aperture_radius, focus_distance), with an
-  ``hdrfilm`` (width, height, box ``rfilter``) and a sampler:
+- sensors: ``perspective`` (fov, fov_axis, near_clip, far_clip, to_world;
+  focus_distance accepted and ignored, as Mitsuba does) and ``thinlens``
+  (also aperture_radius, focus_distance), with an ``hdrfilm`` (width,
+  height, box ``rfilter`` — given explicitly: Mitsuba's default is its
+  gaussian filter, which mcsample does not have yet; pixel_format,
+  component_format "float32" and sample_border accepted) and a sampler:
   ``independent``, ``stratified``, ``multijitter``, ``orthogonal`` or
   ``ldsampler`` (sample_count: the default spp; the type: the default
   ``sampler=`` of :func:`mcsample.render`, see ``MITSUBA_SAMPLERS`` in

@@ -331,7 +331,9 @@ def _environment(d: Any, key: str) -> tuple[str, Any]:
 
 def _camera(d: Mapping[str, Any], key: str) -> Camera:
     kind = d["type"]
-    lens = {"aperture_radius", "focus_distance"} if kind == "thinlens" else set()
+    # A pinhole ignores focus_distance (mi.cornell_box() gives one), as
+    # Mitsuba does.
+    lens = {"aperture_radius", "focus_distance"} if kind == "thinlens" else {"focus_distance"}
     _check_keys(d, {"fov", "fov_axis", "to_world", "near_clip", "far_clip", "film", "sampler"}
                 | lens, key)
     if "fov" not in d:
@@ -348,7 +350,13 @@ def _camera(d: Mapping[str, Any], key: str) -> Camera:
     film = d.get("film", {"type": "hdrfilm"})
     if film.get("type") != "hdrfilm":
         raise ValueError(f"{key}.film.type = {film.get('type')!r}: must be 'hdrfilm'")
-    _check_keys(film, {"width", "height", "rfilter", "pixel_format"}, f"{key}.film")
+    # Keys that do not change the image: component_format float32 (the
+    # default storage), sample_border (it matters to wider filters only).
+    _check_keys(film, {"width", "height", "rfilter", "pixel_format", "component_format",
+                       "sample_border"}, f"{key}.film")
+    if film.get("component_format", "float32") != "float32":
+        raise ValueError(f"{key}.film.component_format must be 'float32' (others round the "
+                         "image)")
     cam.width = int(film.get("width", DEFAULT_WIDTH))
     cam.height = int(film.get("height", DEFAULT_HEIGHT))
     rfilter = film.get("rfilter", {"type": "box"})
