@@ -56,15 +56,8 @@ impl<F: Real> Frame<F> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::cross;
     use proptest::prelude::*;
-
-    fn cross(a: V3<f64>, b: V3<f64>) -> V3<f64> {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    }
 
     fn check(n: V3<f64>) {
         let f = Frame::from_normal(n);

@@ -17,6 +17,16 @@ pub fn dot<F: Real>(a: V3<F>, b: V3<F>) -> F {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// The cross product `a × b`.
+#[inline(always)]
+pub fn cross<F: Real>(a: V3<F>, b: V3<F>) -> V3<F> {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
 /// A floating-point type a kernel can run in: `f32` or `f64`.
 pub trait Real: Float + FloatConst + Debug + Default + Send + Sync + 'static {
     /// The largest value below 1; `u = 1.0` is clamped to it where a kernel

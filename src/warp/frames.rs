@@ -4,7 +4,7 @@
 
 use super::{P2, V3, slack, turn_fraction};
 use crate::frame::Frame;
-use crate::math::{Real, dot, safe_sqrt, sin_cos_turn};
+use crate::math::{Real, cross, dot, safe_sqrt, sin_cos_turn};
 
 /// A direction in the plane orthogonal to the unit normal `n`:
 /// `cos(2πu) s + sin(2πu) t`, with `(s, t, n)` the [`Frame`] of `n` (the
@@ -37,17 +37,10 @@ pub struct Lunes<F> {
     x: V3<F>,
     y: V3<F>,
     z: V3<F>,
-    /// The half angle `θ` of each lune.
+    /// The half angle `θ` of each lune, and its sine and cosine.
     theta: F,
-}
-
-/// `a × b`.
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    sin_theta: F,
+    cos_theta: F,
 }
 
 /// `v / |v|`, or `None` for a zero or non-finite `v`.
@@ -77,6 +70,8 @@ impl<F: Real> Lunes<F> {
             y: y.map(F::c),
             z: z.map(F::c),
             theta: F::c(theta),
+            sin_theta: F::c(theta.sin()),
+            cos_theta: F::c(theta.cos()),
         })
     }
 }
@@ -110,8 +105,7 @@ pub fn square_to_uniform_spherical_lune<F: Real>(u: P2<F>, lunes: &Lunes<F>) -> 
 #[inline(always)]
 pub fn square_to_uniform_spherical_lune_pdf<F: Real>(d: V3<F>, lunes: &Lunes<F>) -> F {
     let (x, y) = (dot(d, lunes.x), dot(d, lunes.y));
-    let (sin, cos) = lunes.theta.sin_cos();
-    if y.abs() * cos <= x.abs() * sin + slack::<F>() {
+    if y.abs() * lunes.cos_theta <= x.abs() * lunes.sin_theta + slack::<F>() {
         F::one() / (F::c(8.0) * lunes.theta)
     } else {
         F::zero()

@@ -27,6 +27,8 @@ from typing import Any
 
 import numpy as np
 
+from .._core import Frame
+
 __all__ = ["read_xml"]
 
 #: Tags of objects with a ``type``: nested dicts.
@@ -121,11 +123,9 @@ def _rotation(axis: np.ndarray, degrees: float) -> np.ndarray:
 
 def _up(direction: np.ndarray) -> np.ndarray:
     """Mitsuba's ``up`` when a ``lookat`` gives none: the first tangent of
-    its orthonormal basis around the viewing direction (Duff et al.)."""
-    n = direction / np.linalg.norm(direction)
-    sign = math.copysign(1.0, n[2])
-    a = -1.0 / (sign + n[2])
-    return np.array([1.0 + sign * n[0] * n[0] * a, sign * n[0] * n[1] * a, -sign * n[0]])
+    the orthonormal basis around the viewing direction (mcsample's
+    :class:`Frame` is built the same way)."""
+    return np.asarray(Frame(direction / np.linalg.norm(direction)).s, dtype=np.float64)
 
 
 def _transform(e: _Element) -> np.ndarray:
