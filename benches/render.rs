@@ -40,6 +40,7 @@ fn rectangle(m: [[f64; 4]; 4], material: Material, emission: Option<[f64; 3]>) -
             .expect("valid mesh"),
         material,
         emission,
+        motion: None,
     }
 }
 
@@ -62,6 +63,7 @@ fn scene(with_plane: bool) -> Scene {
         geometry: Geometry::sphere([0.0, 0.6, 0.0], 0.6, false).expect("sphere"),
         material: diffuse([0.7, 0.6, 0.5]),
         emission: None,
+        motion: None,
     }];
     if with_plane {
         let floor = [

@@ -251,17 +251,6 @@ def test_geometry_and_camera_agree_with_mitsuba(mi, scene_file):
     assert np.allclose(boxes(our_boxes), boxes(their_boxes), atol=2e-4)
 
 
-def mitsuba_reference(mi, scene, spp=16, runs=16):
-    """Mitsuba's render of its own ``scene`` as a RenderResult: the mean of
-    ``runs`` independent renders of ``spp`` samples, with each pixel's
-    luminance variance from their spread (unbiased; no moment integrator)."""
-    images = np.stack([np.asarray(mi.render(scene, spp=spp, seed=k), dtype=np.float64)[..., :3]
-                       for k in range(runs)])
-    y = images @ np.array([0.2126, 0.7152, 0.0722])
-    return mcs.RenderResult(images.mean(axis=0).astype(np.float32), None,
-                            (y.var(axis=0, ddof=1) / runs).astype(np.float32), spp * runs, 0.0)
-
-
 @pytest.mark.mitsuba
 def test_render_agrees_with_mitsubas_load_file(mi, scene_file):
     """Per-pixel z-test of mcsample's render of the file against Mitsuba's
@@ -269,7 +258,7 @@ def test_render_agrees_with_mitsubas_load_file(mi, scene_file):
     independent renders (an unbiased reference, no moment integrator
     needed)."""
     ours = mcs.render(mcs.Scene.from_mitsuba(scene_file), 256, seed=3)
-    ref = mitsuba_reference(mi, mi.load_file(str(scene_file)))
+    ref = mcs.mitsuba.render_runs(mi.load_file(str(scene_file)), 16)
     result = stats.render_ztest(ours, ref)
     assert result.passed, result
     # Power: a light 20 % brighter in one of them (it lights a sixth of the
@@ -395,17 +384,16 @@ def test_a_single_mesh_file_has_no_second_mesh(tmp_path):
 
 @pytest.mark.mitsuba
 def test_mitsubas_cornell_box_renders_as_in_mitsuba(mi):
-    """``mi.cornell_box()`` as Mitsuba 3.9 gives it (focus_distance on a
-    pinhole, component_format, fov_axis "smaller", refs, an emitter with a
-    bsdf), with a box filter: mcsample's render of the dict is z-test-equal
-    to Mitsuba's render of the same dict. Its own gaussian filter is
-    refused by name."""
+    """``mi.cornell_box()`` as Mitsuba 3.9 gives it (its gaussian filter,
+    focus_distance on a pinhole, component_format, fov_axis "smaller",
+    refs, an emitter with a bsdf, 256 x 256): mcsample's render of the dict
+    is z-test-equal to Mitsuba's render of the same dict, whose region
+    variances come from 16 independent renders (its filter splats samples
+    onto neighbouring pixels)."""
     d = mi.cornell_box()
-    with pytest.raises(ValueError, match="sensor.film.rfilter"):
-        mcs.Scene.from_mitsuba(d)
-    d["sensor"]["film"].update(width=40, height=40, rfilter={"type": "box"})
+    assert d["sensor"]["film"]["rfilter"]["type"] == "gaussian"
     ours = mcs.render(mcs.Scene.from_mitsuba(d), 256, seed=1)
-    result = stats.render_ztest(ours, mitsuba_reference(mi, mi.load_dict(d)))
+    result = stats.render_ztest(ours, mcs.mitsuba.render_runs(mi.load_dict(d), 16))
     assert result.passed, result
     d["sensor"]["film"]["component_format"] = "float16"
     with pytest.raises(ValueError, match="component_format must be 'float32'"):

@@ -107,6 +107,11 @@ class RenderResult(Result):
         rendered with ``first_sample=``).
     chunk : Chunk or None
         What :meth:`merge` needs: kept by renders given ``first_sample``.
+    runs : ndarray (R, H, W) float32, or None
+        The luminances of R independent renders whose mean is ``image``,
+        for a Mitsuba reference of a splatting filter (its neighbouring
+        pixels share samples, so the variance of a region is taken from
+        them: :func:`mcsample.stats.render_ztest`); else None.
 
     In a notebook, a RenderResult shows as its tone-mapped image.
     """
@@ -118,8 +123,9 @@ class RenderResult(Result):
     seconds: float
     first_sample: int = 0
     chunk: Chunk | None = None
+    runs: np.ndarray | None = None
 
-    _hidden = ("chunk",)
+    _hidden = ("chunk", "runs")
 
     @classmethod
     def merge(cls, results: Iterable[RenderResult]) -> RenderResult:

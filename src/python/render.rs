@@ -21,6 +21,9 @@ use crate::alloc;
 use crate::error::Error;
 use crate::render::camera::{Camera, FovAxis};
 use crate::render::film::{self, Block};
+use crate::render::filter::Filter;
+use crate::render::motion::Motion;
+use crate::render::scene::daffine;
 use crate::render::scene::{Environment, Geometry, Material, Shape, affine};
 use crate::render::{Integrator, Progress, Samples, Scene, Settings, Strategy};
 use crate::sampler::Sampler;
@@ -69,6 +72,7 @@ pub struct PySceneBuilder {
     shapes: Vec<Shape>,
     environment: Option<Environment>,
     camera: Option<(Camera, usize, usize)>,
+    filter: Option<(Filter, bool)>,
 }
 
 impl PySceneBuilder {
@@ -89,6 +93,7 @@ impl PySceneBuilder {
                 two_sided,
             },
             emission,
+            motion: None,
         });
         Ok(())
     }
@@ -220,6 +225,50 @@ impl PySceneBuilder {
         Ok(())
     }
 
+    /// Moves the shape added last: its transform goes from ``start`` (where
+    /// it was added, at ``shutter_open``) to ``end`` (at ``shutter_close``),
+    /// both row-major 4×4.
+    #[pyo3(signature = (start, end))]
+    fn set_motion(&mut self, start: [[f64; 4]; 4], end: [[f64; 4]; 4]) -> PyResult<()> {
+        let motion = Motion::new(
+            "to_world_end",
+            daffine("to_world", start)?,
+            daffine("to_world_end", end)?,
+        )?;
+        let shape = self.shapes.last_mut().ok_or_else(|| Error::Argument {
+            arg: "to_world_end",
+            message: "no shape to move".into(),
+        })?;
+        shape.motion = Some(motion);
+        Ok(())
+    }
+
+    /// Moves the camera: its ``to_world`` at ``shutter_close`` is ``end``
+    /// (row-major 4×4; call after ``set_camera``).
+    fn set_camera_motion(&mut self, end: [[f64; 4]; 4]) -> PyResult<()> {
+        let end = daffine("to_world_end", end)?;
+        let (camera, width, height) = self.camera.ok_or_else(|| Error::Argument {
+            arg: "to_world_end",
+            message: "set the camera first".into(),
+        })?;
+        self.camera = Some((camera.with_motion(end)?, width, height));
+        Ok(())
+    }
+
+    /// Sets the film's reconstruction filter: ``"box"`` or ``"gaussian"``
+    /// (of standard deviation ``stddev`` pixels), sampled on the film
+    /// alone or, with ``sample_border``, on the film grown by the filter's
+    /// border (Mitsuba's ``rfilter`` and ``sample_border``).
+    #[pyo3(signature = (kind, stddev, sample_border))]
+    fn set_filter(&mut self, kind: &str, stddev: f64, sample_border: bool) -> PyResult<()> {
+        let filter = match choice("rfilter", kind, &[("box", false), ("gaussian", true)])? {
+            false => Filter::Box,
+            true => Filter::gaussian(stddev)?,
+        };
+        self.filter = Some((filter, sample_border));
+        Ok(())
+    }
+
     /// The scene, with its BVH and light selection built.
     fn build(&mut self, py: Python<'_>) -> PyResult<PyScene> {
         let (camera, width, height) = self.camera.ok_or_else(|| Error::Argument {
@@ -228,8 +277,13 @@ impl PySceneBuilder {
         })?;
         let shapes = std::mem::take(&mut self.shapes);
         let environment = self.environment.take();
-        let scene =
-            py.detach(|| guarded(|| Ok(Scene::new(shapes, environment, camera, width, height)?)))?;
+        let (filter, sample_border) = self.filter.unwrap_or((Filter::Box, false));
+        let scene = py.detach(|| {
+            guarded(|| {
+                Ok(Scene::new(shapes, environment, camera, width, height)?
+                    .with_filter(filter, sample_border)?)
+            })
+        })?;
         Ok(PyScene(Arc::new(scene)))
     }
 }

@@ -51,6 +51,15 @@ impl Primitive {
         }
     }
 
+    /// Its area.
+    pub fn area(&self) -> f64 {
+        match self {
+            Primitive::Triangle(t) => f64::from(t.area()),
+            Primitive::Sphere(s) => s.area(),
+            Primitive::Disk(d) => f64::from(d.area),
+        }
+    }
+
     fn bounds(&self) -> Aabb {
         let (lo, hi) = match self {
             Primitive::Triangle(t) => {
@@ -80,7 +89,9 @@ impl Primitive {
 pub struct Hit {
     /// Distance along the ray.
     pub t: f32,
-    /// Index of the primitive in [`Accel::primitives`].
+    /// Index of the primitive in [`Accel::primitives`] (in a scene with
+    /// moving shapes, the primitives of the moving shapes' own BVHs
+    /// follow: [`crate::render::Scene::intersect`]).
     pub primitive: u32,
     /// Barycentrics (triangles).
     pub bary: [f32; 2],

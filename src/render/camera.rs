@@ -2,8 +2,10 @@
 //! `thinlens` (depth of field), looking down +z in camera space, placed by
 //! `to_world` (usually `look_at`: camera +x is `up × dir`, the image's left).
 
-use glam::{Affine3A, Vec2, Vec3A};
+use glam::{Affine3A, DAffine3, Vec2, Vec3A};
 
+use super::geometry::affine_f32;
+use super::motion::Motion;
 use super::shape::Ray;
 use crate::error::{Error, Result};
 use crate::simd;
@@ -50,6 +52,14 @@ pub struct Camera {
     far_clip: f32,
     aperture_radius: f32,
     focus_distance: f32,
+    /// How `to_world` changes during the shutter, for a moving camera.
+    motion: Option<Motion>,
+}
+
+/// The columns of an affine map as plain arrays.
+fn columns(m: Affine3A) -> [[f32; 3]; 4] {
+    let m = m.to_cols_array();
+    std::array::from_fn(|c| std::array::from_fn(|r| m[3 * c + r]))
 }
 
 impl Camera {
@@ -111,15 +121,36 @@ impl Camera {
             FovAxis::Larger if w >= h => t,
             FovAxis::Larger => t * w / h,
         };
-        let m = to_world.to_cols_array();
         Ok(Camera {
-            to_world: std::array::from_fn(|c| std::array::from_fn(|r| m[3 * c + r])),
+            to_world: columns(to_world),
             tan_half: Vec2::new(tx as f32, (tx * h / w) as f32),
             near_clip: near_clip as f32,
             far_clip: far_clip as f32,
             aperture_radius: aperture_radius as f32,
             focus_distance: focus_distance as f32,
+            motion: None,
         })
+    }
+
+    /// The camera moving from its `to_world` at `shutter_open` to `end` at
+    /// `shutter_close` ([`Motion`]).
+    ///
+    /// # Errors
+    /// As [`Motion::new`], naming `to_world_end`.
+    pub fn with_motion(self, end: DAffine3) -> Result<Self> {
+        let start = DAffine3::from_cols_array(&std::array::from_fn(|i| {
+            f64::from(self.to_world[i / 3][i % 3])
+        }));
+        let motion = Motion::new("to_world_end", start, end)?;
+        Ok(Camera {
+            motion: Some(motion),
+            ..self
+        })
+    }
+
+    /// Whether the camera moves during the shutter.
+    pub fn moves(&self) -> bool {
+        self.motion.is_some()
     }
 
     /// Whether rays start across a lens (a thin lens) rather than at a
@@ -138,15 +169,15 @@ impl Camera {
     #[inline]
     pub fn ray(&self, film: [f32; 2], lens: [f32; 2]) -> Ray {
         let thin = self.aperture_radius > 0.0;
-        ray_from_row(self.ray_row([film[0], film[1], lens[0], lens[1]], thin))
+        ray_from_row(self.ray_row([film[0], film[1], lens[0], lens[1]], thin, &self.to_world))
     }
 
     /// [`Camera::ray`] of `u = (film x, film y, lens x, lens y)` as the row
-    /// `[o, d, tmax]`, for a pinhole or (`thin`) a thin lens: plain `f32`
-    /// arithmetic without branches, so that a loop over rays runs one per
-    /// SIMD lane.
+    /// `[o, d, tmax]`, for a pinhole or (`thin`) a thin lens placed by the
+    /// columns `m` of its `to_world`: plain `f32` arithmetic without
+    /// branches, so that a loop over rays runs one per SIMD lane.
     #[inline(always)]
-    fn ray_row(&self, u: [f32; 4], thin: bool) -> [f32; 7] {
+    fn ray_row(&self, u: [f32; 4], thin: bool, m: &[[f32; 3]; 4]) -> [f32; 7] {
         let v = [
             (1.0 - 2.0 * u[0]) * self.tan_half.x,
             (1.0 - 2.0 * u[1]) * self.tan_half.y,
@@ -167,7 +198,6 @@ impl Camera {
         // `near/d.z` along `d` (`d.z > 0`), or `|d|·near/d.z` along `d/|d|`.
         let inv_z = 1.0 / d[2];
         let o: [f32; 3] = std::array::from_fn(|k| o[k] + d[k] * (self.near_clip * inv_z));
-        let m = &self.to_world;
         let wo: [f32; 3] =
             std::array::from_fn(|k| m[0][k] * o[0] + m[1][k] * o[1] + m[2][k] * o[2] + m[3][k]);
         let wd: [f32; 3] =
@@ -186,20 +216,30 @@ impl Camera {
     }
 
     /// `out[i]` the ray of `u[i] = (film x, film y, lens x, lens y)` (see
-    /// [`Camera::ray`]) for a batch, at full SIMD width.
-    pub fn rays_into(&self, u: &[[f32; 4]], out: &mut [Ray]) {
+    /// [`Camera::ray`]) for a batch, at full SIMD width; a moving camera
+    /// placed where it is at `times[i]` (of the shutter, in `[0, 1]`), one
+    /// ray after the other.
+    pub fn rays_into(&self, u: &[[f32; 4]], times: &[f32], out: &mut [Ray]) {
+        let thin_lens = self.aperture_radius > 0.0;
+        if let Some(motion) = &self.motion {
+            for ((u, &tau), out) in u.iter().zip(times).zip(out.iter_mut()) {
+                let m = columns(affine_f32(motion.at(f64::from(tau))));
+                *out = ray_from_row(self.ray_row(*u, thin_lens, &m));
+            }
+            return;
+        }
         let mut rows = [[0.0f32; 7]; BLOCK];
         let pinhole = {
             #[inline(always)]
-            |u: [f32; 4]| self.ray_row(u, false)
+            |u: [f32; 4]| self.ray_row(u, false, &self.to_world)
         };
         let thin = {
             #[inline(always)]
-            |u: [f32; 4]| self.ray_row(u, true)
+            |u: [f32; 4]| self.ray_row(u, true, &self.to_world)
         };
         for (u, out) in u.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
             let rows = &mut rows[..u.len()];
-            if self.aperture_radius > 0.0 {
+            if thin_lens {
                 simd::map_rows(rows, u, &thin, |_| true, false);
             } else {
                 simd::map_rows(rows, u, &pinhole, |_| true, false);

@@ -180,17 +180,27 @@ impl Geometry {
     }
 }
 
+/// The affine map of a row-major 4×4 matrix (its last row ignored), in
+/// `f64`.
+///
+/// # Errors
+/// [`Error::Element`] for an entry that is not finite.
+pub fn daffine(arg: &'static str, m: [[f64; 4]; 4]) -> Result<glam::DAffine3> {
+    finite_rows(arg, &m)?;
+    Ok(glam::DAffine3::from_cols_array(&std::array::from_fn(|i| {
+        m[i % 3][i / 3]
+    })))
+}
+
 /// The affine map of a row-major 4×4 matrix (its last row ignored).
 ///
 /// # Errors
 /// [`Error::Element`] for an entry that is not finite.
 pub fn affine(arg: &'static str, m: [[f64; 4]; 4]) -> Result<glam::Affine3A> {
-    finite_rows(arg, &m)?;
-    let col = |c: usize| glam::Vec3::new(m[0][c] as f32, m[1][c] as f32, m[2][c] as f32);
-    Ok(glam::Affine3A::from_cols(
-        col(0).into(),
-        col(1).into(),
-        col(2).into(),
-        col(3).into(),
-    ))
+    daffine(arg, m).map(affine_f32)
+}
+
+/// An `f64` affine map in `f32`.
+pub fn affine_f32(m: glam::DAffine3) -> glam::Affine3A {
+    glam::Affine3A::from_cols_array(&m.to_cols_array().map(|v| v as f32))
 }

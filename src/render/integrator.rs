@@ -38,7 +38,8 @@ pub mod dims {
     /// The position on the lens (2D; for a pinhole camera only the
     /// independent sampler draws it, to keep its order of draws).
     pub const LENS: u32 = 2;
-    /// The time within the shutter interval (reserved: no motion yet).
+    /// The time within the shutter interval (drawn only when something in
+    /// the scene moves).
     pub const TIME: u32 = 4;
     /// Dimensions of the camera sample.
     pub const CAMERA: u32 = 5;
@@ -252,22 +253,21 @@ pub fn add_escaped(scene: &Scene, settings: &Settings, escaped: &mut Escaped, l:
 /// is not on an area light: the ray passes through them (re-spawned past
 /// each, as Mitsuba's `hide_emitters` does), and `ray` is updated to the
 /// last spawn.
-pub fn skip_emitters(scene: &Scene, ray: &mut Ray, mut hit: Option<Hit>) -> Option<Hit> {
+pub fn skip_emitters(scene: &Scene, ray: &mut Ray, mut hit: Option<Hit>, time: f32) -> Option<Hit> {
     while let Some(h) = hit {
-        let shape = scene.accel().shape_of(h.primitive);
+        let (shape, sp) = scene.surface(ray, &h, time);
         if !scene.is_emitter(shape) {
             break;
         }
-        let primitive = &scene.accel().primitives()[h.primitive as usize];
-        let sp = primitive.point(ray.o + ray.d * h.t, h.bary);
         ray.o = offset(sp.p, sp.ng, ray.d);
-        hit = scene.accel().intersect(ray);
+        hit = scene.intersect(ray, time);
     }
     hit
 }
 
-/// The radiance arriving at the camera along `ray`, whose first hit
-/// ([`super::accel::Accel::intersect`]) is `hit`: one sample of the
+/// The radiance arriving at the camera along `ray` at time `time` of the
+/// shutter (every ray of the path is traced at that time), whose first hit
+/// ([`Scene::intersect`]) is `hit`: one sample of the
 /// estimator above, drawing its random numbers from `stream` (at the
 /// current sample). Light from the
 /// environment is not included: rays that escape are added to `escaped`
@@ -275,7 +275,7 @@ pub fn skip_emitters(scene: &Scene, ray: &mut Ray, mut hit: Option<Hit>) -> Opti
 #[inline]
 pub fn radiance(
     scene: &Scene,
-    ray: Ray,
+    (ray, time): (Ray, f32),
     hit: Option<Hit>,
     stream: &mut Stream,
     settings: &Settings,
@@ -286,7 +286,7 @@ pub fn radiance(
         return [0.0; 3];
     }
     match hit {
-        Some(hit) => path(scene, ray, hit, stream, settings, escaped, slot),
+        Some(hit) => path(scene, (ray, time), hit, stream, settings, escaped, slot),
         None => {
             if scene.environment().is_some() && !settings.hide_emitters {
                 escaped.push(slot, ray.d, [1.0; 3], None);
@@ -301,7 +301,7 @@ pub fn radiance(
 #[inline(never)]
 fn path(
     scene: &Scene,
-    mut ray: Ray,
+    (mut ray, time): (Ray, f32),
     mut hit: Hit,
     stream: &mut Stream,
     settings: &Settings,
@@ -317,9 +317,7 @@ fn path(
     let mut from = ray.o;
     let mut depth = 0u32;
     loop {
-        let shape = scene.accel().shape_of(hit.primitive);
-        let primitive = &scene.accel().primitives()[hit.primitive as usize];
-        let sp = primitive.point(ray.o + ray.d * hit.t, hit.bary);
+        let (shape, sp) = scene.surface(&ray, &hit, time);
         let wi = -ray.d;
         if let Some(le) = scene.emitted(shape, sp.ng, wi) {
             let w = emission_weight(settings, depth, bsdf_pdf, || {
@@ -350,7 +348,7 @@ fn path(
                 let wo = frame.to_local(ls.d.to_array());
                 let (f, pdf_wo) = view.eval_pdf_one(wo);
                 if f.iter().any(|&v| v > 0.0)
-                    && !scene.accel().occluded(&shadow_ray(sp.p, sp.ng, &ls))
+                    && !scene.occluded(&shadow_ray(sp.p, sp.ng, &ls), time)
                 {
                     let w = if settings.strategy == Strategy::Mis {
                         settings.weight(ls.pdf, pdf_wo)
@@ -391,7 +389,7 @@ fn path(
             }
             beta = beta.map(|b| b / q);
         }
-        hit = match scene.accel().intersect(&ray) {
+        hit = match scene.intersect(&ray, time) {
             Some(hit) => hit,
             None => {
                 if scene.environment().is_some() && settings.strategy != Strategy::Emitter {

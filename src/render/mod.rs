@@ -1,11 +1,15 @@
 //! A compact renderer for envmap- and area-lit scenes: shapes in a BVH,
-//! Phong and diffuse materials, a perspective or thin-lens camera, a box-
-//! filtered film, and direct or path integrators by BSDF sampling, emitter
-//! sampling or MIS ([`integrator`]).
+//! Phong and diffuse materials, a perspective or thin-lens camera, a film
+//! with Mitsuba's box or Gaussian filter, motion blur of shapes and camera
+//! ([`motion`]: each sample draws a time in the shutter, at which all its
+//! rays are traced), and direct or path integrators by BSDF sampling,
+//! emitter sampling or MIS ([`integrator`]).
 //!
-//! Pixel `(x, y)` is the mean of `spp` samples at uniform positions inside
-//! it (a box filter of radius ½, as Mitsuba's `box`); its variance is that of
-//! the mean, `s² / spp` with `s²` the unbiased sample variance, both from
+//! Pixel `(x, y)` is the mean of `spp` samples of its own: at uniform
+//! positions inside it for the box filter (radius ½, as Mitsuba's `box`),
+//! or drawn around its centre on the filter and weighted ([`filter`]); its
+//! variance is that of the mean, `s² / spp` with `s²` the unbiased sample
+//! variance, both from
 //! sums that merge exactly ([`film`]). Each pixel draws from its own
 //! [`Stream`] of the settings' [`Sampler`] (keyed by `seed` and the pixel
 //! index), and each sample of the independent sampler from a PCG32
@@ -31,9 +35,11 @@
 pub mod accel;
 pub mod camera;
 pub mod film;
+pub mod filter;
 pub mod geometry;
 pub mod integrator;
 pub mod mesh_file;
+pub mod motion;
 pub mod scene;
 pub mod shape;
 #[cfg(test)]
@@ -146,6 +152,12 @@ struct Batch {
     radiance: Vec<[f32; 3]>,
     /// Film and lens positions of each sample.
     camera_u: Vec<[f32; 4]>,
+    /// The reconstruction filter's weight of each sample (empty for the
+    /// box filter, whose weights are 1).
+    weights: Vec<f32>,
+    /// The time of each sample within the shutter, in `[0, 1]` (empty, and
+    /// 0 for every sample, in a scene where nothing moves).
+    times: Vec<f32>,
     /// The independent sampler's generator of each sample after its camera
     /// draws.
     resume: Vec<Rng>,
@@ -174,16 +186,20 @@ impl Batch {
         let spp = samples.count;
         let (width, height) = scene.film();
         let (inv_width, inv_height) = (1.0 / width as f32, 1.0 / height as f32);
+        let filter = scene.filter();
+        let moves = scene.moves();
         self.escaped.clear();
         self.radiance.clear();
         self.camera_u.clear();
+        self.weights.clear();
+        self.times.clear();
         self.resume.clear();
         // Reserved up front (samples grow with spp): a batch too big for
         // memory is an error, not an abort.
         let n = pixels.len() * spp.max(1) as usize;
         const WHAT: &str = "a batch of samples";
         alloc::reserve_each!(n, WHAT;
-            self.camera_u, self.resume, self.rays, self.hits, self.radiance)?;
+            self.camera_u, self.weights, self.times, self.resume, self.rays, self.hits, self.radiance)?;
         self.escaped.reserve(n)?;
         let mut streams = alloc::with_capacity(pixels.len(), WHAT)?;
         for x in pixels {
@@ -207,9 +223,17 @@ impl Batch {
                 } else {
                     [0.5; 2]
                 };
-                let film_x = (x as f32 + film[0]) * inv_width;
-                let film_y = (y as f32 + film[1]) * inv_height;
-                self.camera_u.push([film_x, film_y, lens[0], lens[1]]);
+                let ([px, py], weight) = filter.sample((x, y), film);
+                self.camera_u
+                    .push([px * inv_width, py * inv_height, lens[0], lens[1]]);
+                if filter.weighted() {
+                    self.weights.push(weight);
+                }
+                // A still scene draws no time (the independent sampler
+                // keeps its order of draws).
+                if moves {
+                    self.times.push(stream.get1(dims::TIME));
+                }
                 if let Some(rng) = stream.independent() {
                     self.resume.push(rng.clone());
                 }
@@ -217,16 +241,21 @@ impl Batch {
             streams.push(stream);
         }
         self.rays.resize(self.camera_u.len(), Ray::default());
-        scene.camera().rays_into(&self.camera_u, &mut self.rays);
+        scene
+            .camera()
+            .rays_into(&self.camera_u, &self.times, &mut self.rays);
         self.hits.clear();
-        self.hits.extend(self.rays.iter_mut().map(|ray| {
-            let hit = scene.accel().intersect(ray);
-            if settings.hide_emitters {
-                integrator::skip_emitters(scene, ray, hit)
-            } else {
-                hit
-            }
-        }));
+        let times = &self.times;
+        let time = |i: usize| if moves { times[i] } else { 0.0 };
+        self.hits
+            .extend(self.rays.iter_mut().enumerate().map(|(i, ray)| {
+                let hit = scene.intersect(ray, time(i));
+                if settings.hide_emitters {
+                    integrator::skip_emitters(scene, ray, hit, time(i))
+                } else {
+                    hit
+                }
+            }));
         let spp = spp.max(1) as usize;
         let per_pixel = self.rays.chunks(spp).zip(self.hits.chunks(spp));
         for (mut stream, (rays, hits)) in streams.into_iter().zip(per_pixel) {
@@ -240,7 +269,7 @@ impl Batch {
                 }
                 let l = integrator::radiance(
                     scene,
-                    *ray,
+                    (*ray, time(slot as usize)),
                     *hit,
                     &mut stream,
                     settings,
@@ -251,6 +280,9 @@ impl Batch {
             }
         }
         integrator::add_escaped(scene, settings, &mut self.escaped, &mut self.radiance);
+        for (l, w) in self.radiance.iter_mut().zip(&self.weights) {
+            *l = l.map(|v| v * w);
+        }
         Ok(())
     }
 }

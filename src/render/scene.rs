@@ -2,13 +2,17 @@
 //! environment, the camera and the film size; and its lights, chosen by
 //! power for emitter sampling.
 
-use glam::Vec3A;
+use glam::{Affine3A, DAffine3, Vec3A};
 use std::sync::Arc;
 
+use super::accel::Hit;
 use super::accel::{Accel, Primitive};
 use super::camera::Camera;
+use super::filter::{FilmFilter, Filter};
+use super::geometry::affine_f32;
 use super::geometry::check_primitives;
-pub use super::geometry::{Geometry, MAX_PRIMITIVES, affine};
+pub use super::geometry::{Geometry, MAX_PRIMITIVES, affine, daffine};
+use super::motion::Motion;
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
 use crate::distr::Discrete1D;
@@ -39,6 +43,51 @@ pub struct Shape {
     pub material: Material,
     /// Emitted radiance, for an area light.
     pub emission: Option<[f64; 3]>,
+    /// How it moves during the shutter, `geometry` being where it is at
+    /// `shutter_open` (`to_world` there, `to_world_end` at `shutter_close`).
+    pub motion: Option<Motion>,
+}
+
+/// A shape that moves during the shutter, traced in a BVH of its own: its
+/// primitives where they are at `shutter_open` (transform `M₀`), met by the
+/// ray mapped through `D(τ)⁻¹`, with `D(τ) = M(τ) M₀⁻¹` taking them to
+/// where they are at time `τ`. The direction is mapped without
+/// renormalising, so distances along the ray are the same in both frames.
+struct Mover {
+    accel: Accel,
+    motion: Motion,
+    start_inverse: DAffine3,
+    /// The number of its first primitive in the scene's [`Hit`]s: they
+    /// follow the still shapes' and those of the moving shapes before it.
+    first: u32,
+}
+
+/// The primitives of a shape's geometry.
+fn primitives_of(geometry: Geometry) -> Box<dyn ExactSizeIterator<Item = Primitive>> {
+    match geometry {
+        Geometry::Mesh(tris) => Box::new(tris.into_iter().map(Primitive::Triangle)),
+        Geometry::Sphere(s) => Box::new(std::iter::once(Primitive::Sphere(s))),
+        Geometry::Disk(d) => Box::new(std::iter::once(Primitive::Disk(d))),
+    }
+}
+
+impl Mover {
+    /// `D(τ)` and `D(τ)⁻¹`.
+    #[inline]
+    fn relative(&self, tau: f32) -> (Affine3A, Affine3A) {
+        let d = self.motion.at(f64::from(tau)) * self.start_inverse;
+        (affine_f32(d), affine_f32(d.inverse()))
+    }
+
+    /// `ray` in the frame of the shape's `shutter_open` position.
+    #[inline]
+    fn local(ray: &Ray, inverse: &Affine3A) -> Ray {
+        Ray {
+            o: inverse.transform_point3a(ray.o),
+            d: inverse.transform_vector3a(ray.d),
+            tmax: ray.tmax,
+        }
+    }
 }
 
 /// Light from infinitely far away.
@@ -179,6 +228,8 @@ pub struct Scene {
     camera: Camera,
     width: usize,
     height: usize,
+    filter: FilmFilter,
+    movers: Vec<Mover>,
 }
 
 impl Scene {
@@ -210,25 +261,39 @@ impl Scene {
         let mut light_of_shape = Vec::with_capacity(shapes.len());
         let mut lights = Vec::new();
         let mut powers = Vec::new();
+        let mut movers = Vec::new();
         for (index, shape) in shapes.into_iter().enumerate() {
             let id = index as u32;
+            if let Some(motion) = shape.motion {
+                if shape.emission.is_some() {
+                    return Err(Error::Argument {
+                        arg: "to_world_end",
+                        message: format!(
+                            "shape {index}: a moving area light is not supported (only \
+                             shapes that do not emit may move)"
+                        ),
+                    });
+                }
+                movers.push(Mover {
+                    accel: Accel::new(alloc::collect(
+                        primitives_of(shape.geometry).map(|p| (p, id)),
+                        "a moving shape's primitives",
+                    )?)?,
+                    motion,
+                    start_inverse: motion.at(0.0).inverse(),
+                    first: 0,
+                });
+                materials.push(shape.material);
+                emission.push(None);
+                light_of_shape.push(None);
+                continue;
+            }
             let first = primitives.len() as u32;
-            let areas: Vec<f64> = match shape.geometry {
-                Geometry::Mesh(tris) => {
-                    let areas =
-                        alloc::collect(tris.iter().map(|t| f64::from(t.area())), "the areas")?;
-                    primitives.extend(tris.into_iter().map(|t| (Primitive::Triangle(t), id)));
-                    areas
-                }
-                Geometry::Sphere(s) => {
-                    primitives.push((Primitive::Sphere(s), id));
-                    vec![s.area()]
-                }
-                Geometry::Disk(d) => {
-                    primitives.push((Primitive::Disk(d), id));
-                    vec![f64::from(d.area)]
-                }
-            };
+            primitives.extend(primitives_of(shape.geometry).map(|p| (p, id)));
+            let areas = alloc::collect(
+                primitives[first as usize..].iter().map(|(p, _)| p.area()),
+                "the areas",
+            )?;
             materials.push(shape.material);
             let radiance = shape.emission.map(|l| l.map(|v| v as f32));
             emission.push(radiance);
@@ -254,6 +319,17 @@ impl Scene {
             }
         }
         let accel = Accel::new(primitives)?;
+        let mut first = accel.primitives().len() as u32;
+        for mover in &mut movers {
+            mover.first = first;
+            first = first
+                .checked_add(mover.accel.primitives().len() as u32)
+                .ok_or(Error::TooLarge {
+                    arg: "shapes",
+                    len: u32::MAX as usize + 1,
+                    max: u32::MAX as usize,
+                })?;
+        }
         let radius = accel
             .bounds()
             .map_or(1.0, |(lo, hi)| 0.5 * f64::from((hi - lo).length()));
@@ -285,7 +361,113 @@ impl Scene {
             camera,
             width,
             height,
+            filter: FilmFilter::none(),
+            movers,
         })
+    }
+
+    /// Whether anything moves during the shutter (a shape or the camera):
+    /// samples then draw a time.
+    pub fn moves(&self) -> bool {
+        !self.movers.is_empty() || self.camera.moves()
+    }
+
+    /// The nearest hit of `ray` at time `tau` (of the shutter, in
+    /// `[0, 1]`): in the BVH of the shapes that stay, then in each moving
+    /// shape's own, placed where it is at `tau`.
+    #[inline(always)]
+    pub fn intersect(&self, ray: &Ray, tau: f32) -> Option<Hit> {
+        let best = self.accel.intersect(ray);
+        if self.movers.is_empty() {
+            best
+        } else {
+            self.intersect_movers(ray, tau, best)
+        }
+    }
+
+    /// [`Scene::intersect`] among the moving shapes, given the `best` hit
+    /// so far.
+    #[inline(never)]
+    fn intersect_movers(&self, ray: &Ray, tau: f32, mut best: Option<Hit>) -> Option<Hit> {
+        for mover in &self.movers {
+            let mut local = Mover::local(ray, &mover.relative(tau).1);
+            if let Some(h) = best {
+                local.tmax = h.t;
+            }
+            if let Some(h) = mover.accel.intersect(&local) {
+                best = Some(Hit {
+                    primitive: mover.first + h.primitive,
+                    ..h
+                });
+            }
+        }
+        best
+    }
+
+    /// Whether anything lies on `ray` in `(0, ray.tmax)` at time `tau`.
+    #[inline(always)]
+    pub fn occluded(&self, ray: &Ray, tau: f32) -> bool {
+        self.accel.occluded(ray) || (!self.movers.is_empty() && self.movers_occlude(ray, tau))
+    }
+
+    /// Whether a moving shape lies on `ray` at time `tau`.
+    #[inline(never)]
+    fn movers_occlude(&self, ray: &Ray, tau: f32) -> bool {
+        self.movers
+            .iter()
+            .any(|m| m.accel.occluded(&Mover::local(ray, &m.relative(tau).1)))
+    }
+
+    /// The shape `ray` meets at `hit` (found by [`Scene::intersect`] at
+    /// time `tau`) and the surface point there; a moving shape's normals
+    /// are carried by the inverse transpose of its motion.
+    #[inline(always)]
+    pub fn surface(&self, ray: &Ray, hit: &Hit, tau: f32) -> (u32, SurfacePoint) {
+        if hit.primitive as usize >= self.accel.primitives().len() {
+            return self.moving_surface(ray, hit, tau);
+        }
+        let primitive = &self.accel.primitives()[hit.primitive as usize];
+        (
+            self.accel.shape_of(hit.primitive),
+            primitive.point(ray.o + ray.d * hit.t, hit.bary),
+        )
+    }
+
+    /// [`Scene::surface`] of a hit on a moving shape.
+    #[inline(never)]
+    fn moving_surface(&self, ray: &Ray, hit: &Hit, tau: f32) -> (u32, SurfacePoint) {
+        let k = self.movers.partition_point(|m| m.first <= hit.primitive) - 1;
+        let mover = &self.movers[k];
+        let own = hit.primitive - mover.first;
+        let (forward, inverse) = mover.relative(tau);
+        let local = Mover::local(ray, &inverse);
+        let primitive = &mover.accel.primitives()[own as usize];
+        let sp = primitive.point(local.o + local.d * hit.t, hit.bary);
+        let normal = |n: Vec3A| (inverse.matrix3.transpose() * n).normalize();
+        (
+            mover.accel.shape_of(own),
+            SurfacePoint {
+                p: forward.transform_point3a(sp.p),
+                ng: normal(sp.ng),
+                ns: normal(sp.ns),
+            },
+        )
+    }
+
+    /// The scene with the film's reconstruction `filter` (the box filter
+    /// unless set), sampled on the film or, with `sample_border`, on the
+    /// film grown by the filter's border.
+    ///
+    /// # Errors
+    /// As [`FilmFilter::new`].
+    pub fn with_filter(self, filter: Filter, sample_border: bool) -> Result<Self> {
+        let filter = FilmFilter::new(filter, self.film(), sample_border)?;
+        Ok(Scene { filter, ..self })
+    }
+
+    /// The film's reconstruction filter.
+    pub fn filter(&self) -> &FilmFilter {
+        &self.filter
     }
 
     /// The film size `(width, height)` in pixels.

@@ -96,6 +96,7 @@ fn floor_scene(rho: f64, lights: Vec<Shape>) -> Scene {
         geometry: rectangle(Affine3A::from_scale(Vec3::splat(50.0))),
         material: diffuse(rho),
         emission: None,
+        motion: None,
     };
     let mut shapes = vec![floor];
     shapes.extend(lights);
@@ -107,6 +108,7 @@ fn light(geometry: Geometry, radiance: f64) -> Shape {
         geometry,
         material: diffuse(0.0),
         emission: Some([radiance; 3]),
+        motion: None,
     }
 }
 
@@ -150,7 +152,15 @@ fn estimate(scene: &Scene, from: Vec3A, target: Vec3A, s: &Settings, n: usize) -
         escaped.clear();
         for (slot, out) in l.iter_mut().enumerate() {
             stream.start((block * 256 + slot) as u32);
-            *out = integrator::radiance(scene, ray, hit, &mut stream, s, &mut escaped, slot as u32);
+            *out = integrator::radiance(
+                scene,
+                (ray, 0.0),
+                hit,
+                &mut stream,
+                s,
+                &mut escaped,
+                slot as u32,
+            );
         }
         integrator::add_escaped(scene, s, &mut escaped, &mut l);
         for v in &l {
@@ -361,6 +371,7 @@ fn glowing_room(rho: f64, l: f64) -> Scene {
         geometry: Geometry::sphere([0.0, 0.0, 0.0], 1.0, true).unwrap(),
         material: diffuse(rho),
         emission: Some([l; 3]),
+        motion: None,
     };
     Scene::new(vec![room], None, camera(), 4, 4).unwrap()
 }
@@ -406,6 +417,7 @@ fn floor_under_a_constant_sky_reflects_its_albedo() {
         geometry: rectangle(Affine3A::from_scale(Vec3::splat(50.0))),
         material: diffuse(rho),
         emission: None,
+        motion: None,
     };
     let scene = Scene::new(
         vec![floor],

@@ -14,11 +14,12 @@ from .emitters import (MitsubaEmitterSample, emitter_eval, emitter_pdf, emitter_
                        envmap_emitter)
 from .export import scene_dict
 from .phong import register_phong
-from .reference import render_reference
+from .reference import render_reference, render_runs
 from .variant import (MIN_LLVM, available, choose_variant, find_libllvm, llvm_usable, load,
                       variant_set)
 
 __all__ = ["MIN_LLVM", "MitsubaEmitterSample", "available", "choose_variant", "emitter_eval",
            "emitter_pdf", "emitter_sample", "envmap_dict", "envmap_emitter", "find_libllvm",
-           "llvm_usable", "load", "register_phong", "render_reference", "scene_dict",
+           "llvm_usable", "load", "register_phong", "render_reference", "render_runs",
+           "scene_dict",
            "variant_set"]

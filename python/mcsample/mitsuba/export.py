@@ -68,14 +68,23 @@ def scene_dict(scene: "Scene", spp: int | None = None,
     source's resolution)."""
     import mitsuba as mi
 
-    phong_type = register_phong()
     c = scene.camera
+    if c.shutter_close > c.shutter_open:
+        moving = [s.key for s in scene.shapes if s.motion is not None]
+        if c.to_world_end is not None:
+            moving.insert(0, "sensor")
+        if moving:
+            raise ValueError(f"{moving[0]}: it moves during the shutter (to_world_end), and "
+                             "Mitsuba 3.9 has no motion blur")
+    phong_type = register_phong()
     sensor: dict[str, Any] = {
         "type": "thinlens" if c.aperture_radius > 0 else "perspective",
         "fov": c.fov, "fov_axis": c.fov_axis, "near_clip": c.near_clip,
         "far_clip": c.far_clip, "to_world": mi.ScalarTransform4f(c.to_world.tolist()),
         "film": {"type": "hdrfilm", "width": c.width, "height": c.height,
-                 "rfilter": {"type": "box"}, "pixel_format": "rgb"},
+                 "rfilter": ({"type": "gaussian", "stddev": c.stddev}
+                             if c.rfilter == "gaussian" else {"type": "box"}),
+                 "sample_border": c.sample_border, "pixel_format": "rgb"},
         "sampler": {"type": c.sampler, "sample_count": int(spp or c.sample_count or 4)},
     }
     if c.aperture_radius > 0:

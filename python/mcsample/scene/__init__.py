@@ -13,7 +13,10 @@ The subset (anything else raises ValueError naming the key):
   flip_normals, to_world), ``serialized`` (also shape_index; Mitsuba's
   compressed meshes, read by :func:`read_serialized`), and ``mesh`` — mcsample's own type for numpy
   arrays: ``vertices`` (N, 3), ``faces`` (M, 3) and optional ``normals``
-  (N, 3). Each may hold a ``bsdf`` and an ``area`` emitter (``radiance``).
+  (N, 3). Each may hold a ``bsdf`` and an ``area`` emitter (``radiance``),
+  and a ``to_world_end``: its transform at shutter_close (``to_world`` being
+  the one at shutter_open; in between, translation and scale interpolated
+  linearly, rotation by slerp), for motion blur (not on an emitter).
 - bsdfs: ``diffuse`` (reflectance), ``mcsample_phong`` (diffuse_reflectance,
   specular_reflectance, exponent), ``twosided`` around either, and
   ``{"type": "ref", "id": ...}`` to a top-level bsdf. A shape without one
@@ -22,10 +25,12 @@ The subset (anything else raises ValueError naming the key):
   given directly as the value, in any mapping) and ``constant`` (radiance).
 - sensors: ``perspective`` (fov, fov_axis, near_clip, far_clip, to_world;
   focus_distance accepted and ignored, as Mitsuba does) and ``thinlens``
-  (also aperture_radius, focus_distance), with an ``hdrfilm`` (width,
-  height, box ``rfilter`` — given explicitly: Mitsuba's default is its
-  gaussian filter, which mcsample does not have yet; pixel_format,
-  component_format "float32" and sample_border accepted) and a sampler:
+  (also aperture_radius, focus_distance), shutter_open / shutter_close (the
+  interval over which each sample's time is drawn; equal, the default: no
+  motion blur) and ``to_world_end`` (a moving camera), with an ``hdrfilm`` (width,
+  height, ``rfilter``: ``gaussian`` (stddev; Mitsuba's default, also when
+  ``rfilter`` is absent) or ``box``, sample_border; pixel_format and
+  component_format "float32" accepted) and a sampler:
   ``independent``, ``stratified``, ``multijitter``, ``orthogonal`` or
   ``ldsampler`` (sample_count: the default spp; the type: the default
   ``sampler=`` of :func:`mcsample.render`, see ``MITSUBA_SAMPLERS`` in
@@ -130,6 +135,10 @@ class Scene:
         """The Rust scene (BVH and light selection), built on first use."""
         if self._compiled is None:
             b = SceneBuilder()
+            c = self.camera
+            # A shutter of length 0 sees everything where it is at
+            # shutter_open.
+            blur = c.shutter_close > c.shutter_open
             for s in self.shapes:
                 bsdf, two = s.material.phong(), s.material.two_sided
                 if s.kind == "sphere":
@@ -141,15 +150,19 @@ class Scene:
                                np.ascontiguousarray(s.faces),
                                None if s.normals is None else np.ascontiguousarray(s.normals),
                                s.face_normals, bsdf, two, s.emission)
+                if s.motion is not None and blur:
+                    b.set_motion(s.motion[0].tolist(), s.motion[1].tolist())
             if self.environment is not None:
                 kind, value = self.environment
                 if kind == "envmap":
                     b.set_envmap(value)
                 else:
                     b.set_constant(value)
-            c = self.camera
             b.set_camera(c.to_world.tolist(), c.fov, c.fov_axis, c.width, c.height,
                          c.near_clip, c.far_clip, c.aperture_radius, c.focus_distance)
+            if c.to_world_end is not None and blur:
+                b.set_camera_motion(c.to_world_end.tolist())
+            b.set_filter(c.rfilter, c.stddev, c.sample_border)
             self._compiled = b.build()
         return self._compiled
 

@@ -141,6 +141,12 @@ class ShapeRecord:
     radius: float = 1.0
     flip_normals: bool = False
     to_world: np.ndarray | None = None
+    #: The transform at shutter_open and at shutter_close (``to_world``, or
+    #: the identity, and ``to_world_end``) of a shape that moves; the
+    #: geometry above is where it is at shutter_open.
+    motion: tuple[np.ndarray, np.ndarray] | None = None
+    #: The shape's key in the scene dict.
+    key: str = ""
 
 
 @dataclass
@@ -157,6 +163,17 @@ class Camera:
     sample_count: int | None = None
     #: The sensor's sampler, by its Mitsuba name.
     sampler: str = "independent"
+    #: The shutter interval (Mitsuba's sensor keys; equal: no motion blur)
+    #: and, for a moving camera, its ``to_world`` at shutter_close.
+    shutter_open: float = 0.0
+    shutter_close: float = 0.0
+    to_world_end: np.ndarray | None = None
+    #: The film's reconstruction filter, Mitsuba's ``"gaussian"`` (its
+    #: default) or ``"box"``, the Gaussian's standard deviation in pixels,
+    #: and whether samples also fall on the filter's border around the film.
+    rfilter: str = "gaussian"
+    stddev: float = 0.5
+    sample_border: bool = False
 
 
 #: Mitsuba's samplers, the keys each takes, and the mcsample sampler that
@@ -233,15 +250,32 @@ def _cube() -> tuple[np.ndarray, np.ndarray]:
 
 
 _SHAPE_KEYS = {
-    "sphere": {"center", "radius", "to_world", "flip_normals"},
-    "rectangle": {"to_world", "flip_normals"},
-    "disk": {"to_world", "flip_normals"},
-    "cube": {"to_world", "flip_normals"},
-    "ply": {"filename", "to_world", "face_normals", "flip_normals"},
-    "obj": {"filename", "to_world", "face_normals", "flip_normals"},
-    "serialized": {"filename", "shape_index", "to_world", "face_normals", "flip_normals"},
-    "mesh": {"vertices", "faces", "normals", "to_world", "face_normals", "flip_normals"},
+    "sphere": {"center", "radius", "to_world", "flip_normals", "to_world_end"},
+    "rectangle": {"to_world", "flip_normals", "to_world_end"},
+    "disk": {"to_world", "flip_normals", "to_world_end"},
+    "cube": {"to_world", "flip_normals", "to_world_end"},
+    "ply": {"filename", "to_world", "face_normals", "flip_normals", "to_world_end"},
+    "obj": {"filename", "to_world", "face_normals", "flip_normals", "to_world_end"},
+    "serialized": {"filename", "shape_index", "to_world", "face_normals", "flip_normals", "to_world_end"},
+    "mesh": {"vertices", "faces", "normals", "to_world", "face_normals", "flip_normals", "to_world_end"},
 }
+
+
+def _motion_end(start: np.ndarray, value: Any, key: str) -> np.ndarray:
+    """The transform ``value`` at shutter_close of something whose
+    transform at shutter_open is ``start``: a 4×4 affine map, invertible,
+    and mirroring exactly when ``start`` does (so a rotation takes one to
+    the other)."""
+    end = _matrix(value, key)
+    if not np.allclose(end[3], [0, 0, 0, 1]):
+        raise ValueError(f"{key}: the last row must be (0, 0, 0, 1) (an affine transform)")
+    det0, det1 = np.linalg.det(start[:3, :3]), np.linalg.det(end[:3, :3])
+    if det1 == 0 or det0 == 0:
+        raise ValueError(f"{key}: the transform is singular")
+    if (det0 < 0) != (det1 < 0):
+        raise ValueError(f"{key}: one end of the motion mirrors the shape and the other "
+                         "does not")
+    return end
 
 
 def _shape(d: Mapping[str, Any], key: str, refs: Mapping[str, Material]) -> ShapeRecord:
@@ -262,7 +296,16 @@ def _shape(d: Mapping[str, Any], key: str, refs: Mapping[str, Material]) -> Shap
         emission = _rgb(e.get("radiance", 1.0), f"{key}.emitter.radiance", emission=True)
     m = _matrix(d["to_world"], f"{key}.to_world") if "to_world" in d else None
     flip = bool(d.get("flip_normals", False))
-    rec = ShapeRecord(kind="mesh", material=material, emission=emission, flip_normals=flip)
+    rec = ShapeRecord(kind="mesh", material=material, emission=emission, flip_normals=flip,
+                      key=key)
+    if "to_world_end" in d:
+        start = m if m is not None else np.eye(4)
+        end = _motion_end(start, d["to_world_end"], f"{key}.to_world_end")
+        if emission is not None:
+            raise ValueError(f"{key}.to_world_end: a moving area light is not supported "
+                             "(only shapes that do not emit may move)")
+        if not np.array_equal(start, end):
+            rec.motion = (start, end)
     if kind == "sphere":
         center = np.asarray(d.get("center", [0.0, 0.0, 0.0]), dtype=np.float64).reshape(3)
         radius = _float(d.get("radius", 1.0), f"{key}.radius")
@@ -334,8 +377,8 @@ def _camera(d: Mapping[str, Any], key: str) -> Camera:
     # A pinhole ignores focus_distance (mi.cornell_box() gives one), as
     # Mitsuba does.
     lens = {"aperture_radius", "focus_distance"} if kind == "thinlens" else {"focus_distance"}
-    _check_keys(d, {"fov", "fov_axis", "to_world", "near_clip", "far_clip", "film", "sampler"}
-                | lens, key)
+    _check_keys(d, {"fov", "fov_axis", "to_world", "near_clip", "far_clip", "film", "sampler",
+                    "shutter_open", "shutter_close", "to_world_end"} | lens, key)
     if "fov" not in d:
         raise ValueError(f"{key}: give the field of view as 'fov' (degrees); "
                          "'focal_length' is not supported")
@@ -344,14 +387,23 @@ def _camera(d: Mapping[str, Any], key: str) -> Camera:
                  fov_axis=str(d.get("fov_axis", "x")),
                  near_clip=_float(d.get("near_clip", 1e-2), f"{key}.near_clip"),
                  far_clip=_float(d.get("far_clip", 1e4), f"{key}.far_clip"))
+    cam.shutter_open = _float(d.get("shutter_open", 0.0), f"{key}.shutter_open")
+    cam.shutter_close = _float(d.get("shutter_close", cam.shutter_open), f"{key}.shutter_close")
+    if not (np.isfinite(cam.shutter_open) and np.isfinite(cam.shutter_close)
+            and cam.shutter_close >= cam.shutter_open):
+        raise ValueError(f"{key}.shutter_close = {cam.shutter_close}: must be finite and >= "
+                         f"shutter_open = {cam.shutter_open}")
+    if "to_world_end" in d:
+        end = _motion_end(cam.to_world, d["to_world_end"], f"{key}.to_world_end")
+        if not np.array_equal(end, cam.to_world):
+            cam.to_world_end = end
     if kind == "thinlens":
         cam.aperture_radius = _float(d.get("aperture_radius", 0.03), f"{key}.aperture_radius")
         cam.focus_distance = _float(d.get("focus_distance", 0.0), f"{key}.focus_distance")
     film = d.get("film", {"type": "hdrfilm"})
     if film.get("type") != "hdrfilm":
         raise ValueError(f"{key}.film.type = {film.get('type')!r}: must be 'hdrfilm'")
-    # Keys that do not change the image: component_format float32 (the
-    # default storage), sample_border (it matters to wider filters only).
+    # component_format float32 is the default storage (others round).
     _check_keys(film, {"width", "height", "rfilter", "pixel_format", "component_format",
                        "sample_border"}, f"{key}.film")
     if film.get("component_format", "float32") != "float32":
@@ -359,10 +411,21 @@ def _camera(d: Mapping[str, Any], key: str) -> Camera:
                          "image)")
     cam.width = int(film.get("width", DEFAULT_WIDTH))
     cam.height = int(film.get("height", DEFAULT_HEIGHT))
-    rfilter = film.get("rfilter", {"type": "box"})
-    if rfilter.get("type") != "box" or set(rfilter) - {"type"}:
-        raise ValueError(f"{key}.film.rfilter: mcsample renders with a box filter only "
-                         "({'type': 'box'})")
+    # Mitsuba's default filter is its gaussian.
+    rfilter = film.get("rfilter", {"type": "gaussian"})
+    cam.rfilter = str(rfilter.get("type"))
+    if cam.rfilter == "gaussian":
+        _check_keys(rfilter, {"stddev"}, f"{key}.film.rfilter")
+        cam.stddev = _float(rfilter.get("stddev", 0.5), f"{key}.film.rfilter.stddev")
+        if not 0 < cam.stddev <= 64:
+            raise ValueError(f"{key}.film.rfilter.stddev = {cam.stddev}: must lie in (0, 64] "
+                             "pixels")
+    elif cam.rfilter == "box":
+        _check_keys(rfilter, set(), f"{key}.film.rfilter")
+    else:
+        raise ValueError(f"{key}.film.rfilter.type = {cam.rfilter!r}: must be 'gaussian' or "
+                         "'box'")
+    cam.sample_border = bool(film.get("sample_border", False))
     if film.get("pixel_format", "rgb") not in ("rgb", "rgba"):
         raise ValueError(f"{key}.film.pixel_format must be 'rgb' or 'rgba'")
     sampler = d.get("sampler")

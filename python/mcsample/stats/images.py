@@ -111,8 +111,45 @@ def _as_image(x: Any, name: str) -> np.ndarray:
     return a
 
 
+def _region_variance(var: np.ndarray, runs: np.ndarray | None, mask: np.ndarray,
+                     block: int) -> tuple[float, np.ndarray, float]:
+    """The variance of one side's whole-image sum and of each block's sum,
+    and its degrees of freedom: from the pixel variances (independent
+    pixels; exact, infinite degrees) or, given ``runs`` (R, H, W) of
+    independent renders whose mean is the image, from the spread of the
+    runs' sums over R (right also when neighbouring pixels share samples,
+    as under a splatting filter; R − 1 degrees)."""
+    if runs is None:
+        return float(np.where(mask, var, 0.0).sum()), _block_sums(np.where(mask, var, 0.0),
+                                                                   block), np.inf
+    r = np.where(mask, runs, 0.0)
+    n = r.shape[0]
+    whole = float(r.sum(axis=(1, 2)).var(ddof=1) / n)
+    blocks = np.stack([_block_sums(x, block) for x in r]).var(axis=0, ddof=1) / n
+    return whole, blocks, float(n - 1)
+
+
+def _normal_equivalent(z: np.ndarray, va: Any, vb: Any, dof_a: float,
+                       dof_b: float) -> np.ndarray:
+    """``z`` of a difference whose variance ``va + vb`` is estimated with
+    ``dof_a`` and ``dof_b`` degrees of freedom, mapped to the normal z of
+    the same tail probability (Student's t with Welch–Satterthwaite's
+    degrees; unchanged when both are exact)."""
+    if np.isinf(dof_a) and np.isinf(dof_b):
+        return z
+    from scipy.special import ndtri
+    from scipy.stats import t as student
+
+    va, vb = np.asarray(va, dtype=np.float64), np.asarray(vb, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dof = (va + vb) ** 2 / (va**2 / dof_a + vb**2 / dof_b)
+        return np.sign(z) * -ndtri(student.sf(np.abs(z), np.where(np.isfinite(dof), dof,
+                                                                     1e9)))
+
+
 def image_ztest(a: Any, var_a: Any, b: Any, var_b: Any, *, block: int = 8,
-                alpha: float = 1e-3, tested: Any = None) -> ZTestResult:
+                alpha: float = 1e-3, tested: Any = None, runs_a: Any = None,
+                runs_b: Any = None) -> ZTestResult:
     """Whether two independent estimates of the same image agree, by z-tests
     of the whole image and of blocks of pixels.
 
@@ -133,6 +170,14 @@ def image_ztest(a: Any, var_a: Any, b: Any, var_b: Any, *, block: int = 8,
 
     ``tested`` (a boolean image) limits the z-tests to some pixels (the
     others count as equal); by default all.
+
+    ``runs_a`` / ``runs_b`` (R, H, W): independent renders whose mean is
+    ``a`` / ``b``, for an image whose neighbouring pixels are correlated
+    (Mitsuba's splatting filters): the variances of the whole image and of
+    each block then come from the spread of the runs' sums (R − 1 degrees
+    of freedom; each z is converted to the normal z of the same Student-t
+    tail probability, Welch–Satterthwaite's degrees), not from the pixel
+    variances, whose sum ignores the covariances.
     """
     from scipy.special import ndtri
 
@@ -155,24 +200,39 @@ def image_ztest(a: Any, var_a: Any, b: Any, var_b: Any, *, block: int = 8,
         if not np.all(np.isfinite(arr[mask])):
             raise ValueError(f"{name} is infinite (a one-sample pixel has no variance: "
                              "render with spp >= 2)")
+    runs = []
+    for name, r, image in (("runs_a", runs_a, a), ("runs_b", runs_b, b)):
+        if r is not None:
+            r = np.asarray(r, dtype=np.float64)
+            if r.ndim != 3 or r.shape[1:] != image.shape or r.shape[0] < 2:
+                raise ValueError(f"{name} must be (R, H, W) with R >= 2 renders of the image's "
+                                 f"shape {image.shape}, got {r.shape}")
+            if not np.all(np.isfinite(r)):
+                raise ValueError(f"{name} has NaN or infinite values")
+        runs.append(r)
     diff = np.where(mask, a - b, 0.0)
     var = np.where(mask, va + vb, 0.0)
     if not var.sum() > 0:
         raise ValueError("no tested pixel has noise: nothing to z-test")
     with np.errstate(divide="ignore", invalid="ignore"):
         z = np.where(var > 0, diff / np.sqrt(var), 0.0)
-    mean_z = float(diff.sum() / np.sqrt(var.sum()))
     block = int(block)
-    block_diff, block_var = _block_sums(diff, block), _block_sums(var, block)
+    (whole_a, blocks_a, dof_a), (whole_b, blocks_b, dof_b) = (
+        _region_variance(v, r, mask, block) for v, r in ((va, runs[0]), (vb, runs[1])))
+    mean_z = float(_normal_equivalent(np.array(diff.sum() / np.sqrt(whole_a + whole_b)),
+                                      whole_a, whole_b, dof_a, dof_b))
+    block_diff, block_var = _block_sums(diff, block), blocks_a + blocks_b
     with np.errstate(divide="ignore", invalid="ignore"):
         block_z = np.where(block_var > 0, block_diff / np.sqrt(block_var), np.nan)
+    block_z = _normal_equivalent(block_z, blocks_a, blocks_b, dof_a, dof_b)
     tests = 1 + int(np.count_nonzero(np.isfinite(block_z)))
     per_test = 1.0 - (1.0 - alpha) ** (1.0 / tests)
     threshold = float(-ndtri(per_test / 2))
     worst = float(np.nanmax(np.abs(block_z)))
     ref_mean = float(b.mean())
     relative = float(a.mean() / ref_mean - 1.0) if ref_mean != 0 else float("nan")
-    relative_se = float(np.sqrt(var.sum()) / b.size / abs(ref_mean)) if ref_mean else float("nan")
+    relative_se = (float(np.sqrt(whole_a + whole_b) / b.size / abs(ref_mean)) if ref_mean
+                   else float("nan"))
     messages = [
         f"whole image: z = {mean_z:.3g} (means {a.mean():.6g} and {ref_mean:.6g}, "
         f"relative difference {relative:+.3%} ± {relative_se:.3%})",
@@ -201,6 +261,10 @@ def render_ztest(image: Any, reference: Any, *, block: int = 8, alpha: float = 1
     :class:`mcsample.RenderResult` and
     :func:`mcsample.mitsuba.render_reference` return.
 
+    A render with ``.runs`` (a Mitsuba reference of a splatting filter,
+    :func:`mcsample.mitsuba.render_reference`) takes its region variances
+    from them (see :func:`image_ztest`'s ``runs_a``).
+
     Pixels whose relative standard error is below ``noise_free`` on both
     sides (e.g. directly seen sky, smooth over a pixel) are deterministic up
     to float32 rounding, which then dominates a variance estimated as
@@ -208,6 +272,7 @@ def render_ztest(image: Any, reference: Any, *, block: int = 8, alpha: float = 1
     instead of entering the z-tests.
     """
     a, b = (np.asarray(x.luminance, dtype=np.float64) for x in (image, reference))
+    runs = [getattr(x, "runs", None) for x in (image, reference)]
     va, vb = (np.asarray(x.luminance_variance, dtype=np.float64) for x in (image, reference))
     if a.shape != b.shape:
         raise ValueError(f"image shape {a.shape} differs from reference shape {b.shape}")
@@ -216,7 +281,8 @@ def render_ztest(image: Any, reference: Any, *, block: int = 8, alpha: float = 1
         noisy = (np.sqrt(va) > noise_free * scale) | (np.sqrt(vb) > noise_free * scale)
     if not noisy.any():
         raise ValueError("no pixel of either render has noise: nothing to z-test")
-    t = image_ztest(a, va, b, vb, block=block, alpha=alpha, tested=noisy)
+    t = image_ztest(a, va, b, vb, block=block, alpha=alpha, tested=noisy, runs_a=runs[0],
+                    runs_b=runs[1])
     quiet = int(np.count_nonzero(~noisy))
     t.messages.insert(2, f"{quiet} noise-free pixels compared with rtol {rtol:g}")
     if not np.allclose(a[~noisy], b[~noisy], rtol=rtol, atol=1e-6):

@@ -1,0 +1,164 @@
+//! Motion blur: a transform that changes during the shutter interval.
+//!
+//! A moving shape or camera has its transform `M₀` at `shutter_open` and
+//! `M₁` at `shutter_close`; at the normalised time `τ ∈ [0, 1]` between
+//! them it is `M(τ) = T(τ) R(τ) S(τ)`, with each of `M₀`, `M₁` split into a
+//! translation `T`, a rotation `R` and a symmetric stretch `S` (the polar
+//! decomposition of the linear part, `A = R S`), `T` and `S` interpolated
+//! linearly and `R` by spherical linear interpolation of its quaternion
+//! (as pbrt's animated transforms). A map that reflects (`det A < 0`) is
+//! split as `A = (−R)(−S)`, so that `−R` is a rotation; both ends must then
+//! reflect.
+
+use glam::{DAffine3, DMat3, DQuat, DVec3};
+
+use crate::error::{Error, Result};
+
+/// An affine map as translation, rotation and stretch.
+#[derive(Clone, Copy, Debug)]
+struct Parts {
+    translation: DVec3,
+    rotation: DQuat,
+    stretch: DMat3,
+    /// Whether the linear part is `−R S` (the map reflects).
+    reflects: bool,
+}
+
+impl Parts {
+    /// The parts of `m`, or `None` when its linear part is singular (or
+    /// not finite).
+    fn new(m: DAffine3) -> Option<Self> {
+        let det = m.matrix3.determinant();
+        if !(det.is_finite() && det != 0.0) {
+            return None;
+        }
+        let reflects = det < 0.0;
+        let a = if reflects { -m.matrix3 } else { m.matrix3 };
+        // Polar decomposition by Newton's iteration `R ← (R + R⁻ᵀ)/2`,
+        // which converges quadratically to the rotation nearest to `a`.
+        let mut r = a;
+        for _ in 0..100 {
+            let next = (r + r.inverse().transpose()) * 0.5;
+            let change = (next - r)
+                .to_cols_array()
+                .iter()
+                .map(|v| v.abs())
+                .sum::<f64>();
+            r = next;
+            if change < 1e-15 {
+                break;
+            }
+        }
+        Some(Parts {
+            translation: m.translation,
+            rotation: DQuat::from_mat3(&r).normalize(),
+            stretch: r.transpose() * a,
+            reflects,
+        })
+    }
+}
+
+/// A transform moving from `start` (at `τ = 0`) to `end` (at `τ = 1`).
+#[derive(Clone, Copy, Debug)]
+pub struct Motion {
+    start: Parts,
+    end: Parts,
+}
+
+impl Motion {
+    /// The motion from `start` to `end`.
+    ///
+    /// # Errors
+    /// [`Error::Argument`] naming `arg` when either map is singular, or
+    /// when one reflects and the other does not (no rotation turns one
+    /// into the other).
+    pub fn new(arg: &'static str, start: DAffine3, end: DAffine3) -> Result<Self> {
+        let (Some(s), Some(e)) = (Parts::new(start), Parts::new(end)) else {
+            return Err(Error::Argument {
+                arg,
+                message: format!("{arg}: a transform at either end of the shutter is singular"),
+            });
+        };
+        if s.reflects != e.reflects {
+            return Err(Error::Argument {
+                arg,
+                message: format!(
+                    "{arg}: one end of the motion mirrors the shape and the other does not"
+                ),
+            });
+        }
+        Ok(Motion { start: s, end: e })
+    }
+
+    /// `M(τ) = T(τ) R(τ) S(τ)`.
+    pub fn at(&self, tau: f64) -> DAffine3 {
+        let (a, b) = (&self.start, &self.end);
+        let rotation = DMat3::from_quat(a.rotation.slerp(b.rotation, tau));
+        let stretch = a.stretch * (1.0 - tau) + b.stretch * tau;
+        let linear = rotation * stretch;
+        DAffine3 {
+            matrix3: if a.reflects { -linear } else { linear },
+            translation: a.translation.lerp(b.translation, tau),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: DAffine3, b: DAffine3) -> bool {
+        a.abs_diff_eq(b, 1e-12)
+    }
+
+    #[test]
+    fn ends_are_the_given_maps() {
+        let start = DAffine3::from_scale_rotation_translation(
+            DVec3::new(1.0, 2.0, 0.5),
+            DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7),
+            DVec3::new(1.0, -2.0, 3.0),
+        );
+        let end = DAffine3::from_cols_array(&[
+            0.3, 0.1, -0.2, 0.0, 1.5, 0.4, 0.2, -0.1, 2.0, 5.0, 6.0, 7.0,
+        ]);
+        let m = Motion::new("to_world_end", start, end).unwrap();
+        assert!(close(m.at(0.0), start), "{:?}", m.at(0.0));
+        assert!(close(m.at(1.0), end), "{:?}", m.at(1.0));
+        // A mirror at both ends.
+        let flip = DAffine3::from_scale(DVec3::new(-1.0, 1.0, 1.0));
+        let m = Motion::new("m", flip, flip * start).unwrap();
+        assert!(close(m.at(0.0), flip) && close(m.at(1.0), flip * start));
+    }
+
+    #[test]
+    fn rotation_by_slerp_translation_and_scale_linearly() {
+        let start = DAffine3::from_scale(DVec3::splat(1.0));
+        let end = DAffine3::from_scale_rotation_translation(
+            DVec3::splat(3.0),
+            DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2),
+            DVec3::new(2.0, 0.0, 0.0),
+        );
+        let m = Motion::new("m", start, end).unwrap();
+        let half = DAffine3::from_scale_rotation_translation(
+            DVec3::splat(2.0),
+            DQuat::from_rotation_z(std::f64::consts::FRAC_PI_4),
+            DVec3::new(1.0, 0.0, 0.0),
+        );
+        assert!(close(m.at(0.5), half), "{:?}", m.at(0.5));
+        // A point on the x axis turns on a circle as it grows (not along
+        // the chord, as interpolating the matrices would).
+        let p = m.at(0.25).transform_point3(DVec3::X);
+        let angle = p.y.atan2(p.x - 0.5);
+        assert!((angle - std::f64::consts::PI / 8.0).abs() < 1e-12, "{p}");
+    }
+
+    #[test]
+    fn singular_and_mirror_to_rotation_refused() {
+        let id = DAffine3::IDENTITY;
+        let flat = DAffine3::from_scale(DVec3::new(1.0, 0.0, 1.0));
+        assert!(Motion::new("to_world_end", id, flat).is_err());
+        let mirror = DAffine3::from_scale(DVec3::new(-1.0, 1.0, 1.0));
+        let e = Motion::new("to_world_end", id, mirror).unwrap_err();
+        assert!(e.to_string().contains("mirrors"), "{e}");
+    }
+}
