@@ -96,7 +96,7 @@ def render(scene: Scene, spp: int | None = None, *,
         nets, ordered along a Morton curve over the screen: blue-noise
         error; best with power-of-two spp).
         Every random decision has its own dimension, in this order: film
-        position (2), lens (2), time (1, reserved), then per shading point
+        position (2), lens (2), time (1, drawn only when something moves), then per shading point
         BSDF lobe (1), BSDF direction (2), light choice (1), light position
         (2), Russian roulette (1).
         Under these samplers a pixel's samples are not independent, and

@@ -8,9 +8,13 @@
 //! linearly and `R` by spherical linear interpolation of its quaternion
 //! (as pbrt's animated transforms). A map that reflects (`det A < 0`) is
 //! split as `A = (−R)(−S)`, so that `−R` is a rotation; both ends must then
-//! reflect.
+//! reflect. A moving shape is traced in a BVH of its own ([`Mover`]).
 
-use glam::{DAffine3, DMat3, DQuat, DVec3};
+use glam::{Affine3A, DAffine3, DMat3, DQuat, DVec3, Vec3A};
+
+use super::accel::{Accel, Hit};
+use super::geometry::affine_f32;
+use super::shape::{Ray, SurfacePoint};
 
 use crate::error::{Error, Result};
 
@@ -25,8 +29,9 @@ struct Parts {
 }
 
 impl Parts {
-    /// The parts of `m`, or `None` when its linear part is singular (or
-    /// not finite).
+    /// The parts of `m`, or `None` when its linear part is singular, not
+    /// finite, or too far from a rotation for the iteration to converge in
+    /// 100 steps (scales beyond about 2^±90).
     fn new(m: DAffine3) -> Option<Self> {
         let det = m.matrix3.determinant();
         if !(det.is_finite() && det != 0.0) {
@@ -37,6 +42,7 @@ impl Parts {
         // Polar decomposition by Newton's iteration `R ← (R + R⁻ᵀ)/2`,
         // which converges quadratically to the rotation nearest to `a`.
         let mut r = a;
+        let mut converged = false;
         for _ in 0..100 {
             let next = (r + r.inverse().transpose()) * 0.5;
             let change = (next - r)
@@ -45,9 +51,14 @@ impl Parts {
                 .map(|v| v.abs())
                 .sum::<f64>();
             r = next;
-            if change < 1e-15 {
+            if change < 1e-12 {
+                converged = true;
                 break;
             }
+        }
+        // Scales beyond about 2^±90 need more steps: refused as singular.
+        if !converged {
+            return None;
         }
         Some(Parts {
             translation: m.translation,
@@ -69,9 +80,9 @@ impl Motion {
     /// The motion from `start` to `end`.
     ///
     /// # Errors
-    /// [`Error::Argument`] naming `arg` when either map is singular, or
-    /// when one reflects and the other does not (no rotation turns one
-    /// into the other).
+    /// [`Error::Argument`] naming `arg` when either map is singular (or
+    /// scales by more than about 2^±90), or when one reflects and the
+    /// other does not (no rotation turns one into the other).
     pub fn new(arg: &'static str, start: DAffine3, end: DAffine3) -> Result<Self> {
         let (Some(s), Some(e)) = (Parts::new(start), Parts::new(end)) else {
             return Err(Error::Argument {
@@ -100,6 +111,103 @@ impl Motion {
             matrix3: if a.reflects { -linear } else { linear },
             translation: a.translation.lerp(b.translation, tau),
         }
+    }
+}
+
+/// A shape that moves during the shutter, traced in a BVH of its own: its
+/// primitives where they are at `shutter_open` (transform `M₀`), met by the
+/// ray mapped through `D(τ)⁻¹`, with `D(τ) = M(τ) M₀⁻¹` taking them to
+/// where they are at time `τ`. The direction is mapped without
+/// renormalising, so distances along the ray are the same in both frames;
+/// normals go back through the inverse transpose of `D(τ)`.
+pub struct Mover {
+    accel: Accel,
+    motion: Motion,
+    start_inverse: DAffine3,
+    /// The number of its first primitive in the scene's [`Hit`]s: they
+    /// follow the still shapes' and those of the moving shapes before it.
+    first: u32,
+}
+
+impl Mover {
+    /// The shape of primitives `accel` (where they are at `shutter_open`)
+    /// moving by `motion`.
+    pub fn new(accel: Accel, motion: Motion) -> Self {
+        Mover {
+            accel,
+            motion,
+            start_inverse: motion.at(0.0).inverse(),
+            first: 0,
+        }
+    }
+
+    /// Numbers its primitives from `first` in the scene's hits; returns the
+    /// number after its last.
+    pub fn number_from(&mut self, first: u32) -> u32 {
+        self.first = first;
+        first + self.accel.primitives().len() as u32
+    }
+
+    /// The number of its first primitive.
+    pub fn first(&self) -> u32 {
+        self.first
+    }
+
+    /// `D(τ)` and `D(τ)⁻¹`.
+    #[inline]
+    fn relative(&self, tau: f32) -> (Affine3A, Affine3A) {
+        let d = self.motion.at(f64::from(tau)) * self.start_inverse;
+        (affine_f32(d), affine_f32(d.inverse()))
+    }
+
+    /// `ray` in the frame of the shape's `shutter_open` position.
+    #[inline]
+    fn local(ray: &Ray, inverse: &Affine3A) -> Ray {
+        Ray {
+            o: inverse.transform_point3a(ray.o),
+            d: inverse.transform_vector3a(ray.d),
+            tmax: ray.tmax,
+        }
+    }
+
+    /// Its hit at time `tau` if nearer than `best`, else `best`.
+    pub fn intersect(&self, ray: &Ray, tau: f32, best: Option<Hit>) -> Option<Hit> {
+        let mut local = Self::local(ray, &self.relative(tau).1);
+        if let Some(h) = best {
+            local.tmax = h.t;
+        }
+        match self.accel.intersect(&local) {
+            Some(h) => Some(Hit {
+                primitive: self.first + h.primitive,
+                ..h
+            }),
+            None => best,
+        }
+    }
+
+    /// Whether it lies on `ray` at time `tau`.
+    pub fn occludes(&self, ray: &Ray, tau: f32) -> bool {
+        self.accel
+            .occluded(&Self::local(ray, &self.relative(tau).1))
+    }
+
+    /// Its shape and surface point at `hit` (one of its own, found at time
+    /// `tau`).
+    pub fn surface(&self, ray: &Ray, hit: &Hit, tau: f32) -> (u32, SurfacePoint) {
+        let own = hit.primitive - self.first;
+        let (forward, inverse) = self.relative(tau);
+        let local = Self::local(ray, &inverse);
+        let primitive = &self.accel.primitives()[own as usize];
+        let sp = primitive.point(local.o + local.d * hit.t, hit.bary);
+        let normal = |n: Vec3A| (inverse.matrix3.transpose() * n).normalize();
+        (
+            self.accel.shape_of(own),
+            SurfacePoint {
+                p: forward.transform_point3a(sp.p),
+                ng: normal(sp.ng),
+                ns: normal(sp.ns),
+            },
+        )
     }
 }
 
@@ -157,6 +265,8 @@ mod tests {
         let id = DAffine3::IDENTITY;
         let flat = DAffine3::from_scale(DVec3::new(1.0, 0.0, 1.0));
         assert!(Motion::new("to_world_end", id, flat).is_err());
+        let huge = DAffine3::from_scale(DVec3::new(1e40, 1.0, 1.0));
+        assert!(Motion::new("to_world_end", id, huge).is_err());
         let mirror = DAffine3::from_scale(DVec3::new(-1.0, 1.0, 1.0));
         let e = Motion::new("to_world_end", id, mirror).unwrap_err();
         assert!(e.to_string().contains("mirrors"), "{e}");

@@ -2,17 +2,16 @@
 //! environment, the camera and the film size; and its lights, chosen by
 //! power for emitter sampling.
 
-use glam::{Affine3A, DAffine3, Vec3A};
+use glam::Vec3A;
 use std::sync::Arc;
 
 use super::accel::Hit;
 use super::accel::{Accel, Primitive};
 use super::camera::Camera;
 use super::filter::{FilmFilter, Filter};
-use super::geometry::affine_f32;
 use super::geometry::check_primitives;
 pub use super::geometry::{Geometry, MAX_PRIMITIVES, affine, daffine};
-use super::motion::Motion;
+use super::motion::{Motion, Mover};
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
 use crate::distr::Discrete1D;
@@ -48,45 +47,12 @@ pub struct Shape {
     pub motion: Option<Motion>,
 }
 
-/// A shape that moves during the shutter, traced in a BVH of its own: its
-/// primitives where they are at `shutter_open` (transform `M₀`), met by the
-/// ray mapped through `D(τ)⁻¹`, with `D(τ) = M(τ) M₀⁻¹` taking them to
-/// where they are at time `τ`. The direction is mapped without
-/// renormalising, so distances along the ray are the same in both frames.
-struct Mover {
-    accel: Accel,
-    motion: Motion,
-    start_inverse: DAffine3,
-    /// The number of its first primitive in the scene's [`Hit`]s: they
-    /// follow the still shapes' and those of the moving shapes before it.
-    first: u32,
-}
-
 /// The primitives of a shape's geometry.
 fn primitives_of(geometry: Geometry) -> Box<dyn ExactSizeIterator<Item = Primitive>> {
     match geometry {
         Geometry::Mesh(tris) => Box::new(tris.into_iter().map(Primitive::Triangle)),
         Geometry::Sphere(s) => Box::new(std::iter::once(Primitive::Sphere(s))),
         Geometry::Disk(d) => Box::new(std::iter::once(Primitive::Disk(d))),
-    }
-}
-
-impl Mover {
-    /// `D(τ)` and `D(τ)⁻¹`.
-    #[inline]
-    fn relative(&self, tau: f32) -> (Affine3A, Affine3A) {
-        let d = self.motion.at(f64::from(tau)) * self.start_inverse;
-        (affine_f32(d), affine_f32(d.inverse()))
-    }
-
-    /// `ray` in the frame of the shape's `shutter_open` position.
-    #[inline]
-    fn local(ray: &Ray, inverse: &Affine3A) -> Ray {
-        Ray {
-            o: inverse.transform_point3a(ray.o),
-            d: inverse.transform_vector3a(ray.d),
-            tmax: ray.tmax,
-        }
     }
 }
 
@@ -235,7 +201,8 @@ pub struct Scene {
 impl Scene {
     /// Builds the BVH and the light selection (by power: `π A Y(L)` for an
     /// area light, `π R² ∫ Y(L) dω` for the environment, R the radius of the
-    /// scene's bounding sphere).
+    /// bounding sphere of the shapes that do not move: the choice need not
+    /// follow the powers exactly).
     ///
     /// # Errors
     /// [`Error::Parameter`] for a film of zero pixels.
@@ -274,15 +241,13 @@ impl Scene {
                         ),
                     });
                 }
-                movers.push(Mover {
-                    accel: Accel::new(alloc::collect(
+                movers.push(Mover::new(
+                    Accel::new(alloc::collect(
                         primitives_of(shape.geometry).map(|p| (p, id)),
                         "a moving shape's primitives",
                     )?)?,
                     motion,
-                    start_inverse: motion.at(0.0).inverse(),
-                    first: 0,
-                });
+                ));
                 materials.push(shape.material);
                 emission.push(None);
                 light_of_shape.push(None);
@@ -319,16 +284,10 @@ impl Scene {
             }
         }
         let accel = Accel::new(primitives)?;
+        // At most MAX_PRIMITIVES in all (check_primitives above).
         let mut first = accel.primitives().len() as u32;
         for mover in &mut movers {
-            mover.first = first;
-            first = first
-                .checked_add(mover.accel.primitives().len() as u32)
-                .ok_or(Error::TooLarge {
-                    arg: "shapes",
-                    len: u32::MAX as usize + 1,
-                    max: u32::MAX as usize,
-                })?;
+            first = mover.number_from(first);
         }
         let radius = accel
             .bounds()
@@ -388,20 +347,10 @@ impl Scene {
     /// [`Scene::intersect`] among the moving shapes, given the `best` hit
     /// so far.
     #[inline(never)]
-    fn intersect_movers(&self, ray: &Ray, tau: f32, mut best: Option<Hit>) -> Option<Hit> {
-        for mover in &self.movers {
-            let mut local = Mover::local(ray, &mover.relative(tau).1);
-            if let Some(h) = best {
-                local.tmax = h.t;
-            }
-            if let Some(h) = mover.accel.intersect(&local) {
-                best = Some(Hit {
-                    primitive: mover.first + h.primitive,
-                    ..h
-                });
-            }
-        }
-        best
+    fn intersect_movers(&self, ray: &Ray, tau: f32, best: Option<Hit>) -> Option<Hit> {
+        self.movers
+            .iter()
+            .fold(best, |best, m| m.intersect(ray, tau, best))
     }
 
     /// Whether anything lies on `ray` in `(0, ray.tmax)` at time `tau`.
@@ -413,9 +362,7 @@ impl Scene {
     /// Whether a moving shape lies on `ray` at time `tau`.
     #[inline(never)]
     fn movers_occlude(&self, ray: &Ray, tau: f32) -> bool {
-        self.movers
-            .iter()
-            .any(|m| m.accel.occluded(&Mover::local(ray, &m.relative(tau).1)))
+        self.movers.iter().any(|m| m.occludes(ray, tau))
     }
 
     /// The shape `ray` meets at `hit` (found by [`Scene::intersect`] at
@@ -436,22 +383,8 @@ impl Scene {
     /// [`Scene::surface`] of a hit on a moving shape.
     #[inline(never)]
     fn moving_surface(&self, ray: &Ray, hit: &Hit, tau: f32) -> (u32, SurfacePoint) {
-        let k = self.movers.partition_point(|m| m.first <= hit.primitive) - 1;
-        let mover = &self.movers[k];
-        let own = hit.primitive - mover.first;
-        let (forward, inverse) = mover.relative(tau);
-        let local = Mover::local(ray, &inverse);
-        let primitive = &mover.accel.primitives()[own as usize];
-        let sp = primitive.point(local.o + local.d * hit.t, hit.bary);
-        let normal = |n: Vec3A| (inverse.matrix3.transpose() * n).normalize();
-        (
-            mover.accel.shape_of(own),
-            SurfacePoint {
-                p: forward.transform_point3a(sp.p),
-                ng: normal(sp.ng),
-                ns: normal(sp.ns),
-            },
-        )
+        let k = self.movers.partition_point(|m| m.first() <= hit.primitive) - 1;
+        self.movers[k].surface(ray, hit, tau)
     }
 
     /// The scene with the film's reconstruction `filter` (the box filter
@@ -480,7 +413,8 @@ impl Scene {
         &self.camera
     }
 
-    /// The ray tracer.
+    /// The BVH of the shapes that do not move (the moving shapes have
+    /// their own: [`Scene::intersect`] traces both).
     pub fn accel(&self) -> &Accel {
         &self.accel
     }

@@ -1,5 +1,5 @@
 """An :class:`mcsample.Scene` as a Mitsuba 3 scene dict: the same camera,
-film (box filter), shapes, materials (mcsample's Phong as the
+film (its box or gaussian filter), shapes, materials (mcsample's Phong as the
 ``mcsample_phong`` plugin) and lights. Meshes go in as ``mi.Mesh`` objects
 built in memory (no files); a non-lat-long envmap is converted to lat-long,
 the only form Mitsuba's envmap emitter takes."""
@@ -66,8 +66,6 @@ def scene_dict(scene: "Scene", spp: int | None = None,
     the sampler's ``sample_count`` (default: the scene's, else 4);
     ``latlong_width`` the columns of a converted envmap (default 4× the
     source's resolution)."""
-    import mitsuba as mi
-
     c = scene.camera
     if c.shutter_close > c.shutter_open:
         moving = [s.key for s in scene.shapes if s.motion is not None]
@@ -76,6 +74,8 @@ def scene_dict(scene: "Scene", spp: int | None = None,
         if moving:
             raise ValueError(f"{moving[0]}: it moves during the shutter (to_world_end), and "
                              "Mitsuba 3.9 has no motion blur")
+    import mitsuba as mi
+
     phong_type = register_phong()
     sensor: dict[str, Any] = {
         "type": "thinlens" if c.aperture_radius > 0 else "perspective",

@@ -39,7 +39,9 @@ def render_reference(scene: "Scene", spp: int, *, seed: SeedLike = 0,
     ``ceil(spp / 16)`` samples instead: their mean is the image, each
     pixel's luminance variance comes from their spread, and their
     luminances are kept as ``.runs`` for region variances
-    (:func:`mcsample.stats.render_ztest`). ``integrator``,
+    (:func:`mcsample.stats.render_ztest`). Each run's pixels are Mitsuba's
+    ratio of splatted sums, biased by O(1 / its spp): keep ``spp / 16`` at
+    16 or more where the bias matters. ``integrator``,
     ``max_depth``, ``rr_depth`` and ``hide_emitters`` default to the scene
     dict's integrator, as in :func:`mcsample.render`; ``seed`` is taken as
     there (and reduced to Mitsuba's 32 bits). ``sampler`` is Mitsuba's
@@ -102,6 +104,8 @@ def render_runs(mi_scene: Any, spp: int, *, runs: int = RUNS, seed: SeedLike = 0
 
     if int(runs) < 2:
         raise ValueError(f"runs = {runs}: must be >= 2")
+    if int(spp) < 1:
+        raise ValueError(f"spp = {spp}: must be >= 1")
     base = resolve_seed(seed)
     start = time.perf_counter()
     images = np.stack([np.asarray(mi.render(mi_scene, spp=int(spp),

@@ -26,8 +26,8 @@ The subset (anything else raises ValueError naming the key):
 - sensors: ``perspective`` (fov, fov_axis, near_clip, far_clip, to_world;
   focus_distance accepted and ignored, as Mitsuba does) and ``thinlens``
   (also aperture_radius, focus_distance), shutter_open / shutter_close (the
-  interval over which each sample's time is drawn; equal, the default: no
-  motion blur) and ``to_world_end`` (a moving camera), with an ``hdrfilm`` (width,
+  interval over which each sample's time is drawn; both 0 by default, as
+  Mitsuba's; equal: no motion blur) and ``to_world_end`` (a moving camera), with an ``hdrfilm`` (width,
   height, ``rfilter``: ``gaussian`` (stddev; Mitsuba's default, also when
   ``rfilter`` is absent) or ``box``, sample_border; pixel_format and
   component_format "float32" accepted) and a sampler:

@@ -270,7 +270,9 @@ def _motion_end(start: np.ndarray, value: Any, key: str) -> np.ndarray:
     if not np.allclose(end[3], [0, 0, 0, 1]):
         raise ValueError(f"{key}: the last row must be (0, 0, 0, 1) (an affine transform)")
     det0, det1 = np.linalg.det(start[:3, :3]), np.linalg.det(end[:3, :3])
-    if det1 == 0 or det0 == 0:
+    if det0 == 0:
+        raise ValueError(f"{key}: the transform at shutter_open (to_world) is singular")
+    if det1 == 0:
         raise ValueError(f"{key}: the transform is singular")
     if (det0 < 0) != (det1 < 0):
         raise ValueError(f"{key}: one end of the motion mirrors the shape and the other "
@@ -304,6 +306,10 @@ def _shape(d: Mapping[str, Any], key: str, refs: Mapping[str, Material]) -> Shap
         if emission is not None:
             raise ValueError(f"{key}.to_world_end: a moving area light is not supported "
                              "(only shapes that do not emit may move)")
+        if kind == "sphere":
+            scales = np.linalg.norm(end[:3, :3], axis=0)
+            if not np.allclose(scales, scales[0], rtol=1e-5):
+                raise ValueError(f"{key}.to_world_end: a sphere takes a uniform scale only")
         if not np.array_equal(start, end):
             rec.motion = (start, end)
     if kind == "sphere":
@@ -388,7 +394,7 @@ def _camera(d: Mapping[str, Any], key: str) -> Camera:
                  near_clip=_float(d.get("near_clip", 1e-2), f"{key}.near_clip"),
                  far_clip=_float(d.get("far_clip", 1e4), f"{key}.far_clip"))
     cam.shutter_open = _float(d.get("shutter_open", 0.0), f"{key}.shutter_open")
-    cam.shutter_close = _float(d.get("shutter_close", cam.shutter_open), f"{key}.shutter_close")
+    cam.shutter_close = _float(d.get("shutter_close", 0.0), f"{key}.shutter_close")
     if not (np.isfinite(cam.shutter_open) and np.isfinite(cam.shutter_close)
             and cam.shutter_close >= cam.shutter_open):
         raise ValueError(f"{key}.shutter_close = {cam.shutter_close}: must be finite and >= "
