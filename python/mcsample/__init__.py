@@ -9,7 +9,7 @@ steradian on directions, +z normal) are in the README.
 from . import data, distr, estimators, io, mis, mitsuba, plot, qmc, stats, warp
 from . import distributed
 from .rendering import render
-from .results import EmitterSample, RenderResult
+from .results import EmitterSample, RenderResult, SensorSample
 from .scene import Scene, look_at
 from ._core import (
     EnvMap,
@@ -39,6 +39,7 @@ __all__ = [
     "EnvMap",
     "RenderResult",
     "Scene",
+    "SensorSample",
     "look_at",
     "render",
     "EnvSample",

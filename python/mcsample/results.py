@@ -12,7 +12,8 @@ from typing import Any, Iterable, Iterator
 
 import numpy as np
 
-__all__ = ["Chunk", "EmitterSample", "RenderResult", "Result", "TupleResult", "describe"]
+__all__ = ["Chunk", "EmitterSample", "RenderResult", "Result", "SensorSample", "TupleResult",
+           "describe"]
 
 
 def describe(value: Any) -> str:
@@ -178,6 +179,37 @@ class RenderResult(Result):
         from ._core.io import encode_png
 
         return encode_png(np.ascontiguousarray(self.image, dtype=np.float32))
+
+
+@dataclasses.dataclass(frozen=True, repr=False)
+class SensorSample(Result):
+    """Connections to the camera, from :meth:`mcsample.Scene.sample_sensor`
+    (as Mitsuba's ``sensor.sample_direction``).
+
+    Attributes
+    ----------
+    pixel : ndarray (N, 2)
+        Where the ray from the lens point through the point lands on the
+        film, in pixels (x right, y down; Mitsuba's ``uv``).
+    direction : ndarray (N, 3)
+        Unit vectors from the point toward the lens point.
+    distance : ndarray (N,)
+        Distance to the lens point.
+    pdf : ndarray (N,)
+        Density per steradian of the lens point seen from the point (1 for
+        a pinhole, a delta).
+    weight : ndarray (N,)
+        The importance the connection carries, ``1 / (A cos³θ d²)`` (``A``
+        the image's area at distance 1, ``θ`` the ray's angle to the
+        optical axis, ``d`` the distance); all fields 0 where the point is
+        outside the clip range or its ray misses the film.
+    """
+
+    pixel: np.ndarray
+    direction: np.ndarray
+    distance: np.ndarray
+    pdf: np.ndarray
+    weight: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True, repr=False)

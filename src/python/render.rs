@@ -300,6 +300,43 @@ impl PyScene {
         self.0.film()
     }
 
+    /// The camera seen from points ``x`` (N, 3) or (3,), as light tracing
+    /// connects to it (Mitsuba's ``sensor.sample_direction``), with
+    /// uniform ``u`` (N, 2) or (2,) placing the point on a thin lens's
+    /// aperture. Returns float64 (N, 8) or (8,): the film position in
+    /// pixels (2; x right, y down), the unit direction from ``x`` to the
+    /// lens point (3), the distance, the density per steradian of that
+    /// point (1 for a pinhole) and the importance weight; all 0 where
+    /// ``x`` is outside the clip range or the ray misses the film.
+    fn sample_sensor<'py>(
+        &self,
+        py: Python<'py>,
+        x: &Obj<'py>,
+        u: &Obj<'py>,
+    ) -> PyResult<Obj<'py>> {
+        let x = Points::<f64, 3>::extract(x, "x")?;
+        let u = Points::<f64, 2>::extract(u, "u")?;
+        let scene = &self.0;
+        let (width, height) = scene.film();
+        map_pair(py, (&x, Check::Finite), (&u, Check::Unit), |x, u| {
+            let x = Vec3A::from(x.map(|v| v as f32));
+            let s = scene.camera().sample_direction(x, u.map(|v| v as f32));
+            s.map_or([0.0; 8], |s| {
+                let [dx, dy, dz] = s.d.to_array().map(f64::from);
+                [
+                    f64::from(s.film[0]) * width as f64,
+                    f64::from(s.film[1]) * height as f64,
+                    dx,
+                    dy,
+                    dz,
+                    f64::from(s.dist),
+                    f64::from(s.pdf),
+                    f64::from(s.weight),
+                ]
+            })
+        })
+    }
+
     /// Emitter sampling, as the renderer's next-event estimation does it:
     /// from points ``x`` (N, 3) or (3,), with uniform numbers ``u`` (N, 3)
     /// or (3,) in [0, 1] (the light's choice, then two for the point or

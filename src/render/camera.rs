@@ -54,6 +54,31 @@ pub struct Camera {
     focus_distance: f32,
     /// How `to_world` changes during the shutter, for a moving camera.
     motion: Option<Motion>,
+    /// The inverse of `to_world` (at `shutter_open`).
+    to_local: Affine3A,
+}
+
+/// A connection from a point `x` to the camera, as Mitsuba's
+/// `Sensor::sample_direction` makes it: the lens point (the pinhole, or a
+/// point drawn uniformly on the aperture), where the ray from it through
+/// `x` lands on the film, and the camera's importance.
+#[derive(Clone, Copy, Debug)]
+pub struct SensorSample {
+    /// The film position in `[0, 1]²` (x right, y down).
+    pub film: [f32; 2],
+    /// Unit direction from `x` toward the lens point.
+    pub d: Vec3A,
+    /// Distance from `x` to the lens point.
+    pub dist: f32,
+    /// Density per steradian at `x` of the lens point: 1 for the pinhole
+    /// (a delta, Mitsuba's convention), `dist² / (π R² cos θ)` for a lens
+    /// of radius `R`, `θ` the angle of the ray to the optical axis.
+    pub pdf: f32,
+    /// The importance the connection carries, `1 / (A cos³θ dist²)` with
+    /// `A = 4 tan(fov_x/2) tan(fov_y/2)` the image's area at distance 1 (the
+    /// importance per unit solid angle, times the film's cosine, over the
+    /// lens point's density by area).
+    pub weight: f32,
 }
 
 /// The columns of an affine map as plain arrays.
@@ -122,6 +147,7 @@ impl Camera {
             FovAxis::Larger => t * w / h,
         };
         Ok(Camera {
+            to_local: to_world.inverse(),
             to_world: columns(to_world),
             tan_half: Vec2::new(tx as f32, (tx * h / w) as f32),
             near_clip: near_clip as f32,
@@ -151,6 +177,67 @@ impl Camera {
     /// Whether the camera moves during the shutter.
     pub fn moves(&self) -> bool {
         self.motion.is_some()
+    }
+
+    /// The film position in `[0, 1]²` of camera-space point `p` seen from
+    /// the pinhole: `v = p / p_z`, `x = (1 − v_x / tan(fov_x/2)) / 2`, and
+    /// likewise `y`; `None` outside the film.
+    fn film_of(&self, p: Vec3A) -> Option<[f32; 2]> {
+        let (vx, vy) = (p.x / p.z, p.y / p.z);
+        let film = [
+            0.5 * (1.0 - vx / self.tan_half.x),
+            0.5 * (1.0 - vy / self.tan_half.y),
+        ];
+        (p.z > 0.0 && film.iter().all(|f| (0.0..=1.0).contains(f))).then_some(film)
+    }
+
+    /// The connection from world point `x` to the camera (where it stands
+    /// at `shutter_open`), with `u` placing the point on a thin lens's
+    /// aperture (concentric disk); `None` when `x` lies outside the clip
+    /// range or the ray through it misses the film (Mitsuba's
+    /// `sample_direction` of `perspective` and `thinlens`).
+    pub fn sample_direction(&self, x: Vec3A, u: [f32; 2]) -> Option<SensorSample> {
+        let p = self.to_local.transform_point3a(x);
+        if !(p.z >= self.near_clip && p.z <= self.far_clip) {
+            return None;
+        }
+        let lens = if self.has_lens() {
+            let [a, b] = warp::square_to_uniform_disk_concentric(u);
+            Vec3A::new(a * self.aperture_radius, b * self.aperture_radius, 0.0)
+        } else {
+            Vec3A::ZERO
+        };
+        let to_x = p - lens;
+        let dist = to_x.length();
+        let local = to_x / dist;
+        let cos = local.z;
+        // Through the lens, the ray lands where its point on the focal plane
+        // is seen from the pinhole.
+        let film = if self.has_lens() {
+            let focus = lens + local * (self.focus_distance / cos);
+            if !(self.near_clip..=self.far_clip).contains(&self.focus_distance) {
+                return None;
+            }
+            self.film_of(focus)?
+        } else {
+            self.film_of(p)?
+        };
+        let area = 4.0 * self.tan_half.x * self.tan_half.y;
+        let m = &self.to_world;
+        let origin = Vec3A::from(m[3]);
+        let world_lens = origin + Vec3A::from(m[0]) * lens.x + Vec3A::from(m[1]) * lens.y;
+        let pdf = if self.has_lens() {
+            dist * dist / (std::f32::consts::PI * self.aperture_radius.powi(2) * cos)
+        } else {
+            1.0
+        };
+        Some(SensorSample {
+            film,
+            d: (world_lens - x) / dist,
+            dist,
+            pdf,
+            weight: 1.0 / (area * cos * cos * cos * dist * dist),
+        })
     }
 
     /// Whether rays start across a lens (a thin lens) rather than at a

@@ -56,13 +56,13 @@ from typing import Any, Mapping
 import numpy as np
 
 from .._core.render import CompiledScene, SceneBuilder
-from ..results import EmitterSample
+from ..results import EmitterSample, SensorSample
 from .meshes import icosphere
 from .parse import Camera, ShapeRecord, look_at, parse_scene
 from .serialized import read_serialized
 from .xml import read_xml, read_xml_located
 
-__all__ = ["EmitterSample", "Scene", "icosphere", "look_at", "read_serialized", "read_xml"]
+__all__ = ["EmitterSample", "Scene", "SensorSample", "icosphere", "look_at", "read_serialized", "read_xml"]
 
 
 @dataclass
@@ -190,6 +190,24 @@ class Scene:
         """
         out = np.asarray(self.compiled.sample_emitter(x, u))
         return EmitterSample(out[..., :3], out[..., 3], out[..., 4:7], out[..., 7])
+
+    def sample_sensor(self, x: Any, u: Any) -> "SensorSample":
+        """The camera seen from points ``x``, as light tracing connects to
+        it (Mitsuba's ``sensor.sample_direction``): ``x`` (N, 3) or (3,) in
+        world space, ``u`` (N, 2) or (2,) uniform in [0, 1] placing the
+        point on a thin lens's aperture (concentric disk; a pinhole ignores
+        it). The camera stands where it is at shutter_open.
+
+        Returns a :class:`mcsample.results.SensorSample`: ``.pixel`` (N, 2),
+        ``.direction`` (N, 3) toward the lens point, ``.distance``, ``.pdf``
+        and ``.weight`` (N,); 0 where ``x`` is outside the clip range or its
+        ray misses the film. The value a point of outgoing radiance ``L``
+        adds to its pixel's mean is ``L · weight · W · H`` over the number of
+        points drawn per unit area (times the cosine at the point), for a
+        film of W × H pixels and its box filter.
+        """
+        out = np.asarray(self.compiled.sample_sensor(x, u))
+        return SensorSample(out[..., :2], out[..., 2:5], out[..., 5], out[..., 6], out[..., 7])
 
     def emitter_pdf(self, x: Any, d: Any) -> Any:
         """The density per steradian with which :meth:`sample_emitter` from

@@ -355,8 +355,13 @@ def _shape(d: Mapping[str, Any], key: str, refs: Mapping[str, Material]) -> Shap
         else:
             v, f, n = read_mesh(os.fspath(d["filename"]))
         rec.face_normals = bool(d.get("face_normals", False))
-    if flip:
+    # Mitsuba's rectangle and cube face where to_world's inverse transpose
+    # takes their normals, also through a mirror (a mirror reverses their
+    # corners' order); a mesh read from a file keeps its winding.
+    mirrored = kind in ("rectangle", "cube") and m is not None and np.linalg.det(m[:3, :3]) < 0
+    if flip != mirrored:
         f = f[:, ::-1].copy()
+    if flip:
         n = None if n is None else -n
     rec.vertices, rec.normals = _transform_mesh(v, n, m)
     rec.faces = f
