@@ -390,13 +390,19 @@ def test_mitsubas_cornell_box_renders_as_in_mitsuba(mi):
     refs, an emitter with a bsdf, 256 x 256): mcsample's render of the dict
     is z-test-equal to Mitsuba's render of the same dict, whose region
     variances come from 16 independent renders (its filter splats samples
-    onto neighbouring pixels)."""
+    onto neighbouring pixels); a light 5 % brighter is rejected."""
     skip_scalar(mi)
     d = mi.cornell_box()
     assert d["sensor"]["film"]["rfilter"]["type"] == "gaussian"
     ours = mcs.render(mcs.Scene.from_mitsuba(d), 256, seed=1)
-    result = stats.render_ztest(ours, mcs.mitsuba.render_runs(mi.load_dict(d), 16))
+    reference = mcs.mitsuba.render_runs(mi.load_dict(d), 16)
+    result = stats.render_ztest(ours, reference)
     assert result.passed, result
+    # Power: the light 5 % brighter is seen.
+    light = d["light"]["emitter"]["radiance"]
+    light["value"] = [1.05 * v for v in light["value"]]
+    brighter = mcs.render(mcs.Scene.from_mitsuba(d), 256, seed=1)
+    assert not stats.render_ztest(brighter, reference).passed
     d["sensor"]["film"]["component_format"] = "float16"
     with pytest.raises(ValueError, match="component_format must be 'float32'"):
         mcs.Scene.from_mitsuba(d)

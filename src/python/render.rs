@@ -314,13 +314,9 @@ impl PyScene {
         x: &Obj<'py>,
         u: &Obj<'py>,
     ) -> PyResult<Obj<'py>> {
-        let x = Points::<f64, 3>::extract(x, "x")?;
-        let u = Points::<f64, 2>::extract(u, "u")?;
-        let scene = &self.0;
-        let (width, height) = scene.film();
-        map_pair(py, (&x, Check::Finite), (&u, Check::Unit), |x, u| {
-            let x = Vec3A::from(x.map(|v| v as f32));
-            let s = scene.camera().sample_direction(x, u.map(|v| v as f32));
+        let (width, height) = self.0.film();
+        self.at_points(py, x, (u, "u", Check::Unit), |scene, x, u| {
+            let s = scene.camera().sample_direction(x, u);
             s.map_or([0.0; 8], |s| {
                 let [dx, dy, dz] = s.d.to_array().map(f64::from);
                 [
@@ -351,12 +347,8 @@ impl PyScene {
         x: &Obj<'py>,
         u: &Obj<'py>,
     ) -> PyResult<Obj<'py>> {
-        let x = Points::<f64, 3>::extract(x, "x")?;
-        let u = Points::<f64, 3>::extract(u, "u")?;
-        let scene = &self.0;
-        map_pair(py, (&x, Check::Finite), (&u, Check::Unit), |x, u| {
-            let x = Vec3A::from(x.map(|v| v as f32));
-            let s = scene.sample_light(x, u.map(|v| v as f32), None::<fn() -> u64>);
+        self.at_points(py, x, (u, "u", Check::Unit), |scene, x, u| {
+            let s = scene.sample_light(x, u, None::<fn() -> u64>);
             s.map_or([0.0; 8], |s| {
                 let [dx, dy, dz] = s.d.to_array();
                 let [r, g, b] = s.radiance;
@@ -369,16 +361,32 @@ impl PyScene {
     /// points ``x`` (N, 3) or (3,) draws the unit directions ``d`` (N, 3)
     /// or (3,): float64 (N,) or a scalar.
     fn emitter_pdf<'py>(&self, py: Python<'py>, x: &Obj<'py>, d: &Obj<'py>) -> PyResult<Obj<'py>> {
-        let x = Points::<f64, 3>::extract(x, "x")?;
-        let d = Points::<f64, 3>::extract(d, "d")?;
-        let scene = &self.0;
-        map_pair(py, (&x, Check::Finite), (&d, Check::Finite), |x, d| {
-            let x = Vec3A::from(x.map(|v| v as f32));
-            let d = Vec3A::from(d.map(|v| v as f32)).normalize_or_zero();
+        self.at_points(py, x, (d, "d", Check::Finite), |scene, x, d| {
+            let d = Vec3A::from(d).normalize_or_zero();
             if d == Vec3A::ZERO {
                 return [0.0];
             }
             [f64::from(scene.emitter_pdf(x, d))]
+        })
+    }
+}
+
+impl PyScene {
+    /// `kernel(scene, x, v)` for each world point `x` of `x` (N, 3) or (3,)
+    /// and its row of `v` (N, K) or (K,) (argument `arg`, checked by
+    /// `check`), in `f32`, as float64 rows of `M`; the GIL released.
+    fn at_points<'py, const K: usize, const M: usize>(
+        &self,
+        py: Python<'py>,
+        x: &Obj<'py>,
+        (v, arg, check): (&Obj<'py>, &'static str, Check),
+        kernel: impl Fn(&Scene, Vec3A, [f32; K]) -> [f64; M] + Sync + Send,
+    ) -> PyResult<Obj<'py>> {
+        let x = Points::<f64, 3>::extract(x, "x")?;
+        let v = Points::<f64, K>::extract(v, arg)?;
+        let scene = &self.0;
+        map_pair(py, (&x, Check::Finite), (&v, check), |x, v| {
+            kernel(scene, Vec3A::from(x.map(|c| c as f32)), v.map(|c| c as f32))
         })
     }
 }
