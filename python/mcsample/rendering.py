@@ -42,7 +42,7 @@ def _progress_bar(total: int, enabled: bool) -> tuple[Callable[[int], None] | No
 
 
 def render(scene: Scene, spp: int | None = None, *,
-           integrator: Literal["direct", "path"] | None = None,
+           integrator: Literal["direct", "path", "ptracer"] | None = None,
            strategy: Literal["bsdf", "emitter", "mis"] = "mis",
            heuristic: Literal["balance", "power"] = "power", max_depth: int | None = None,
            rr_depth: int | None = None, seed: SeedLike = 0, progress: bool = True,
@@ -56,10 +56,16 @@ def render(scene: Scene, spp: int | None = None, *,
         From :meth:`mcsample.Scene.from_mitsuba`.
     spp : int, optional
         Samples per pixel (default: the scene's sampler ``sample_count``, else 16).
-    integrator : "direct" or "path", optional
-        Direct illumination (emitted + direct light), or path tracing with
-        next-event estimation and Russian roulette. Default: the scene dict's
-        integrator, else "path".
+    integrator : "direct", "path" or "ptracer", optional
+        Direct illumination (emitted + direct light), path tracing with
+        next-event estimation and Russian roulette, or light tracing (as
+        Mitsuba's ``ptracer``: ``spp`` × H × W paths start on the lights,
+        each vertex is connected to the camera and splatted onto the film
+        with the scene's filter, normalised as Mitsuba's; lights seen
+        directly are connected to the camera from a point drawn on them;
+        the variance of each pixel comes from its value on every path).
+        ``strategy`` and ``heuristic`` do not apply to "ptracer". Default:
+        the scene dict's integrator, else "path".
     strategy : "bsdf", "emitter" or "mis"
         How light is found: BSDF sampling, emitter sampling (envmap
         importance sampling; area lights uniformly by area, converted to
@@ -154,6 +160,7 @@ def render(scene: Scene, spp: int | None = None, *,
             if total_spp is None else int(total_spp)
         strategy_name = "emitter" if strategy == "envmap" else strategy
         chunk = Chunk(blocks, sums, (scene.shape, seed, sampler, total, strategy_name, heuristic,
-                                     tuple(sorted(settings.items()))))
+                                     tuple(sorted(settings.items()))),
+                      height * width if settings["integrator"] == "ptracer" else 1)
     return RenderResult(image.reshape(height, width, 3), variance.reshape(height, width, 3),
                         lum_var.reshape(height, width), int(spp), seconds, first, chunk)

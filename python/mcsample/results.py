@@ -78,11 +78,15 @@ class Chunk(Result):
         luminance and its square.
     key : tuple
         Shape, seed, sampler, sequence length and settings of the render.
+    paths_per_sample : int
+        The paths each sample index holds for a pixel's estimate: 1, or the
+        film's pixels for light tracing (one light path per pixel).
     """
 
     blocks: list[tuple[int, int]]
     sums: np.ndarray
     key: tuple[Any, ...]
+    paths_per_sample: int = 1
 
 
 @dataclasses.dataclass(repr=False)
@@ -163,12 +167,14 @@ class RenderResult(Result):
                     "results are chunks of different renders: shape, seed, sampler, total_spp "
                     f"or settings differ ({key} and {r.chunk.key})")  # type: ignore[union-attr]
         height, width = results[0].image.shape[:2]
+        per_sample = results[0].chunk.paths_per_sample  # type: ignore[union-attr]
         image, variance, lum_var, blocks, sums = merge(
-            [(r.chunk.blocks, r.chunk.sums) for r in results], height * width)  # type: ignore[union-attr]
+            [(r.chunk.blocks, r.chunk.sums) for r in results], height * width,  # type: ignore[union-attr]
+            per_sample)
         spp = sum(length for _, length in blocks)
         return cls(image.reshape(height, width, 3), variance.reshape(height, width, 3),
                    lum_var.reshape(height, width), spp, sum(r.seconds for r in results),
-                   results[0].first_sample, Chunk(blocks, sums, key))
+                   results[0].first_sample, Chunk(blocks, sums, key, per_sample))
 
     @property
     def luminance(self) -> np.ndarray:

@@ -316,7 +316,7 @@ impl PyScene {
     ) -> PyResult<Obj<'py>> {
         let (width, height) = self.0.film();
         self.at_points(py, x, (u, "u", Check::Unit), |scene, x, u| {
-            let s = scene.camera().sample_direction(x, u);
+            let s = scene.camera().sample_direction(x, u, 0.0);
             s.map_or([0.0; 8], |s| {
                 let [dx, dy, dz] = s.d.to_array().map(f64::from);
                 [
@@ -441,7 +441,11 @@ pub fn render<'py>(
         integrator: choice(
             "integrator",
             integrator,
-            &[("direct", Integrator::Direct), ("path", Integrator::Path)],
+            &[
+                ("direct", Integrator::Direct),
+                ("path", Integrator::Path),
+                ("ptracer", Integrator::Ptracer),
+            ],
         )?,
         strategy: choice(
             "strategy",
@@ -551,8 +555,16 @@ type Chunk<'py> = (Vec<(u64, u64)>, PyReadonlyArray1<'py, f64>);
 /// as :func:`render` returns them with ``keep_sums``, in sample order, for a
 /// film of ``pixels`` pixels; returns what :func:`render` returns for the
 /// samples they cover (the same bits as rendering those samples at once).
+/// ``paths_per_sample`` is 1, or ``pixels`` for light tracing (whose
+/// sample index holds one light path per pixel).
 #[pyfunction]
-pub fn merge<'py>(py: Python<'py>, chunks: Vec<Chunk<'py>>, pixels: usize) -> PyResult<Film<'py>> {
+#[pyo3(signature = (chunks, pixels, paths_per_sample = 1))]
+pub fn merge<'py>(
+    py: Python<'py>,
+    chunks: Vec<Chunk<'py>>,
+    pixels: usize,
+    paths_per_sample: u64,
+) -> PyResult<Film<'py>> {
     let mut parts = Vec::with_capacity(chunks.len());
     for (blocks, sums) in &chunks {
         let blocks = blocks
@@ -561,7 +573,7 @@ pub fn merge<'py>(py: Python<'py>, chunks: Vec<Chunk<'py>>, pixels: usize) -> Py
             .collect::<Result<Vec<_>, _>>()?;
         parts.push((blocks, sums.as_slice()?));
     }
-    let merged = py.detach(|| film::merge(&parts, pixels))?;
+    let merged = py.detach(|| film::merge(&parts, pixels, paths_per_sample.max(1)))?;
     Ok(film(
         py,
         [merged.mean, merged.variance, merged.luminance_variance],

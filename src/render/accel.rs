@@ -60,6 +60,16 @@ impl Primitive {
         }
     }
 
+    /// A point drawn uniformly by area (density `1 / area`).
+    #[inline]
+    pub fn sample(&self, u: [f32; 2]) -> SurfacePoint {
+        match self {
+            Primitive::Triangle(t) => t.sample(u),
+            Primitive::Sphere(s) => s.sample(u),
+            Primitive::Disk(d) => d.sample(u),
+        }
+    }
+
     fn bounds(&self) -> Aabb {
         let (lo, hi) = match self {
             Primitive::Triangle(t) => {

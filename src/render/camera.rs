@@ -79,6 +79,8 @@ pub struct SensorSample {
     /// importance per unit solid angle, times the film's cosine, over the
     /// lens point's density by area).
     pub weight: f32,
+    /// The lens point, in world space.
+    pub lens: Vec3A,
 }
 
 /// The columns of an affine map as plain arrays.
@@ -191,41 +193,67 @@ impl Camera {
         (p.z > 0.0 && film.iter().all(|f| (0.0..=1.0).contains(f))).then_some(film)
     }
 
-    /// The connection from world point `x` to the camera (where it stands
-    /// at `shutter_open`), with `u` placing the point on a thin lens's
-    /// aperture (concentric disk); `None` when `x` lies outside the clip
-    /// range or the ray through it misses the film (Mitsuba's
-    /// `sample_direction` of `perspective` and `thinlens`).
-    pub fn sample_direction(&self, x: Vec3A, u: [f32; 2]) -> Option<SensorSample> {
-        let p = self.to_local.transform_point3a(x);
-        if !(p.z >= self.near_clip && p.z <= self.far_clip) {
-            return None;
+    /// The camera's `to_world` and its inverse at time `tau` of the shutter.
+    fn placed(&self, tau: f32) -> (Affine3A, Affine3A) {
+        match &self.motion {
+            Some(motion) => {
+                let m = affine_f32(motion.at(f64::from(tau)));
+                (m, m.inverse())
+            }
+            None => {
+                let [x, y, z, w] = self.to_world.map(Vec3A::from);
+                (Affine3A::from_cols(x, y, z, w), self.to_local)
+            }
         }
-        let lens = if self.has_lens() {
+    }
+
+    /// A point on the aperture in camera space: the pinhole, or `u` on the
+    /// lens disk (concentric mapping).
+    fn lens_point(&self, u: [f32; 2]) -> Vec3A {
+        if self.has_lens() {
             let [a, b] = warp::square_to_uniform_disk_concentric(u);
             Vec3A::new(a * self.aperture_radius, b * self.aperture_radius, 0.0)
         } else {
             Vec3A::ZERO
-        };
+        }
+    }
+
+    /// Where the camera-space ray from lens point `lens` along the unit
+    /// direction `local` lands on the film: through a thin lens, where its
+    /// point on the focal plane is seen from the pinhole.
+    fn film_through(&self, lens: Vec3A, local: Vec3A) -> Option<[f32; 2]> {
+        if local.z <= 0.0 {
+            return None;
+        }
+        if self.has_lens() {
+            if !(self.near_clip..=self.far_clip).contains(&self.focus_distance) {
+                return None;
+            }
+            self.film_of(lens + local * (self.focus_distance / local.z))
+        } else {
+            self.film_of(local)
+        }
+    }
+
+    /// The connection from world point `x` to the camera where it stands at
+    /// time `tau` of the shutter (in `[0, 1]`), with `u` placing the point
+    /// on a thin lens's aperture (concentric disk); `None` when `x` lies
+    /// outside the clip range or the ray through it misses the film
+    /// (Mitsuba's `sample_direction` of `perspective` and `thinlens`).
+    pub fn sample_direction(&self, x: Vec3A, u: [f32; 2], tau: f32) -> Option<SensorSample> {
+        let (to_world, to_local) = self.placed(tau);
+        let p = to_local.transform_point3a(x);
+        if !(p.z >= self.near_clip && p.z <= self.far_clip) {
+            return None;
+        }
+        let lens = self.lens_point(u);
         let to_x = p - lens;
         let dist = to_x.length();
         let local = to_x / dist;
         let cos = local.z;
-        // Through the lens, the ray lands where its point on the focal plane
-        // is seen from the pinhole.
-        let film = if self.has_lens() {
-            let focus = lens + local * (self.focus_distance / cos);
-            if !(self.near_clip..=self.far_clip).contains(&self.focus_distance) {
-                return None;
-            }
-            self.film_of(focus)?
-        } else {
-            self.film_of(p)?
-        };
+        let film = self.film_through(lens, local)?;
         let area = 4.0 * self.tan_half.x * self.tan_half.y;
-        let m = &self.to_world;
-        let origin = Vec3A::from(m[3]);
-        let world_lens = origin + Vec3A::from(m[0]) * lens.x + Vec3A::from(m[1]) * lens.y;
+        let world_lens = to_world.transform_point3a(lens);
         let pdf = if self.has_lens() {
             dist * dist / (std::f32::consts::PI * self.aperture_radius.powi(2) * cos)
         } else {
@@ -237,6 +265,7 @@ impl Camera {
             dist,
             pdf,
             weight: 1.0 / (area * cos * cos * cos * dist * dist),
+            lens: world_lens,
         })
     }
 
@@ -252,11 +281,13 @@ impl Camera {
     /// `v = ((1 − 2x) tan(fov_x/2), (1 − 2y) tan(fov_y/2), 1)`; the thin lens
     /// aims from the aperture point `a` at `v·focus_distance`. The ray starts
     /// where it crosses the near clip plane and ends at the far one, as in
-    /// Mitsuba.
+    /// Mitsuba. A moving camera is placed where it is at time `tau` of the
+    /// shutter.
     #[inline]
-    pub fn ray(&self, film: [f32; 2], lens: [f32; 2]) -> Ray {
-        let thin = self.aperture_radius > 0.0;
-        ray_from_row(self.ray_row([film[0], film[1], lens[0], lens[1]], thin, &self.to_world))
+    pub fn ray(&self, film: [f32; 2], lens: [f32; 2], tau: f32) -> Ray {
+        let mut out = [Ray::default()];
+        self.rays_into(&[[film[0], film[1], lens[0], lens[1]]], &[tau], &mut out);
+        out[0]
     }
 
     /// [`Camera::ray`] of `u = (film x, film y, lens x, lens y)` as the row
@@ -369,10 +400,10 @@ mod tests {
             0.0,
         )
         .unwrap();
-        let r = cam.ray([0.5, 0.5], [0.5, 0.5]);
+        let r = cam.ray([0.5, 0.5], [0.5, 0.5], 0.0);
         assert!((r.d - Vec3A::Z).length() < 1e-6);
         // The left edge of the image is camera +x, the top is +y.
-        let r = cam.ray([0.0, 0.0], [0.5, 0.5]);
+        let r = cam.ray([0.0, 0.0], [0.5, 0.5], 0.0);
         let expected = Vec3A::new(1.0, 0.5, 1.0).normalize();
         assert!((r.d - expected).length() < 1e-6);
         // It starts on the near plane and ends on the far one: z from 1e-3
@@ -397,10 +428,10 @@ mod tests {
         )
         .unwrap();
         for lens in [[0.1, 0.2], [0.9, 0.5], [0.5, 0.95]] {
-            let r = cam.ray([0.3, 0.6], lens);
+            let r = cam.ray([0.3, 0.6], lens, 0.0);
             let t = (3.0 - r.o.z) / r.d.z;
             let p = r.o + t * r.d;
-            let pin = cam.ray([0.3, 0.6], [0.5, 0.5]);
+            let pin = cam.ray([0.3, 0.6], [0.5, 0.5], 0.0);
             let q = pin.o + (3.0 - pin.o.z) / pin.d.z * pin.d;
             assert!((p - q).length() < 1e-4, "{p} {q}");
         }

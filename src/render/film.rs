@@ -153,6 +153,15 @@ impl<T> Tree<T> {
     /// # Errors
     /// [`Error::Argument`] when `block` does not start where the tree ends.
     pub fn push(&mut self, block: Block, value: T, plus: impl Fn(&T, &T) -> T) -> Result<()> {
+        self.push_into(block, value, |left, right| *left = plus(left, &right))
+    }
+
+    /// [`Tree::push`] with siblings merged in place: `merge(left, right)`
+    /// makes `left` their sum (for large values, such as whole films).
+    ///
+    /// # Errors
+    /// As [`Tree::push`].
+    pub fn push_into(&mut self, block: Block, value: T, merge: impl Fn(&mut T, T)) -> Result<()> {
         if let Some((last, _)) = self.nodes.last()
             && last.start + last.len != block.start
         {
@@ -168,16 +177,19 @@ impl<T> Tree<T> {
             });
         }
         self.nodes.push((block, value));
-        while let [.., (left, a), (right, b)] = &self.nodes[..]
+        while let [.., (left, _), (right, _)] = &self.nodes[..]
             && left.is_left_sibling_of(right)
         {
-            let parent = Block {
-                start: left.start,
-                len: 2 * left.len,
+            let len = 2 * left.len;
+            // Both are there (matched above).
+            let Some((_, b)) = self.nodes.pop() else {
+                break;
             };
-            let sum = plus(a, b);
-            self.nodes.truncate(self.nodes.len() - 2);
-            self.nodes.push((parent, sum));
+            let Some((left, a)) = self.nodes.last_mut() else {
+                break;
+            };
+            left.len = len;
+            merge(a, b);
         }
         Ok(())
     }
@@ -263,13 +275,15 @@ pub fn finish_pixel(
 
 /// Chunks of one render merged: the blocks of each chunk (`blocks`, in
 /// sample order, following one another) and its sums (`sums`, pixel by
-/// pixel, 8 per block) for a film of `pixels` pixels.
+/// pixel, 8 per block) for a film of `pixels` pixels, each sample index
+/// holding `per_sample` samples of a pixel's estimate (1, or the film's
+/// pixels for light tracing: [`super::splat`]).
 ///
 /// # Errors
 /// [`Error::Argument`] when the chunks do not follow one another or a
 /// chunk's sums do not match its blocks and `pixels`;
 /// [`Error::Memory`] when the result does not fit in memory.
-pub fn merge(chunks: &[(Vec<Block>, &[f64])], pixels: usize) -> Result<Merged> {
+pub fn merge(chunks: &[(Vec<Block>, &[f64])], pixels: usize, per_sample: u64) -> Result<Merged> {
     for (blocks, sums) in chunks {
         let expected = pixels.checked_mul(blocks.len() * 8);
         if expected != Some(sums.len()) {
@@ -328,7 +342,7 @@ pub fn merge(chunks: &[(Vec<Block>, &[f64])], pixels: usize) -> Result<Merged> {
                     }
                     block_sums.clear();
                     block_sums.extend(tree.nodes().iter().map(|(_, s)| *s));
-                    finish_pixel(block_sums, count, (mean, var), lum, sums);
+                    finish_pixel(block_sums, count * per_sample, (mean, var), lum, sums);
                 },
             );
     })?;

@@ -171,6 +171,8 @@ impl Offsets {
 /// A film's reconstruction filter, ready to place samples.
 #[derive(Clone, Debug)]
 pub struct FilmFilter {
+    /// The filter.
+    filter: Filter,
     /// The Gaussian's offsets; `None` for the box filter.
     offsets: Option<Offsets>,
     /// The film's size in pixels and how far beyond its edges samples go.
@@ -182,6 +184,7 @@ impl FilmFilter {
     /// The box filter, whatever the film.
     pub fn none() -> Self {
         FilmFilter {
+            filter: Filter::Box,
             offsets: None,
             size: [0.0; 2],
             border: 0.0,
@@ -203,10 +206,16 @@ impl FilmFilter {
             return Ok(Self::none());
         };
         Ok(FilmFilter {
+            filter,
             offsets: Some(Offsets::new(stddev)?),
             size: [width as f64, height as f64],
             border: if sample_border { filter.border() } else { 0.0 },
         })
+    }
+
+    /// The filter.
+    pub fn filter(&self) -> Filter {
+        self.filter
     }
 
     /// Whether samples carry weights other than 1.

@@ -74,6 +74,9 @@ pub enum Integrator {
     Direct,
     /// Paths of any length (up to `max_depth`), with Russian roulette.
     Path,
+    /// Light tracing ([`super::ptracer`]): paths from the lights, each
+    /// vertex connected to the camera.
+    Ptracer,
 }
 
 /// How light is found at each shading point.
@@ -116,10 +119,10 @@ impl Settings {
         self.heuristic.weight(pdf_a, pdf_b)
     }
 
-    fn max_depth(&self) -> u32 {
+    pub(super) fn max_depth(&self) -> u32 {
         match self.integrator {
             Integrator::Direct => 2,
-            Integrator::Path => self.max_depth.unwrap_or(u32::MAX),
+            Integrator::Path | Integrator::Ptracer => self.max_depth.unwrap_or(u32::MAX),
         }
     }
 }
@@ -127,7 +130,7 @@ impl Settings {
 /// Offset of a ray origin off a surface, as Mitsuba's: `(1 + max |p_i|) ε`
 /// with `ε = 1500 · 2⁻²⁴`.
 #[inline]
-fn offset(p: Vec3A, n: Vec3A, toward: Vec3A) -> Vec3A {
+pub(super) fn offset(p: Vec3A, n: Vec3A, toward: Vec3A) -> Vec3A {
     let eps = (1.0 + p.abs().max_element()) * (1500.0 / 16_777_216.0);
     if n.dot(toward) >= 0.0 {
         p + n * eps

@@ -34,14 +34,17 @@
 
 pub mod accel;
 pub mod camera;
+pub mod environment;
 pub mod film;
 pub mod filter;
 pub mod geometry;
 pub mod integrator;
 pub mod mesh_file;
 pub mod motion;
+pub mod ptracer;
 pub mod scene;
 pub mod shape;
+pub mod splat;
 #[cfg(test)]
 mod tests;
 
@@ -332,6 +335,9 @@ pub fn render(
     }
     if settings.sampler == Sampler::ZSobol {
         ZOrder::check((width, height), samples.total)?;
+    }
+    if settings.integrator == Integrator::Ptracer {
+        return ptracer::render(scene, samples, seed, settings, progress);
     }
     let spp = samples.count.max(1) as usize;
     let blocks = film::blocks(samples.first, u64::from(samples.count));

@@ -101,6 +101,24 @@ impl Motion {
         Ok(Motion { start: s, end: e })
     }
 
+    /// A sphere holding, at every time, where the points of the sphere
+    /// `(center, radius)` at `τ = 0` go. With `p = M(0)⁻¹ x` (so
+    /// `|p| ≤ |M(0)⁻¹ c| + ‖L(0)⁻¹‖ r`, `L` the linear part) and
+    /// `M(τ) p = T(τ) ± R(τ) S(τ) p`: `T(τ)` runs along the segment of its
+    /// ends and `‖S(τ)‖ ≤ max(‖S(0)‖, ‖S(1)‖)` (a norm is convex and `S` is
+    /// linear in `τ`), Frobenius norms bounding the operator norm.
+    pub fn bounding_sphere(&self, center: DVec3, radius: f64) -> (DVec3, f64) {
+        let start = self.at(0.0).inverse();
+        let frobenius = |m: DMat3| m.to_cols_array().iter().map(|v| v * v).sum::<f64>().sqrt();
+        let p = start.transform_point3(center).length() + frobenius(start.matrix3) * radius;
+        let (a, b) = (&self.start, &self.end);
+        let stretch = frobenius(a.stretch).max(frobenius(b.stretch));
+        (
+            0.5 * (a.translation + b.translation),
+            0.5 * (b.translation - a.translation).length() + stretch * p,
+        )
+    }
+
     /// `M(τ) = T(τ) R(τ) S(τ)`.
     pub fn at(&self, tau: f64) -> DAffine3 {
         let (a, b) = (&self.start, &self.end);
@@ -151,6 +169,19 @@ impl Mover {
     /// The number of its first primitive.
     pub fn first(&self) -> u32 {
         self.first
+    }
+
+    /// A sphere around the shape at every time ([`Motion::bounding_sphere`]
+    /// of the sphere around its box at `shutter_open`); `None` when it has
+    /// no primitives.
+    pub fn bounding_sphere(&self) -> Option<(Vec3A, f32)> {
+        let (lo, hi) = self.accel.bounds()?;
+        let (c, r) = self.motion.bounding_sphere(
+            (0.5 * (lo + hi)).as_dvec3(),
+            f64::from(0.5 * (hi - lo).length()),
+        );
+        // Rounded outward to f32.
+        Some((c.as_vec3a(), (r * (1.0 + 1e-6)) as f32))
     }
 
     /// `D(τ)` and `D(τ)⁻¹`.
@@ -270,5 +301,39 @@ mod tests {
         let mirror = DAffine3::from_scale(DVec3::new(-1.0, 1.0, 1.0));
         let e = Motion::new("to_world_end", id, mirror).unwrap_err();
         assert!(e.to_string().contains("mirrors"), "{e}");
+    }
+
+    #[test]
+    fn the_bounding_sphere_holds_the_shape_at_every_time() {
+        let start = DAffine3::from_scale_rotation_translation(
+            DVec3::new(1.0, 2.0, 0.5),
+            DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7),
+            DVec3::new(1.0, -2.0, 3.0),
+        );
+        let end = DAffine3::from_scale_rotation_translation(
+            DVec3::new(0.5, 3.0, 1.0),
+            DQuat::from_axis_angle(DVec3::new(-1.0, 0.5, 0.2).normalize(), 2.5),
+            DVec3::new(-4.0, 1.0, 0.0),
+        );
+        let m = Motion::new("m", start, end).unwrap();
+        let (c0, r0) = (DVec3::new(1.0, -1.5, 3.5), 0.8);
+        let (c, r) = m.bounding_sphere(c0, r0);
+        let inverse = start.inverse();
+        let mut farthest = 0.0f64;
+        for i in 0..=64 {
+            let tau = f64::from(i) / 64.0;
+            let d = m.at(tau) * inverse;
+            for j in 0..200 {
+                // Points on the sphere at τ = 0 (a spiral over it).
+                let z = 1.0 - 2.0 * (f64::from(j) + 0.5) / 200.0;
+                let phi = 2.399_963 * f64::from(j);
+                let rho = (1.0 - z * z).sqrt();
+                let p = c0 + r0 * DVec3::new(rho * phi.cos(), rho * phi.sin(), z);
+                farthest = farthest.max((d.transform_point3(p) - c).length());
+            }
+        }
+        assert!(farthest <= r, "{farthest} > {r}");
+        // Not wildly loose either.
+        assert!(r < 4.0 * farthest, "{r} vs {farthest}");
     }
 }

@@ -3,11 +3,11 @@
 //! power for emitter sampling.
 
 use glam::Vec3A;
-use std::sync::Arc;
 
 use super::accel::Hit;
 use super::accel::{Accel, Primitive};
 use super::camera::Camera;
+pub use super::environment::Environment;
 use super::filter::{FilmFilter, Filter};
 use super::geometry::check_primitives;
 pub use super::geometry::{Geometry, MAX_PRIMITIVES, affine, daffine};
@@ -15,11 +15,10 @@ use super::motion::{Motion, Mover};
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
 use crate::distr::Discrete1D;
-use crate::envmap::{CellSampler, EnvMap, EnvSample};
+use crate::envmap::CellSampler;
 use crate::error::{Error, Result};
 use crate::math::luminance;
 use crate::phong::Phong;
-use crate::warp;
 
 /// A surface's BSDF: the Phong BRDF (a diffuse material is Phong with
 /// `ρs = 0`), reflecting on the front side only unless `two_sided`, as in
@@ -53,96 +52,6 @@ fn primitives_of(geometry: Geometry) -> Box<dyn ExactSizeIterator<Item = Primiti
         Geometry::Mesh(tris) => Box::new(tris.into_iter().map(Primitive::Triangle)),
         Geometry::Sphere(s) => Box::new(std::iter::once(Primitive::Sphere(s))),
         Geometry::Disk(d) => Box::new(std::iter::once(Primitive::Disk(d))),
-    }
-}
-
-/// Light from infinitely far away.
-#[derive(Clone, Debug)]
-pub enum Environment {
-    /// An environment map (sampled by its own importance sampling).
-    Map(Arc<EnvMap>),
-    /// The same radiance from every direction (sampled uniformly on the
-    /// sphere, pdf `1/(4π)`).
-    Constant([f64; 3]),
-}
-
-impl Environment {
-    /// Radiance arriving from world direction `d`.
-    #[inline]
-    pub fn eval(&self, d: Vec3A) -> [f32; 3] {
-        match self {
-            Environment::Map(env) => env.eval(d.to_array()),
-            Environment::Constant(l) => l.map(|v| v as f32),
-        }
-    }
-
-    /// [`Environment::eval`] for a batch of directions.
-    pub fn eval_into(&self, d: &[[f32; 3]], out: &mut [[f32; 3]]) {
-        match self {
-            Environment::Map(env) => {
-                env.eval_into(d, out, |_| true);
-            }
-            Environment::Constant(l) => out.fill(l.map(|v| v as f32)),
-        }
-    }
-
-    /// Density of [`Environment::sample`] at `d`, per steradian.
-    #[inline]
-    pub fn pdf(&self, d: Vec3A) -> f32 {
-        match self {
-            Environment::Map(env) => env.pdf(d.as_dvec3().to_array()) as f32,
-            Environment::Constant(_) => 0.25 * std::f32::consts::FRAC_1_PI,
-        }
-    }
-
-    /// A direction, its density per steradian and its radiance. A map
-    /// draws by `cells` (its [`CellSampler`], with 64 random bits for the
-    /// cell, `u` placing the point in it) where it has one, else by
-    /// [`EnvMap::sample`] of `u`.
-    #[inline]
-    pub fn sample(
-        &self,
-        u: [f32; 2],
-        cells: Option<(&CellSampler, u64)>,
-    ) -> (Vec3A, f32, [f32; 3]) {
-        match self {
-            Environment::Map(env) => {
-                let s = match cells {
-                    Some((cells, bits)) => cells.sample(env, bits, u),
-                    None => {
-                        let s = env.sample(u.map(f64::from)).cast::<f32>();
-                        // Radiance as weight · pdf in f32 rather than rounded
-                        // from f64, so that these renders keep their bits.
-                        EnvSample {
-                            radiance: s.weight.map(|w| w * s.pdf),
-                            ..s
-                        }
-                    }
-                };
-                (Vec3A::from(s.direction), s.pdf, s.radiance)
-            }
-            Environment::Constant(l) => {
-                let d = warp::square_to_uniform_sphere(u);
-                (Vec3A::from(d), self.pdf(Vec3A::Z), l.map(|v| v as f32))
-            }
-        }
-    }
-
-    /// `∫ Y(L(ω)) dω` over the sphere, by the midpoint rule on a 256 × 128
-    /// grid in (φ, cos θ) (for choosing among lights; it need not be exact).
-    fn luminance_integral(&self) -> f64 {
-        let (nx, ny) = (256, 128);
-        let mut sum = 0.0;
-        for j in 0..ny {
-            let z = 1.0 - 2.0 * (j as f64 + 0.5) / ny as f64;
-            let r = (1.0 - z * z).sqrt();
-            for i in 0..nx {
-                let phi = 2.0 * std::f64::consts::PI * (i as f64 + 0.5) / nx as f64;
-                let d = Vec3A::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32);
-                sum += luminance(self.eval(d).map(f64::from));
-            }
-        }
-        sum * 4.0 * std::f64::consts::PI / (nx * ny) as f64
     }
 }
 
@@ -181,6 +90,45 @@ pub struct LightSample {
     pub point: Option<SurfacePoint>,
 }
 
+/// Where light starts ([`Scene::sample_emission`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Emission {
+    /// A point on an area light.
+    Surface {
+        /// The point (light leaves its front side, along `ng`).
+        point: SurfacePoint,
+        /// Density per unit area, including the choice of the light.
+        pdf: f32,
+        /// Emitted radiance.
+        radiance: [f32; 3],
+    },
+    /// Light from the environment.
+    Environment {
+        /// Unit direction toward the environment (light travels along `−d`).
+        d: Vec3A,
+        /// Density per steradian, including the choice of the light.
+        pdf: f32,
+        /// Radiance arriving along `−d`.
+        radiance: [f32; 3],
+        /// The probability of having chosen the environment.
+        choice: f32,
+    },
+}
+
+/// The sphere of [`Scene::bounding_sphere`].
+fn bounding_sphere(accel: &Accel, movers: &[Mover]) -> (Vec3A, f32) {
+    let spheres = accel
+        .bounds()
+        .map(|(lo, hi)| (0.5 * (lo + hi), 0.5 * (hi - lo).length()))
+        .into_iter()
+        .chain(movers.iter().filter_map(Mover::bounding_sphere));
+    let boxes = spheres.map(|(c, r)| (c - Vec3A::splat(r), c + Vec3A::splat(r)));
+    match boxes.reduce(|(a, b), (c, d)| (a.min(c), b.max(d))) {
+        Some((lo, hi)) => (0.5 * (lo + hi), 0.5 * (hi - lo).length()),
+        None => (Vec3A::ZERO, 1.0),
+    }
+}
+
 /// A scene ready to render.
 pub struct Scene {
     accel: Accel,
@@ -196,13 +144,14 @@ pub struct Scene {
     height: usize,
     filter: FilmFilter,
     movers: Vec<Mover>,
+    bounding_sphere: (Vec3A, f32),
 }
 
 impl Scene {
     /// Builds the BVH and the light selection (by power: `π A Y(L)` for an
-    /// area light, `π R² ∫ Y(L) dω` for the environment, R the radius of the
-    /// bounding sphere of the shapes that do not move: the choice need not
-    /// follow the powers exactly).
+    /// area light, `π R² ∫ Y(L) dω` for the environment, R the radius of
+    /// [`Scene::bounding_sphere`]: the choice need not follow the powers
+    /// exactly).
     ///
     /// # Errors
     /// [`Error::Parameter`] for a film of zero pixels.
@@ -289,9 +238,8 @@ impl Scene {
         for mover in &mut movers {
             first = mover.number_from(first);
         }
-        let radius = accel
-            .bounds()
-            .map_or(1.0, |(lo, hi)| 0.5 * f64::from((hi - lo).length()));
+        let bounding_sphere = bounding_sphere(&accel, &movers);
+        let radius = f64::from(bounding_sphere.1);
         let mut env_light = None;
         if let Some(env) = &environment {
             let power = std::f64::consts::PI * radius * radius * env.luminance_integral();
@@ -322,6 +270,7 @@ impl Scene {
             height,
             filter: FilmFilter::none(),
             movers,
+            bounding_sphere,
         })
     }
 
@@ -536,12 +485,73 @@ impl Scene {
         pdf
     }
 
+    /// A sphere around every shape at every time of the shutter: the
+    /// sphere around the still shapes' bounding box and the moving shapes'
+    /// spheres ([`Mover::bounding_sphere`]); a unit sphere at the origin
+    /// for an empty scene. Light from the environment enters the scene
+    /// through it ([`Scene::sample_emission`]).
+    pub fn bounding_sphere(&self) -> (Vec3A, f32) {
+        self.bounding_sphere
+    }
+
+    /// Primitive of an area light's `first ..` chosen by area (`areas`,
+    /// when it has several) with `u[0]`, and `u` made uniform again.
+    #[inline]
+    fn pick_primitive(
+        &self,
+        first: u32,
+        areas: Option<&Discrete1D>,
+        u: [f32; 2],
+    ) -> (&Primitive, [f32; 2]) {
+        let (k, u0) = match areas {
+            Some(a) => a.sample_reuse(u[0]),
+            None => (0, u[0]),
+        };
+        (&self.accel.primitives()[first as usize + k], [u0, u[1]])
+    }
+
+    /// Where light starts, for light tracing: a light chosen by power
+    /// (`u[0]`, as [`Scene::sample_light`]), then a point on an area light
+    /// uniformly by area, or a direction toward the environment by its own
+    /// sampling ([`Environment::sample`] by inversion) (`u[1..3]`). `None`
+    /// when the scene has no light or the sample carries no radiance.
+    pub fn sample_emission(&self, u: [f32; 3]) -> Option<Emission> {
+        let choice = self.light_choice.as_ref()?;
+        let index = choice.sample(u[0]);
+        let pmf = choice.pmf(index) as f32;
+        match &self.lights[index] {
+            Light::Environment { .. } => {
+                let (d, pdf, radiance) = self.environment.as_ref()?.sample([u[1], u[2]], None);
+                (pdf > 0.0).then_some(Emission::Environment {
+                    d,
+                    pdf: pdf * pmf,
+                    radiance,
+                    choice: pmf,
+                })
+            }
+            Light::Area {
+                first,
+                areas,
+                total_area,
+                radiance,
+                ..
+            } => {
+                let (primitive, u2) = self.pick_primitive(*first, areas.as_ref(), [u[1], u[2]]);
+                Some(Emission::Surface {
+                    point: primitive.sample(u2),
+                    pdf: pmf / total_area,
+                    radiance: *radiance,
+                })
+            }
+        }
+    }
+
     /// Emitter sampling from the shading point `x`: a light chosen by power
     /// (`u[0]`), then a point on it (uniformly by area, or for a sphere seen
     /// from outside by the cone it subtends) or an environment
     /// direction by the environment's own sampling (`u[1..3]`; a map's
     /// cell by its [`CellSampler`] from 64 bits of `bits` when given, else
-    /// by [`EnvMap::sample`] of `u[1..3]`, with the same density). `None`
+    /// by [`EnvMap::sample`](crate::envmap::EnvMap::sample) of `u[1..3]`, with the same density). `None`
     /// when the scene has no light or the sample carries no radiance.
     #[inline]
     pub fn sample_light(
@@ -573,20 +583,14 @@ impl Scene {
                 radiance,
                 ..
             } => {
-                let (k, u1) = match areas {
-                    Some(a) => a.sample_reuse(u[1]),
-                    None => (0, u[1]),
-                };
-                let primitive = &self.accel.primitives()[*first as usize + k];
-                let u2 = [u1, u[2]];
+                let (primitive, u2) = self.pick_primitive(*first, areas.as_ref(), [u[1], u[2]]);
                 // A sphere seen from outside: by the cone it subtends.
                 let (y, cone_pdf) = match primitive {
-                    Primitive::Triangle(t) => (t.sample(u2), None),
                     Primitive::Sphere(s) => match s.sample_cone(x, u2) {
                         Some((y, pdf)) => (y, Some(pdf)),
                         None => (s.sample(u2), None),
                     },
-                    Primitive::Disk(d) => (d.sample(u2), None),
+                    _ => (primitive.sample(u2), None),
                 };
                 let to_light = y.p - x;
                 let dist = to_light.length();

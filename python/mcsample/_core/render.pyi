@@ -41,7 +41,7 @@ class CompiledScene:
 
 def render(
     scene: CompiledScene, spp: int, seed: int | np.random.Generator | None,
-    integrator: Literal["direct", "path"], strategy: Literal["bsdf", "emitter", "mis"],
+    integrator: Literal["direct", "path", "ptracer"], strategy: Literal["bsdf", "emitter", "mis"],
     heuristic: Literal["balance", "power"],
     max_depth: int, rr_depth: int, hide_emitters: bool = False,
     callback: Callable[[int], object] | None = None,
@@ -55,5 +55,5 @@ _Film = tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32],
              list[tuple[int, int]], NDArray[np.float64] | None]
 
 def merge(chunks: list[tuple[list[tuple[int, int]], NDArray[np.float64]]],
-          pixels: int) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32],
+          pixels: int, paths_per_sample: int = 1) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32],
                                 list[tuple[int, int]], NDArray[np.float64]]: ...

@@ -23,7 +23,7 @@ RUNS = 16
 
 
 def render_reference(scene: "Scene", spp: int, *, seed: SeedLike = 0,
-                     integrator: Literal["direct", "path"] | None = None,
+                     integrator: Literal["direct", "path", "ptracer"] | None = None,
                      max_depth: int | None = None, rr_depth: int | None = None,
                      variant: str | None = None,
                      hide_emitters: bool | None = None,
@@ -35,7 +35,9 @@ def render_reference(scene: "Scene", spp: int, *, seed: SeedLike = 0,
     luminance. The film has the scene's filter. Under a Gaussian filter
     (Mitsuba splats each sample onto several pixels and divides by the
     weights, so pixels share samples and the moments do not give a pixel's
-    variance) it renders ``RUNS`` = 16 independent images of
+    variance), and with its ``ptracer`` (light tracing splats every path
+    anywhere on the film; ``moment`` cannot wrap it), it renders
+    ``RUNS`` = 16 independent images of
     ``ceil(spp / 16)`` samples instead: their mean is the image, each
     pixel's luminance variance comes from their spread, and their
     luminances are kept as ``.runs`` for region variances
@@ -61,13 +63,13 @@ def render_reference(scene: "Scene", spp: int, *, seed: SeedLike = 0,
     with variant_set(variant) as mi:
         settings = scene.integrator_settings(integrator, max_depth, rr_depth, hide_emitters)
         kind = settings["integrator"]
-        if kind not in ("path", "direct"):
-            raise ValueError(f"integrator = {kind!r}: must be 'path' or 'direct'")
+        if kind not in ("path", "direct", "ptracer"):
+            raise ValueError(f"integrator = {kind!r}: must be 'path', 'direct' or 'ptracer'")
         nested: dict = {"type": kind, "hide_emitters": settings["hide_emitters"]}
-        if kind == "path":
+        if kind != "direct":
             nested["max_depth"] = int(settings["max_depth"])
             nested["rr_depth"] = int(settings["rr_depth"])
-        runs = 1 if scene.camera.rfilter == "box" else RUNS
+        runs = 1 if scene.camera.rfilter == "box" and kind != "ptracer" else RUNS
         d = scene_dict(scene, spp=-(-spp // runs))
         if sampler is not None:
             if sampler not in MITSUBA_SAMPLERS:

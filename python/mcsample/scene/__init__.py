@@ -35,7 +35,8 @@ The subset (anything else raises ValueError naming the key):
   ``ldsampler`` (sample_count: the default spp; the type: the default
   ``sampler=`` of :func:`mcsample.render`, see ``MITSUBA_SAMPLERS`` in
   :mod:`mcsample.scene.parse`).
-- ``integrator``: ``path`` or ``direct`` (max_depth, rr_depth, hide_emitters): the
+- ``integrator``: ``path``, ``direct`` or ``ptracer`` (max_depth, rr_depth,
+  hide_emitters; ptracer's samples_per_pass is accepted): the
   defaults of :func:`mcsample.render`.
 
 Colours are a float, an RGB triple, ``{"type": "rgb", "value": ...}`` or

@@ -493,8 +493,10 @@ def parse_scene(d: Mapping[str, Any]) -> ParsedScene:
             if camera is not None:
                 raise ValueError(f"{key}: mcsample renders scenes with one sensor")
             camera = _camera(value, key)
-        elif kind in ("path", "direct"):
-            _check_keys(value, {"max_depth", "rr_depth", "hide_emitters"}, key)
+        elif kind in ("path", "direct", "ptracer"):
+            # samples_per_pass only splits Mitsuba's work into passes.
+            _check_keys(value, {"max_depth", "rr_depth", "hide_emitters"}
+                        | ({"samples_per_pass"} if kind == "ptracer" else set()), key)
             integrator = {"integrator": kind,
                           **{k: int(value[k]) for k in ("max_depth", "rr_depth")
                              if k in value}}

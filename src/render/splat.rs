@@ -1,0 +1,264 @@
+//! The film of light tracing: light paths land anywhere on it, so each
+//! pixel's estimate is a sum over all paths of what they splat there.
+//!
+//! A render of `n` samples per pixel traces `N = n·P` light paths (`P`
+//! the film's pixels); path `i` splats values `c` at film positions, each
+//! spread over the pixels around it by the reconstruction filter as
+//! Mitsuba's `ImageBlock::put` spreads it with `normalize`: weights
+//! `w_x w_y` with `w_x = f(x − p_x) / Σ_i f(i − p_x)` over the pixel
+//! centres `i` within the filter's radius (those off the film included, so
+//! light splatted near an edge is partly lost, as in Mitsuba). Pixel `q`'s
+//! value is `I_q = (1/n) Σ_i Σ c w_q = (1/N) Σ_i Y_{i,q}` with
+//! `Y_{i,q} = P Σ c w_q`, the path's total at `q` scaled by `P`: the
+//! paths being independent, the variance of `I_q` is `s²/N` with `s²` the
+//! sample variance of the `Y_{i,q}` over all `N` paths (most of them 0).
+//! The film keeps the [`Sums`] of the `Y` per pixel (each path's values at
+//! a pixel added before squaring), one film per sample index (the `P`
+//! paths of that index), added over the sample index in the tree of
+//! [`film`] so that chunks of samples merge to the bits of one render.
+
+use rayon::prelude::*;
+
+use super::film::{self, Block, Sums, Tree};
+use super::filter::Filter;
+use crate::alloc;
+use crate::error::Result;
+use crate::parallel;
+
+/// A value splatted onto the film.
+#[derive(Clone, Copy, Debug)]
+pub struct Splat {
+    /// The position on the film, in `[0, 1]²` (x right, y down).
+    pub film: [f32; 2],
+    /// The value `c` (RGB).
+    pub value: [f32; 3],
+}
+
+/// A path's value `Y` at one pixel (the pixel's index, row-major).
+pub type Entry = (u32, [f32; 3]);
+
+/// Spreads a path's splats over pixels.
+#[derive(Clone, Debug)]
+pub struct Splatter {
+    filter: Filter,
+    size: [usize; 2],
+    /// `P`, the film's pixels.
+    scale: f32,
+    xs: Vec<(u32, f32)>,
+    ys: Vec<(u32, f32)>,
+    entries: Vec<Entry>,
+}
+
+impl Splatter {
+    /// For a film of `width × height` pixels and `filter`.
+    pub fn new(filter: Filter, (width, height): (usize, usize)) -> Self {
+        Splatter {
+            filter,
+            size: [width, height],
+            scale: (width * height) as f32,
+            xs: Vec::new(),
+            ys: Vec::new(),
+            entries: Vec::new(),
+        }
+    }
+
+    /// Appends to `out` one path's values `Y` (see the module's text) at
+    /// each pixel its `splats` reach, each pixel once, in pixel order.
+    pub fn path(&mut self, splats: &[Splat], out: &mut Vec<Entry>) {
+        self.entries.clear();
+        for s in splats {
+            axis_weights(&self.filter, s.film[0], self.size[0], &mut self.xs);
+            axis_weights(&self.filter, s.film[1], self.size[1], &mut self.ys);
+            for &(y, wy) in &self.ys {
+                for &(x, wx) in &self.xs {
+                    let w = self.scale * wx * wy;
+                    let pixel = y * self.size[0] as u32 + x;
+                    self.entries.push((pixel, s.value.map(|v| v * w)));
+                }
+            }
+        }
+        self.entries.sort_unstable_by_key(|e| e.0);
+        for &(pixel, v) in &self.entries {
+            match out.last_mut() {
+                Some((last, acc)) if *last == pixel => {
+                    *acc = std::array::from_fn(|k| acc[k] + v[k]);
+                }
+                _ => out.push((pixel, v)),
+            }
+        }
+    }
+}
+
+/// The normalised weights along one axis of a splat at film coordinate
+/// `t ∈ [0, 1]` on an axis of `n` pixels: `(pixel, w)` for the pixels on
+/// the film whose centres lie within the filter's radius `r`,
+/// `w = f(i + ½ − tn) / Σ f` over every centre within `r`.
+fn axis_weights(filter: &Filter, t: f32, n: usize, out: &mut Vec<(u32, f32)>) {
+    out.clear();
+    let r = filter.radius();
+    // Offsets from pixel centres: pixel i's centre is at i + ½.
+    let c = f64::from(t) * n as f64 - 0.5;
+    let (lo, hi) = ((c - r).ceil(), (c + r).floor());
+    let mut total = 0.0;
+    let mut i = lo;
+    while i <= hi {
+        let w = filter.eval(i - c);
+        total += w;
+        if i >= 0.0 && i < n as f64 && w > 0.0 {
+            out.push((i as u32, w as f32));
+        }
+        i += 1.0;
+    }
+    if total > 0.0 {
+        let inv = (1.0 / total) as f32;
+        out.iter_mut().for_each(|(_, w)| *w *= inv);
+    } else {
+        out.clear();
+    }
+}
+
+/// The per-pixel [`Sums`] of a light-tracing render, one film per block
+/// of sample indices.
+#[derive(Debug)]
+pub struct SplatFilm {
+    pixels: usize,
+    tree: Tree<Vec<Sums>>,
+}
+
+/// A finished light-tracing film: per pixel its mean and variances (as
+/// [`film::finish_pixel`] writes them) and, when asked for, its sums per
+/// block.
+#[derive(Debug)]
+pub struct Developed {
+    /// Mean per pixel and channel.
+    pub mean: Vec<f32>,
+    /// Variance of each pixel's mean per channel.
+    pub variance: Vec<f32>,
+    /// Variance of each pixel's mean luminance.
+    pub luminance_variance: Vec<f32>,
+    /// The blocks of sample indices rendered.
+    pub blocks: Vec<Block>,
+    /// Sums per pixel and block (8 each), or empty.
+    pub sums: Vec<f64>,
+}
+
+impl SplatFilm {
+    /// An empty film of `pixels` pixels.
+    pub fn new(pixels: usize) -> Self {
+        SplatFilm {
+            pixels,
+            tree: Tree::new(),
+        }
+    }
+
+    /// Adds the `P` paths of sample index `index`: their entries, in the
+    /// order given (the same order whatever the threads, so the same bits).
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when the film does not fit in memory.
+    pub fn add_sample<'a>(
+        &mut self,
+        index: u64,
+        parts: impl Iterator<Item = &'a [Entry]>,
+    ) -> Result<()> {
+        let mut leaf = alloc::filled(self.pixels, Sums::default(), "the light tracer's film")?;
+        for &(pixel, y) in parts.flatten() {
+            let s = &mut leaf[pixel as usize];
+            *s = film::add(s, &film::sums_of(y));
+        }
+        self.tree.push_into(Block::sample(index), leaf, |a, b| {
+            a.par_iter_mut()
+                .zip(b)
+                .for_each(|(a, b)| *a = film::add(a, &b));
+        })
+    }
+
+    /// The film's estimate, from `paths_per_sample` paths per sample index
+    /// (`N = n·P` in the module's text), with the sums per block when
+    /// `keep_sums`.
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when the outputs do not fit in memory; or
+    /// when the thread pool cannot start.
+    pub fn develop(self, paths_per_sample: u64, keep_sums: bool) -> Result<Developed> {
+        let pixels = self.pixels;
+        let nodes = self.tree.nodes();
+        let count: u64 = nodes.iter().map(|(b, _)| b.len).sum();
+        let per_pixel = if keep_sums { nodes.len() * 8 } else { 0 };
+        const WHAT: &str = "the light tracer's image";
+        let mut out = Developed {
+            mean: alloc::filled(pixels * 3, 0.0f32, WHAT)?,
+            variance: alloc::filled(pixels * 3, 0.0f32, WHAT)?,
+            luminance_variance: alloc::filled(pixels, 0.0f32, WHAT)?,
+            blocks: nodes.iter().map(|(b, _)| *b).collect(),
+            sums: alloc::filled(pixels * per_pixel, 0.0f64, WHAT)?,
+        };
+        let mut sums_rows: Vec<&mut [f64]> = alloc::with_capacity(pixels, WHAT)?;
+        if per_pixel > 0 {
+            sums_rows.extend(out.sums.chunks_mut(per_pixel));
+        } else {
+            sums_rows.extend((0..pixels).map(|_| &mut [][..]));
+        }
+        parallel::install(|| {
+            out.mean
+                .par_chunks_mut(3)
+                .zip(out.variance.par_chunks_mut(3))
+                .zip(out.luminance_variance.par_iter_mut())
+                .zip(sums_rows.into_par_iter())
+                .enumerate()
+                .for_each_init(Vec::new, |blocks, (p, (((mean, var), lum), sums))| {
+                    blocks.clear();
+                    blocks.extend(nodes.iter().map(|(_, film)| film[p]));
+                    film::finish_pixel(blocks, count * paths_per_sample, (mean, var), lum, sums);
+                });
+        })?;
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn box_splats_land_in_one_pixel_and_gaussian_weights_sum_to_one_inside() {
+        let mut w = Vec::new();
+        axis_weights(&Filter::Box, 0.33, 10, &mut w);
+        assert_eq!(w, [(3, 1.0)]);
+        let g = Filter::gaussian(0.5).unwrap();
+        axis_weights(&g, 0.5, 10, &mut w);
+        let total: f32 = w.iter().map(|x| x.1).sum();
+        assert!((total - 1.0).abs() < 1e-6, "{total}");
+        assert!(w.len() == 4 && w.iter().all(|&(i, _)| (3..=6).contains(&i)));
+        // At the edge, the weights off the film are lost.
+        axis_weights(&g, 0.0, 10, &mut w);
+        let total: f32 = w.iter().map(|x| x.1).sum();
+        assert!((total - 0.5).abs() < 1e-6, "{total}");
+    }
+
+    #[test]
+    fn a_path_adds_its_values_at_a_pixel_before_they_are_squared() {
+        let mut s = Splatter::new(Filter::Box, (4, 2));
+        let mut out = Vec::new();
+        let at = |x: f32, y: f32, v: f32| Splat {
+            film: [x, y],
+            value: [v; 3],
+        };
+        s.path(
+            &[at(0.9, 0.9, 1.0), at(0.1, 0.1, 2.0), at(0.95, 0.6, 3.0)],
+            &mut out,
+        );
+        // P = 8: pixel 0 gets 2·8, pixel 7 gets (1 + 3)·8.
+        assert_eq!(out, [(0, [16.0; 3]), (7, [32.0; 3])]);
+        let mut film = SplatFilm::new(8);
+        film.add_sample(0, [&out[..]].into_iter()).unwrap();
+        film.add_sample(1, std::iter::empty()).unwrap();
+        let d = film.develop(8, false).unwrap();
+        // 16 paths: pixel 7's mean 32/16 = 2 = (1 + 3)/2 samples.
+        assert_eq!(d.mean[21], 2.0);
+        // Variance of the mean: (32² − 32²/16)/15/16.
+        let expected = (1024.0 - 64.0) / 15.0 / 16.0;
+        assert!((d.variance[21] - expected).abs() < 1e-4);
+        assert_eq!(d.blocks, [Block { start: 0, len: 2 }]);
+    }
+}
