@@ -48,7 +48,7 @@ def main(argv: list[str] | None = None) -> int:
     rend.add_argument("-o", "--out", default="render.exr", help="output .exr (a .png is "
                       "written beside it)")
     rend.add_argument("--spp", type=_int(1), default=None)
-    rend.add_argument("--integrator", choices=["direct", "path", "ptracer"], default=None)
+    rend.add_argument("--integrator", choices=["direct", "path", "ptracer", "bdpt"], default=None)
     rend.add_argument("--strategy", choices=["bsdf", "emitter", "mis"], default="mis")
     rend.add_argument("--heuristic", choices=["balance", "power"], default="power")
     rend.add_argument("--max-depth", type=_int(-1, 2**32 - 1), default=None,

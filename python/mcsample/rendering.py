@@ -42,7 +42,7 @@ def _progress_bar(total: int, enabled: bool) -> tuple[Callable[[int], None] | No
 
 
 def render(scene: Scene, spp: int | None = None, *,
-           integrator: Literal["direct", "path", "ptracer"] | None = None,
+           integrator: Literal["direct", "path", "ptracer", "bdpt"] | None = None,
            strategy: Literal["bsdf", "emitter", "mis"] = "mis",
            heuristic: Literal["balance", "power"] = "power", max_depth: int | None = None,
            rr_depth: int | None = None, seed: SeedLike = 0, progress: bool = True,
@@ -56,7 +56,7 @@ def render(scene: Scene, spp: int | None = None, *,
         From :meth:`mcsample.Scene.from_mitsuba`.
     spp : int, optional
         Samples per pixel (default: the scene's sampler ``sample_count``, else 16).
-    integrator : "direct", "path" or "ptracer", optional
+    integrator : "direct", "path", "ptracer" or "bdpt", optional
         Direct illumination (emitted + direct light), path tracing with
         next-event estimation and Russian roulette, or light tracing (as
         Mitsuba's ``ptracer``: ``spp`` × H × W paths start on the lights,
@@ -64,8 +64,16 @@ def render(scene: Scene, spp: int | None = None, *,
         with the scene's filter, normalised as Mitsuba's; lights seen
         directly are connected to the camera from a point drawn on them;
         the variance of each pixel comes from its value on every path).
-        ``strategy`` and ``heuristic`` do not apply to "ptracer". Default:
-        the scene dict's integrator, else "path".
+        "bdpt" is bidirectional path tracing (Veach; as pbrt-v4's): per
+        sample a camera subpath and a light subpath, joined in every way
+        (s light vertices, t camera vertices: the camera path hitting a
+        light, next-event estimation, light tracing's connection to the
+        camera, and every other join), weighted by ``heuristic`` over all
+        the ways; its light connections and camera samples are splatted
+        alike (with the Gaussian filter, the normalised splat of
+        "ptracer"), and each pixel's variance comes from its per-sample
+        totals. ``strategy`` does not apply to "ptracer" and "bdpt".
+        Default: the scene dict's integrator, else "path".
     strategy : "bsdf", "emitter" or "mis"
         How light is found: BSDF sampling, emitter sampling (envmap
         importance sampling; area lights uniformly by area, converted to

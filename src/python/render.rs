@@ -445,6 +445,7 @@ pub fn render<'py>(
                 ("direct", Integrator::Direct),
                 ("path", Integrator::Path),
                 ("ptracer", Integrator::Ptracer),
+                ("bdpt", Integrator::Bdpt),
             ],
         )?,
         strategy: choice(

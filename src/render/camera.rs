@@ -235,6 +235,29 @@ impl Camera {
         }
     }
 
+    /// The world position at time `tau` of the lens point that `u` places
+    /// (the pinhole, or a point of the thin lens's aperture).
+    pub fn lens_point_at(&self, u: [f32; 2], tau: f32) -> Vec3A {
+        self.placed(tau).0.transform_point3a(self.lens_point(u))
+    }
+
+    /// The density per steradian with which the camera at time `tau`,
+    /// from its lens point `lens` (world), sends rays along the unit world
+    /// direction `d`: `1 / (A cos³θ)` when the ray lands on the film, else
+    /// 0 (Mitsuba's and pbrt's `pdf` of a perspective camera's direction,
+    /// the film position drawn uniformly).
+    pub fn pdf_direction(&self, lens: Vec3A, d: Vec3A, tau: f32) -> f32 {
+        let to_local = self.placed(tau).1;
+        let local = to_local.transform_vector3a(d).normalize();
+        match self.film_through(to_local.transform_point3a(lens), local) {
+            Some(_) => {
+                let cos = local.z;
+                1.0 / (4.0 * self.tan_half.x * self.tan_half.y * cos * cos * cos)
+            }
+            None => 0.0,
+        }
+    }
+
     /// The connection from world point `x` to the camera where it stands at
     /// time `tau` of the shutter (in `[0, 1]`), with `u` placing the point
     /// on a thin lens's aperture (concentric disk); `None` when `x` lies

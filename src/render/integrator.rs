@@ -77,6 +77,8 @@ pub enum Integrator {
     /// Light tracing ([`super::ptracer`]): paths from the lights, each
     /// vertex connected to the camera.
     Ptracer,
+    /// Bidirectional path tracing ([`super::bdpt`]).
+    Bdpt,
 }
 
 /// How light is found at each shading point.
@@ -122,7 +124,9 @@ impl Settings {
     pub(super) fn max_depth(&self) -> u32 {
         match self.integrator {
             Integrator::Direct => 2,
-            Integrator::Path | Integrator::Ptracer => self.max_depth.unwrap_or(u32::MAX),
+            Integrator::Path | Integrator::Ptracer | Integrator::Bdpt => {
+                self.max_depth.unwrap_or(u32::MAX)
+            }
         }
     }
 }
@@ -155,7 +159,7 @@ pub(crate) fn shadow_ray(p: Vec3A, n: Vec3A, ls: &LightSample) -> Ray {
             d: ls.d,
             tmax: f32::INFINITY,
         },
-        Some(y) => {
+        Some((y, _)) => {
             let to = offset(y.p, y.ng, -ls.d) - o;
             let tmax = to.length();
             Ray {

@@ -33,6 +33,7 @@
 //! table's running sums would wait on each of its loads in turn.
 
 pub mod accel;
+pub mod bdpt;
 pub mod camera;
 pub mod environment;
 pub mod film;
@@ -45,6 +46,7 @@ pub mod ptracer;
 pub mod scene;
 pub mod shape;
 pub mod splat;
+pub mod splatting;
 #[cfg(test)]
 mod tests;
 
@@ -336,8 +338,16 @@ pub fn render(
     if settings.sampler == Sampler::ZSobol {
         ZOrder::check((width, height), samples.total)?;
     }
-    if settings.integrator == Integrator::Ptracer {
-        return ptracer::render(scene, samples, seed, settings, progress);
+    match settings.integrator {
+        Integrator::Ptracer => {
+            let paths = ptracer::LightPaths { scene, settings };
+            return splatting::render(scene, samples, (seed, settings), progress, &paths);
+        }
+        Integrator::Bdpt => {
+            let paths = bdpt::Bidirectional { scene, settings };
+            return splatting::render(scene, samples, (seed, settings), progress, &paths);
+        }
+        Integrator::Direct | Integrator::Path => {}
     }
     let spp = samples.count.max(1) as usize;
     let blocks = film::blocks(samples.first, u64::from(samples.count));

@@ -43,22 +43,16 @@
 //! counts, as in Mitsuba).
 
 use glam::Vec3A;
-use rayon::prelude::*;
-use std::ops::Range;
-use std::sync::atomic::Ordering;
 
+use super::Settings;
 use super::camera::SensorSample;
 use super::integrator::offset;
 use super::scene::{Emission, Scene};
 use super::shape::{Ray, SurfacePoint};
-use super::splat::{Entry, Splat, SplatFilm, Splatter};
-use super::{Image, Progress, Samples, Settings, mix, start_sample};
-use crate::error::Result;
+use super::splat::Splat;
+use super::splatting::Paths;
 use crate::frame::Frame;
-use crate::parallel;
-use crate::rng::Rng;
 use crate::sampler::Stream;
-use crate::sampler::zorder::ZOrder;
 use crate::warp;
 
 /// The dimensions of a light path's sample, in this order: the time, the
@@ -100,107 +94,23 @@ pub mod dims {
     }
 }
 
-/// Light paths per parallel task.
-const CHUNK: usize = 512;
-
-/// Renders samples `samples.first ..` of `scene` by light tracing: for
-/// each sample index, one path per pixel, the paths in parallel (in
-/// fixed chunks whose splats are added in order: the same bits at any
-/// thread count); [`Progress::samples`] counts paths.
-///
-/// # Errors
-/// As [`super::render`].
-pub fn render(
-    scene: &Scene,
-    samples: Samples,
-    seed: u64,
-    settings: &Settings,
-    progress: &Progress,
-) -> Result<Image> {
-    let (width, height) = scene.film();
-    let pixels = width * height;
-    let chunks: Vec<Range<usize>> = (0..pixels)
-        .step_by(CHUNK)
-        .map(|a| a..(a + CHUNK).min(pixels))
-        .collect();
-    let mut film = SplatFilm::new(pixels);
-    parallel::install(|| -> Result<()> {
-        for index in samples.first..samples.first + u64::from(samples.count) {
-            let parts: Vec<Vec<Entry>> = chunks
-                .par_iter()
-                .map_init(
-                    || Tracer::new(scene),
-                    |tracer, range| {
-                        if progress.cancel.load(Ordering::Relaxed) {
-                            return Vec::new();
-                        }
-                        tracer.run(scene, settings, (seed, samples.total), index, range.clone())
-                    },
-                )
-                .collect();
-            if progress.cancel.load(Ordering::Relaxed) {
-                break;
-            }
-            film.add_sample(index, parts.iter().map(Vec::as_slice))?;
-            progress.samples.fetch_add(pixels as u64, Ordering::Relaxed);
-        }
-        Ok(())
-    })??;
-    let developed = film.develop(pixels as u64, samples.keep_sums)?;
-    Ok(Image {
-        width,
-        height,
-        mean: developed.mean,
-        variance: developed.variance,
-        luminance_variance: developed.luminance_variance,
-        blocks: developed.blocks,
-        sums: developed.sums,
-        cancelled: progress.cancel.load(Ordering::Relaxed),
-    })
+/// Light tracing as a [`Paths`] integrator: the path of "pixel" `j` is
+/// just the `j`-th light path of its sample index.
+pub struct LightPaths<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// The settings (`max_depth`, `rr_depth`, `hide_emitters`).
+    pub settings: &'a Settings,
 }
 
-/// One thread's buffers.
-struct Tracer {
-    splats: Vec<Splat>,
-    splatter: Splatter,
-}
+impl Paths for LightPaths<'_> {
+    type Scratch = ();
+    const PER_PATH: bool = true;
 
-impl Tracer {
-    fn new(scene: &Scene) -> Self {
-        Tracer {
-            splats: Vec::new(),
-            splatter: Splatter::new(scene.filter().filter(), scene.film()),
-        }
-    }
+    fn scratch(&self) {}
 
-    /// The entries of the paths `paths` of sample index `index`, path
-    /// after path.
-    fn run(
-        &mut self,
-        scene: &Scene,
-        settings: &Settings,
-        (seed, total): (u64, u64),
-        index: u64,
-        paths: Range<usize>,
-    ) -> Vec<Entry> {
-        let (width, height) = scene.film();
-        let mut out = Vec::new();
-        for j in paths {
-            let pixel = j as u64;
-            let key = mix(seed, pixel);
-            let mut stream = Stream::new(
-                settings.sampler,
-                key,
-                Rng::new(key, pixel),
-                total,
-                ZOrder::new((j % width, j / width), (width, height), total, seed),
-            );
-            start_sample(&mut stream, key, pixel, index);
-            self.splats.clear();
-            light_path(scene, settings, &mut stream, &mut self.splats);
-            self.splatter.path(&self.splats, &mut out);
-        }
-        out
+    fn trace(&self, (): &mut (), stream: &mut Stream, _pixel: usize, out: &mut Vec<Splat>) {
+        light_path(self.scene, self.settings, stream, out);
     }
 }
 
@@ -303,12 +213,13 @@ fn light_path(scene: &Scene, settings: &Settings, stream: &mut Stream, out: &mut
 /// The first ray of a light path and its weight `β₀` (see the module's
 /// text), `u` drawing its direction (area light) or its point on the disk
 /// (environment).
-fn emitted_ray(scene: &Scene, emission: Emission, u: [f32; 2]) -> (Ray, [f32; 3]) {
+pub(super) fn emitted_ray(scene: &Scene, emission: Emission, u: [f32; 2]) -> (Ray, [f32; 3]) {
     match emission {
         Emission::Surface {
             point,
             pdf,
             radiance,
+            ..
         } => {
             let frame = Frame::from_normal(point.ng.to_array());
             let local = warp::square_to_cosine_hemisphere(u);
@@ -355,6 +266,7 @@ fn seen_directly(scene: &Scene, u: [f32; 3], lens: [f32; 2], tau: f32) -> Option
             point,
             pdf,
             radiance,
+            ..
         } => {
             let c = camera.sample_direction(point.p, lens, tau)?;
             let cos = point.ng.dot(c.d);

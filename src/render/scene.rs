@@ -85,9 +85,9 @@ pub struct LightSample {
     pub pdf: f32,
     /// Radiance arriving along `d` (before the visibility test).
     pub radiance: [f32; 3],
-    /// The point on an area light (where the shadow ray ends), `None` for
-    /// the environment.
-    pub point: Option<SurfacePoint>,
+    /// The point on an area light (where the shadow ray ends) and its
+    /// shape, `None` for the environment.
+    pub point: Option<(SurfacePoint, u32)>,
 }
 
 /// Where light starts ([`Scene::sample_emission`]).
@@ -95,6 +95,8 @@ pub struct LightSample {
 pub enum Emission {
     /// A point on an area light.
     Surface {
+        /// The shape it lies on.
+        shape: u32,
         /// The point (light leaves its front side, along `ng`).
         point: SurfacePoint,
         /// Density per unit area, including the choice of the light.
@@ -428,6 +430,26 @@ impl Scene {
         pmf * dist * dist / (cos * total_area)
     }
 
+    /// The density per unit area with which [`Scene::sample_emission`]
+    /// draws a point of shape `shape` (0 unless it is an area light): the
+    /// choice of its light over its area.
+    pub fn emission_pdf(&self, shape: u32) -> f32 {
+        let light = self.light_of_shape[shape as usize];
+        match light.map(|l| &self.lights[l as usize]) {
+            Some(Light::Area { total_area, .. }) => self.choice_pmf(light) / total_area,
+            _ => 0.0,
+        }
+    }
+
+    /// The density per steradian with which [`Scene::sample_light`] and
+    /// [`Scene::sample_emission`] draw the environment direction `d` (the
+    /// choice of the environment included).
+    pub fn environment_pdf(&self, d: Vec3A) -> f32 {
+        self.environment
+            .as_ref()
+            .map_or(0.0, |env| self.choice_pmf(self.env_light) * env.pdf(d))
+    }
+
     /// `out[i]`: the density per steradian with which emitter sampling
     /// draws the environment direction `d[i]` (the choice of the
     /// environment among the lights included).
@@ -530,6 +552,7 @@ impl Scene {
                 })
             }
             Light::Area {
+                shape,
                 first,
                 areas,
                 total_area,
@@ -538,6 +561,7 @@ impl Scene {
             } => {
                 let (primitive, u2) = self.pick_primitive(*first, areas.as_ref(), [u[1], u[2]]);
                 Some(Emission::Surface {
+                    shape: *shape,
                     point: primitive.sample(u2),
                     pdf: pmf / total_area,
                     radiance: *radiance,
@@ -577,6 +601,7 @@ impl Scene {
                 })
             }
             Light::Area {
+                shape,
                 first,
                 areas,
                 total_area,
@@ -605,7 +630,7 @@ impl Scene {
                     dist,
                     pdf: pmf * pdf,
                     radiance: *radiance,
-                    point: Some(y),
+                    point: Some((y, *shape)),
                 })
             }
         }

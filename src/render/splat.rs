@@ -1,5 +1,6 @@
-//! The film of light tracing: light paths land anywhere on it, so each
-//! pixel's estimate is a sum over all paths of what they splat there.
+//! The film of light tracing (and of bidirectional path tracing): light
+//! paths land anywhere on it, so each pixel's estimate is a sum over all
+//! paths of what they splat there.
 //!
 //! A render of `n` samples per pixel traces `N = n·P` light paths (`P`
 //! the film's pixels); path `i` splats values `c` at film positions, each
@@ -16,6 +17,9 @@
 //! a pixel added before squaring), one film per sample index (the `P`
 //! paths of that index), added over the sample index in the tree of
 //! [`film`] so that chunks of samples merge to the bits of one render.
+//! Where paths are not alike (a camera path splats its own pixel), the
+//! film keeps instead the sums of each sample index's total at a pixel, an
+//! estimate of the pixel on its own ([`SplatFilm::new`]).
 
 use rayon::prelude::*;
 
@@ -42,7 +46,7 @@ pub type Entry = (u32, [f32; 3]);
 pub struct Splatter {
     filter: Filter,
     size: [usize; 2],
-    /// `P`, the film's pixels.
+    /// `P`, the film's pixels, or 1 (see [`SplatFilm::new`]).
     scale: f32,
     xs: Vec<(u32, f32)>,
     ys: Vec<(u32, f32)>,
@@ -50,12 +54,13 @@ pub struct Splatter {
 }
 
 impl Splatter {
-    /// For a film of `width × height` pixels and `filter`.
-    pub fn new(filter: Filter, (width, height): (usize, usize)) -> Self {
+    /// For a film of `width × height` pixels and `filter`, values scaled
+    /// by `scale` (`P` for a per-path variance, else 1).
+    pub fn new(filter: Filter, (width, height): (usize, usize), scale: f32) -> Self {
         Splatter {
             filter,
             size: [width, height],
-            scale: (width * height) as f32,
+            scale,
             xs: Vec::new(),
             ys: Vec::new(),
             entries: Vec::new(),
@@ -117,15 +122,16 @@ fn axis_weights(filter: &Filter, t: f32, n: usize, out: &mut Vec<(u32, f32)>) {
     }
 }
 
-/// The per-pixel [`Sums`] of a light-tracing render, one film per block
-/// of sample indices.
+/// The per-pixel [`Sums`] of a splatting render, one film per block of
+/// sample indices.
 #[derive(Debug)]
 pub struct SplatFilm {
     pixels: usize,
+    per_path: bool,
     tree: Tree<Vec<Sums>>,
 }
 
-/// A finished light-tracing film: per pixel its mean and variances (as
+/// A finished splatting film: per pixel its mean and variances (as
 /// [`film::finish_pixel`] writes them) and, when asked for, its sums per
 /// block.
 #[derive(Debug)]
@@ -143,10 +149,17 @@ pub struct Developed {
 }
 
 impl SplatFilm {
-    /// An empty film of `pixels` pixels.
-    pub fn new(pixels: usize) -> Self {
+    /// An empty film of `pixels` pixels. With `per_path`, the sums are
+    /// those of each path's values `Y` (the module's text); else of each
+    /// sample index's total at the pixel, `X_q = Σ_paths Σ c w_q` (whose
+    /// mean over the sample indices is the pixel's estimate, and whose
+    /// spread over them its variance: for an integrator whose paths
+    /// differ from pixel to pixel, as bidirectional path tracing's camera
+    /// paths).
+    pub fn new(pixels: usize, per_path: bool) -> Self {
         SplatFilm {
             pixels,
+            per_path,
             tree: Tree::new(),
         }
     }
@@ -161,10 +174,22 @@ impl SplatFilm {
         index: u64,
         parts: impl Iterator<Item = &'a [Entry]>,
     ) -> Result<()> {
-        let mut leaf = alloc::filled(self.pixels, Sums::default(), "the light tracer's film")?;
-        for &(pixel, y) in parts.flatten() {
-            let s = &mut leaf[pixel as usize];
-            *s = film::add(s, &film::sums_of(y));
+        const WHAT: &str = "the splatting film";
+        let mut leaf = alloc::filled(self.pixels, Sums::default(), WHAT)?;
+        if self.per_path {
+            for &(pixel, y) in parts.flatten() {
+                let s = &mut leaf[pixel as usize];
+                *s = film::add(s, &film::sums_of(y));
+            }
+        } else {
+            let mut totals = alloc::filled(self.pixels, [0.0f64; 3], WHAT)?;
+            for &(pixel, x) in parts.flatten() {
+                let t = &mut totals[pixel as usize];
+                *t = std::array::from_fn(|k| t[k] + f64::from(x[k]));
+            }
+            for (s, t) in leaf.iter_mut().zip(&totals) {
+                *s = film::sums_of(t.map(|v| v as f32));
+            }
         }
         self.tree.push_into(Block::sample(index), leaf, |a, b| {
             a.par_iter_mut()
@@ -173,9 +198,9 @@ impl SplatFilm {
         })
     }
 
-    /// The film's estimate, from `paths_per_sample` paths per sample index
-    /// (`N = n·P` in the module's text), with the sums per block when
-    /// `keep_sums`.
+    /// The film's estimate, from `paths_per_sample` samples of `Y` per
+    /// sample index (`P`, for `N = n·P` in the module's text; 1 for sums
+    /// per sample index), with the sums per block when `keep_sums`.
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the outputs do not fit in memory; or
@@ -238,7 +263,7 @@ mod tests {
 
     #[test]
     fn a_path_adds_its_values_at_a_pixel_before_they_are_squared() {
-        let mut s = Splatter::new(Filter::Box, (4, 2));
+        let mut s = Splatter::new(Filter::Box, (4, 2), 8.0);
         let mut out = Vec::new();
         let at = |x: f32, y: f32, v: f32| Splat {
             film: [x, y],
@@ -250,7 +275,7 @@ mod tests {
         );
         // P = 8: pixel 0 gets 2·8, pixel 7 gets (1 + 3)·8.
         assert_eq!(out, [(0, [16.0; 3]), (7, [32.0; 3])]);
-        let mut film = SplatFilm::new(8);
+        let mut film = SplatFilm::new(8, true);
         film.add_sample(0, [&out[..]].into_iter()).unwrap();
         film.add_sample(1, std::iter::empty()).unwrap();
         let d = film.develop(8, false).unwrap();

@@ -41,7 +41,7 @@ class CompiledScene:
 
 def render(
     scene: CompiledScene, spp: int, seed: int | np.random.Generator | None,
-    integrator: Literal["direct", "path", "ptracer"], strategy: Literal["bsdf", "emitter", "mis"],
+    integrator: Literal["direct", "path", "ptracer", "bdpt"], strategy: Literal["bsdf", "emitter", "mis"],
     heuristic: Literal["balance", "power"],
     max_depth: int, rr_depth: int, hide_emitters: bool = False,
     callback: Callable[[int], object] | None = None,
