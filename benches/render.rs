@@ -116,6 +116,7 @@ fn main() {
                 rr_depth: 5,
                 hide_emitters: false,
                 sampler,
+                strategies: false,
             };
             let mut times: Vec<f64> = (0..5)
                 .map(|seed| {

@@ -14,10 +14,13 @@ Mitsuba 3's own ``ptracer``: the same, with the box and the Gaussian
 filter (whose normalised splats are Mitsuba's). The variance of a pixel
 comes from its value on every light path: its calibration is tested over
 independent seeds. Chunks of samples merge to the bits of one render, at
-any thread count.
+any thread count (these two also for bidirectional path tracing, which
+shares the light tracer's film).
 """
 
 from __future__ import annotations
+
+import functools
 
 import numpy as np
 import pytest
@@ -109,13 +112,15 @@ def test_path_lengths_are_mitsubas(max_depth):
     assert t.passed, t.message
 
 
-def test_variance_is_that_of_the_pixel_means_over_seeds():
-    """Each pixel's reported variance (from its value on every light path)
-    against the spread of its mean over 24 independent renders: their
-    ratio, pooled over the pixels the light reaches, lies near 1."""
+@pytest.mark.parametrize("integrator", ["ptracer", "bdpt"])
+def test_variance_is_that_of_the_pixel_means_over_seeds(integrator):
+    """Each pixel's reported variance (light tracing: from its value on
+    every light path; bidirectional: from its per-sample totals) against
+    the spread of its mean over 24 independent renders: their ratio, pooled
+    over the pixels the light reaches, lies near 1."""
     d = area_lit_floor("rectangle", "near", width=16, height=12)
     scene = mcs.Scene.from_mitsuba(d)
-    runs = [mcs.render(scene, 16, seed=100 + k, progress=False, integrator="ptracer")
+    runs = [mcs.render(scene, 16, seed=100 + k, progress=False, integrator=integrator)
             for k in range(24)]
     y = np.stack([r.luminance for r in runs])
     reported = np.mean([r.luminance_variance for r in runs], axis=0)
@@ -125,23 +130,23 @@ def test_variance_is_that_of_the_pixel_means_over_seeds():
     assert 0.8 < ratio < 1.25
 
 
-def test_chunks_merge_to_one_render_at_any_thread_count():
+@pytest.mark.parametrize("integrator", ["ptracer", "bdpt"])
+def test_chunks_merge_to_one_render_at_any_thread_count(integrator):
     scene, _, _ = _scene("sphere on plane, sky and light")
+    render = functools.partial(mcs.render, scene, seed=5, progress=False, integrator=integrator)
     mcs.set_num_threads(1)
-    whole = mcs.render(scene, 6, seed=5, progress=False)
+    whole = render(6)
     mcs.set_num_threads(2)
-    again = mcs.render(scene, 6, seed=5, progress=False)
-    chunks = [mcs.render(scene, n, seed=5, progress=False, first_sample=k)
-              for k, n in [(0, 1), (1, 3), (4, 2)]]
-    merged = mcs.RenderResult.merge(chunks)
+    again = render(6)
+    merged = mcs.RenderResult.merge([render(n, first_sample=k)
+                                     for k, n in [(0, 1), (1, 3), (4, 2)]])
     for r in (again, merged):
         np.testing.assert_array_equal(r.image, whole.image)
         np.testing.assert_array_equal(r.variance, whole.variance)
         np.testing.assert_array_equal(r.luminance_variance, whole.luminance_variance)
     assert merged.spp == 6
     # Another seed gives another image.
-    other = mcs.render(scene, 6, seed=6, progress=False)
-    assert not np.array_equal(other.image, whole.image)
+    assert not np.array_equal(render(6, seed=6).image, whole.image)
 
 
 def test_a_scene_dict_names_the_light_tracer():

@@ -35,6 +35,7 @@ __all__ = [
     "image",
     "phong_lobe",
     "samples",
+    "strategies",
     "tonemap",
 ]
 
@@ -180,6 +181,36 @@ def compare(images: Mapping[str, Any], reference: Any, exposure: float = 0.0,
 
 # --------------------------------------------------------------------------
 # Samples and histograms
+
+
+def strategies(result: Any, weighted: bool = True, exposure: float = 0.0,
+               fig: Figure | None = None) -> Figure:
+    """The images of a bidirectional render's strategies (``mcsample.render
+    (..., integrator="bdpt", strategies=True)``), as pbrt-v4's "visualize
+    strategies": one row per path length (segments), one column per number
+    of light vertices ``s`` (``t`` camera vertices), each tone-mapped with
+    ``exposure``. ``weighted``: each strategy's MIS-weighted contribution
+    (a row adds up to that length's light); else each strategy's estimate
+    alone (every image of a row estimates the same light, with its own
+    noise)."""
+    images = getattr(result, "strategies", None)
+    if not images:
+        raise ValueError("result has no strategy images: render with integrator='bdpt', "
+                         "strategies=True")
+    depth = max(v.depth for v in images.values())
+    columns = depth + 1
+    h, w = next(iter(images.values())).weighted.shape[:2]
+    if fig is None:
+        fig = _figure(figsize=(1.8 * columns, 1.8 * depth * h / w + 0.6), layout="constrained")
+    axes = fig.subplots(depth, columns, squeeze=False)
+    for ax in axes.flat:
+        ax.set_axis_off()
+    for (s, t), v in sorted(images.items()):
+        image(v.weighted if weighted else v.unweighted, exposure, ax=axes[v.depth - 1, s],
+              title=f"s={s}, t={t}")
+    fig.suptitle(f"bidirectional strategies ({'weighted' if weighted else 'unweighted'}); "
+                 "rows: path length 1 .. " + str(depth))
+    return fig
 
 
 def samples(points: Any, domain: DomainLike = "square", projection: str = "flat",

@@ -13,7 +13,7 @@ import warnings
 from typing import Any, Callable, Literal
 
 from ._core.render import render as _render
-from .results import Chunk, RenderResult
+from .results import Chunk, RenderResult, StrategyImage
 from .estimators import Sampler
 from .scene import Scene
 from .scene.parse import MITSUBA_SAMPLERS
@@ -47,7 +47,8 @@ def render(scene: Scene, spp: int | None = None, *,
            heuristic: Literal["balance", "power"] = "power", max_depth: int | None = None,
            rr_depth: int | None = None, seed: SeedLike = 0, progress: bool = True,
            hide_emitters: bool | None = None, sampler: Sampler | None = None,
-           first_sample: int | None = None, total_spp: int | None = None) -> RenderResult:
+           first_sample: int | None = None, total_spp: int | None = None,
+           strategies: bool = False) -> RenderResult:
     """Renders ``scene`` with ``spp`` samples per pixel.
 
     Parameters
@@ -132,6 +133,15 @@ def render(scene: Scene, spp: int | None = None, *,
         one render must all give it (the independent sampler ignores it: an
         independent render can be continued with more samples).
 
+    strategies : bool
+        With ``integrator="bdpt"`` and a ``max_depth`` in [1, 64]: also
+        render the image of each strategy (s, t) (s light vertices, t camera
+        vertices; path length s + t - 1 segments), weighted by its MIS weight
+        (the render is their sum) and unweighted (each an estimate, on its
+        own, of the light carried by paths of that length), as pbrt-v4's
+        "visualize strategies": ``.strategies`` of the result,
+        :func:`mcsample.plot.strategies` draws them.
+
     Everything after ``spp`` is keyword-only.
 
     Returns
@@ -154,7 +164,7 @@ def render(scene: Scene, spp: int | None = None, *,
         image, variance, lum_var, blocks, sums = _render(
             scene.compiled, spp, seed, settings["integrator"], strategy, heuristic,
             settings["max_depth"], settings["rr_depth"], settings["hide_emitters"], callback,
-            sampler, first_sample, total_spp, first_sample is not None)
+            sampler, first_sample, total_spp, first_sample is not None, strategies)
     finally:
         if bar is not None:
             bar.close()
@@ -170,5 +180,15 @@ def render(scene: Scene, spp: int | None = None, *,
         chunk = Chunk(blocks, sums, (scene.shape, seed, sampler, total, strategy_name, heuristic,
                                      tuple(sorted(settings.items()))),
                       height * width if settings["integrator"] == "ptracer" else 1)
-    return RenderResult(image.reshape(height, width, 3), variance.reshape(height, width, 3),
-                        lum_var.reshape(height, width), int(spp), seconds, first, chunk)
+    # The render, then (with strategies) each strategy's two images.
+    image, variance = (a.reshape(-1, height, width, 3) for a in (image, variance))
+    lum_var = lum_var.reshape(-1, height, width)
+    images = None
+    if strategies:
+        from ._core.render import bdpt_strategies
+
+        images = {(s, t): StrategyImage(s, t, image[1 + 2 * i], image[2 + 2 * i],
+                                        lum_var[1 + 2 * i], lum_var[2 + 2 * i])
+                  for i, (s, t) in enumerate(bdpt_strategies(settings["max_depth"]))}
+    return RenderResult(image[0], variance[0], lum_var[0], int(spp), seconds, first, chunk,
+                        strategies=images)

@@ -12,8 +12,8 @@ from typing import Any, Iterable, Iterator
 
 import numpy as np
 
-__all__ = ["Chunk", "EmitterSample", "RenderResult", "Result", "SensorSample", "TupleResult",
-           "describe"]
+__all__ = ["Chunk", "EmitterSample", "RenderResult", "Result", "SensorSample", "StrategyImage",
+           "TupleResult", "describe"]
 
 
 def describe(value: Any) -> str:
@@ -112,6 +112,9 @@ class RenderResult(Result):
         rendered with ``first_sample=``).
     chunk : Chunk or None
         What :meth:`merge` needs: kept by renders given ``first_sample``.
+    strategies : dict or None
+        For a bidirectional render given ``strategies=True``: each strategy
+        ``(s, t)`` → its :class:`StrategyImage`.
     runs : ndarray (R, H, W) float32, or None
         The luminances of R independent renders whose mean is ``image``,
         for a Mitsuba reference of a splatting filter (its neighbouring
@@ -129,8 +132,9 @@ class RenderResult(Result):
     first_sample: int = 0
     chunk: Chunk | None = None
     runs: np.ndarray | None = None
+    strategies: dict[tuple[int, int], StrategyImage] | None = None
 
-    _hidden = ("chunk", "runs")
+    _hidden = ("chunk", "runs", "strategies")
 
     @classmethod
     def merge(cls, results: Iterable[RenderResult]) -> RenderResult:
@@ -185,6 +189,40 @@ class RenderResult(Result):
         from ._core.io import encode_png
 
         return encode_png(np.ascontiguousarray(self.image, dtype=np.float32))
+
+
+@dataclasses.dataclass(frozen=True, repr=False)
+class StrategyImage(Result):
+    """One strategy of a bidirectional render (``mcsample.render(...,
+    integrator="bdpt", strategies=True)``): paths made of ``s`` light
+    vertices and ``t`` camera vertices, ``s + t - 1`` segments.
+
+    Attributes
+    ----------
+    s, t : int
+        Light and camera vertices.
+    weighted : ndarray (H, W, 3) float32
+        Its contribution to the render (MIS-weighted); over the strategies
+        of one path length these add up to that length's light.
+    unweighted : ndarray (H, W, 3) float32
+        Its estimate alone (not weighted): an unbiased image of the light
+        carried by paths of ``s + t - 1`` segments, noisy where the
+        strategy samples those paths poorly.
+    weighted_variance, unweighted_variance : ndarray (H, W) float32
+        Variance of each pixel's mean luminance.
+    """
+
+    s: int
+    t: int
+    weighted: np.ndarray
+    unweighted: np.ndarray
+    weighted_variance: np.ndarray
+    unweighted_variance: np.ndarray
+
+    @property
+    def depth(self) -> int:
+        """Segments of its paths, ``s + t - 1``."""
+        return self.s + self.t - 1
 
 
 @dataclasses.dataclass(frozen=True, repr=False)

@@ -7,6 +7,7 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use glam::Vec3A;
@@ -397,11 +398,14 @@ impl PyScene {
 /// float32 arrays of ``height * width * 3`` (the third ``height * width``),
 /// the samples' blocks as ``(start, length)`` pairs, and (when
 /// ``keep_sums``) their float64 sums, 8 per pixel and block, else None.
+/// With ``strategies`` (``integrator="bdpt"``), the three arrays hold
+/// after the render's pixels, per strategy of ``mcsample._core.render.
+/// bdpt_strategies(max_depth)``, its weighted then unweighted image.
 /// ``callback(samples_done)`` is
 /// called about ten times a second, holding the GIL; a pending signal (such
 /// as Ctrl-C) stops the render and is raised once its threads have stopped.
 #[pyfunction]
-#[pyo3(signature = (scene, spp, seed, integrator, strategy, heuristic, max_depth, rr_depth, hide_emitters = false, callback = None, sampler = "independent", first_sample = None, total_spp = None, keep_sums = false))]
+#[pyo3(signature = (scene, spp, seed, integrator, strategy, heuristic, max_depth, rr_depth, hide_emitters = false, callback = None, sampler = "independent", first_sample = None, total_spp = None, keep_sums = false, strategies = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -419,6 +423,7 @@ pub fn render<'py>(
     first_sample: Option<Obj<'py>>,
     total_spp: Option<Obj<'py>>,
     keep_sums: bool,
+    strategies: bool,
 ) -> PyResult<Film<'py>> {
     let spp = index_arg(spp, "spp", 1, u64::from(u32::MAX))? as u32;
     let first = match first_sample {
@@ -462,7 +467,20 @@ pub fn render<'py>(
         rr_depth,
         hide_emitters,
         sampler: choice("sampler", sampler, Sampler::NAMES)?,
+        strategies,
     };
+    let bounded = settings.max_depth.is_some_and(|d| (1..=64).contains(&d));
+    if strategies && (settings.integrator != Integrator::Bdpt || !bounded) {
+        return Err(PyValueError::new_err(
+            "strategies=True needs integrator='bdpt' and a max_depth in [1, 64] (its images \
+             are one per strategy of each path length)",
+        ));
+    }
+    if strategies && keep_sums {
+        return Err(PyValueError::new_err(
+            "strategies=True renders whole images: it does not combine with first_sample",
+        ));
+    }
     let scene = Arc::clone(&scene.get().0);
     let progress = Arc::new(Progress::default());
     let (tx, rx) = mpsc::channel();
@@ -583,11 +601,22 @@ pub fn merge<'py>(
     ))
 }
 
+/// The strategies ``(s, t)`` of bidirectional path tracing's paths of at
+/// most ``max_depth`` segments (at most 64), in the order of
+/// :func:`render`'s strategy images: by path length, then by ``s`` (light
+/// vertices); ``(1, 1)`` is not used.
+#[pyfunction]
+pub fn bdpt_strategies(max_depth: &Obj<'_>) -> PyResult<Vec<(u32, u32)>> {
+    let max_depth = index_arg(max_depth, "max_depth", 1, 64)? as u32;
+    Ok(crate::render::bdpt::strategies(max_depth))
+}
+
 /// Registers ``mcsample._core.render``.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PySceneBuilder>()?;
     m.add_class::<PyScene>()?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(merge, m)?)?;
+    m.add_function(wrap_pyfunction!(bdpt_strategies, m)?)?;
     Ok(())
 }

@@ -114,6 +114,9 @@ pub struct Settings {
     pub hide_emitters: bool,
     /// Where each pixel's random numbers come from.
     pub sampler: Sampler,
+    /// Bidirectional path tracing only: also render each strategy's image
+    /// ([`super::bdpt::strategies`]).
+    pub strategies: bool,
 }
 
 impl Settings {
@@ -169,6 +172,22 @@ pub(crate) fn shadow_ray(p: Vec3A, n: Vec3A, ls: &LightSample) -> Ray {
             }
         }
     }
+}
+
+/// Whether nothing blocks the segment from `o` to `end` at time `tau`
+/// (the caller moves either end off its surface).
+pub(super) fn unoccluded(scene: &Scene, o: Vec3A, end: Vec3A, tau: f32) -> bool {
+    let to = end - o;
+    let tmax = to.length();
+    tmax > 0.0
+        && !scene.occluded(
+            &Ray {
+                o,
+                d: to / tmax,
+                tmax,
+            },
+            tau,
+        )
 }
 
 #[inline]

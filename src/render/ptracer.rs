@@ -46,7 +46,7 @@ use glam::Vec3A;
 
 use super::Settings;
 use super::camera::SensorSample;
-use super::integrator::offset;
+use super::integrator::{offset, unoccluded};
 use super::scene::{Emission, Scene};
 use super::shape::{Ray, SurfacePoint};
 use super::splat::Splat;
@@ -136,15 +136,14 @@ fn light_path(scene: &Scene, settings: &Settings, stream: &mut Stream, out: &mut
             out.push(s);
         }
     }
-    let u = [
-        stream.get1(dims::EMITTER_CHOICE),
-        stream.get1(dims::EMITTER_POSITION),
-        stream.get1(dims::EMITTER_POSITION + 1),
-    ];
-    let Some(emission) = scene.sample_emission(u) else {
+    let start = (
+        dims::EMITTER_CHOICE,
+        dims::EMITTER_POSITION,
+        dims::EMITTER_DIRECTION,
+    );
+    let Some((_, mut ray, mut beta)) = start_light_path(scene, stream, start) else {
         return;
     };
-    let (mut ray, mut beta) = emitted_ray(scene, emission, stream.get2(dims::EMITTER_DIRECTION));
     // Segments of the camera's path through the next vertex: the light's
     // ray, then the connection.
     let mut depth = 1u32;
@@ -176,6 +175,7 @@ fn light_path(scene: &Scene, settings: &Settings, stream: &mut Stream, out: &mut
                 out.push(Splat {
                     film: camera.film,
                     value,
+                    channel: 0,
                 });
             }
         }
@@ -210,10 +210,29 @@ fn light_path(scene: &Scene, settings: &Settings, stream: &mut Stream, out: &mut
     }
 }
 
+/// The start of a light path from `stream`: the light, and its point or
+/// direction ([`Scene::sample_emission`]), drawn from dimensions `choice`
+/// (1) and `position` (2), and the first ray with its weight
+/// ([`emitted_ray`]) from dimensions `direction` (2).
+pub(super) fn start_light_path(
+    scene: &Scene,
+    stream: &mut Stream,
+    (choice, position, direction): (u32, u32, u32),
+) -> Option<(Emission, Ray, [f32; 3])> {
+    let u = [
+        stream.get1(choice),
+        stream.get1(position),
+        stream.get1(position + 1),
+    ];
+    let emission = scene.sample_emission(u)?;
+    let (ray, beta) = emitted_ray(scene, emission, stream.get2(direction));
+    Some((emission, ray, beta))
+}
+
 /// The first ray of a light path and its weight `β₀` (see the module's
 /// text), `u` drawing its direction (area light) or its point on the disk
 /// (environment).
-pub(super) fn emitted_ray(scene: &Scene, emission: Emission, u: [f32; 2]) -> (Ray, [f32; 3]) {
+fn emitted_ray(scene: &Scene, emission: Emission, u: [f32; 2]) -> (Ray, [f32; 3]) {
     match emission {
         Emission::Surface {
             point,
@@ -274,6 +293,7 @@ fn seen_directly(scene: &Scene, u: [f32; 3], lens: [f32; 2], tau: f32) -> Option
             (cos > 0.0 && visible(scene, point.p, point.ng, &c, tau)).then(|| Splat {
                 film: c.film,
                 value: radiance.map(|l| l * s),
+                channel: 0,
             })
         }
         Emission::Environment { choice, .. } => {
@@ -283,6 +303,7 @@ fn seen_directly(scene: &Scene, u: [f32; 3], lens: [f32; 2], tau: f32) -> Option
             (!scene.occluded(&ray, tau)).then(|| Splat {
                 film,
                 value: radiance.map(|l| l / choice),
+                channel: 0,
             })
         }
     }
@@ -291,26 +312,24 @@ fn seen_directly(scene: &Scene, u: [f32; 3], lens: [f32; 2], tau: f32) -> Option
 /// Whether the lens point of `camera` is seen from surface point `p`
 /// (geometric normal `ng`).
 fn visible(scene: &Scene, p: Vec3A, ng: Vec3A, camera: &SensorSample, tau: f32) -> bool {
-    let o = offset(p, ng, camera.d);
-    let to = camera.lens - o;
-    let tmax = to.length();
-    tmax > 0.0
-        && !scene.occluded(
-            &Ray {
-                o,
-                d: to / tmax,
-                tmax,
-            },
-            tau,
-        )
+    unoccluded(scene, offset(p, ng, camera.d), camera.lens, tau)
 }
 
 /// Veach's correction `K` (see the module's text) at `sp` for light from
-/// `to_light` leaving toward `out`; `None` when either direction lies on
-/// different sides of the shading and the geometric normal.
+/// `to_light` leaving toward `out` ([`shading_correction`]).
 #[inline]
 fn adjoint(sp: &SurfacePoint, to_light: Vec3A, out: Vec3A) -> Option<f32> {
-    let (si, so) = (sp.ns.dot(to_light), sp.ns.dot(out));
-    let (gi, go) = (sp.ng.dot(to_light), sp.ng.dot(out));
+    shading_correction(sp.ns, sp.ng, to_light, out)
+}
+
+/// Veach's correction of the adjoint BSDF for shading normals at a point
+/// with shading normal `ns` and geometric normal `ng`, for light arriving
+/// from `from` and leaving toward `to` (unit vectors away from the point):
+/// `|(ns·from)(ng·to)| / |(ns·to)(ng·from)|`; `None` when either direction
+/// lies on different sides of the two normals (light leaks).
+#[inline]
+pub(super) fn shading_correction(ns: Vec3A, ng: Vec3A, from: Vec3A, to: Vec3A) -> Option<f32> {
+    let (si, so) = (ns.dot(from), ns.dot(to));
+    let (gi, go) = (ng.dot(from), ng.dot(to));
     (si * gi > 0.0 && so * go > 0.0).then(|| ((si * go) / (so * gi)).abs())
 }

@@ -58,20 +58,24 @@ fn primitives_of(geometry: Geometry) -> Box<dyn ExactSizeIterator<Item = Primiti
 /// Something emitter sampling can draw a direction toward.
 #[derive(Clone, Debug)]
 enum Light {
-    /// The emitting shape `shape`, whose primitives are
-    /// `primitives[first..first + count]`, one chosen by area (`areas`,
-    /// when there are several).
-    Area {
-        shape: u32,
-        first: u32,
-        count: u32,
-        areas: Option<Discrete1D>,
-        total_area: f32,
-        radiance: [f32; 3],
-    },
+    /// An area light.
+    Area(AreaLight),
     /// The environment, drawn by its map's [`CellSampler`] where it has
     /// one.
     Environment { cells: Option<CellSampler> },
+}
+
+/// The emitting shape `shape`, whose primitives are
+/// `primitives[first..first + count]`, one chosen by area (`areas`, when
+/// there are several).
+#[derive(Clone, Debug)]
+struct AreaLight {
+    shape: u32,
+    first: u32,
+    count: u32,
+    areas: Option<Discrete1D>,
+    total_area: f32,
+    radiance: [f32; 3],
 }
 
 /// A direction toward a light, from emitter sampling.
@@ -219,7 +223,7 @@ impl Scene {
                 .map_or(0.0, |l| std::f64::consts::PI * total * luminance(l));
             if power > 0.0 {
                 light_of_shape.push(Some(lights.len() as u32));
-                lights.push(Light::Area {
+                lights.push(Light::Area(AreaLight {
                     shape: id,
                     first,
                     count: areas.len() as u32,
@@ -228,7 +232,7 @@ impl Scene {
                         .transpose()?,
                     total_area: total as f32,
                     radiance: radiance.unwrap_or_default(),
-                });
+                }));
                 powers.push(power);
             } else {
                 light_of_shape.push(None);
@@ -411,14 +415,11 @@ impl Scene {
     #[inline]
     pub fn light_pdf(&self, shape: u32, x: Vec3A, ng: Vec3A, d: Vec3A, dist: f32) -> f32 {
         let light = self.light_of_shape[shape as usize];
-        let Some(Light::Area {
-            first, total_area, ..
-        }) = light.map(|l| &self.lights[l as usize])
-        else {
+        let Some(Light::Area(area)) = light.map(|l| &self.lights[l as usize]) else {
             return 0.0;
         };
         let pmf = self.choice_pmf(light);
-        if let Primitive::Sphere(s) = &self.accel.primitives()[*first as usize]
+        if let Primitive::Sphere(s) = &self.accel.primitives()[area.first as usize]
             && let Some(pdf) = s.cone_pdf(x)
         {
             return pmf * pdf;
@@ -427,7 +428,7 @@ impl Scene {
         if cos <= 0.0 {
             return 0.0;
         }
-        pmf * dist * dist / (cos * total_area)
+        pmf * dist * dist / (cos * area.total_area)
     }
 
     /// The density per unit area with which [`Scene::sample_emission`]
@@ -436,7 +437,7 @@ impl Scene {
     pub fn emission_pdf(&self, shape: u32) -> f32 {
         let light = self.light_of_shape[shape as usize];
         match light.map(|l| &self.lights[l as usize]) {
-            Some(Light::Area { total_area, .. }) => self.choice_pmf(light) / total_area,
+            Some(Light::Area(area)) => self.choice_pmf(light) / area.total_area,
             _ => 0.0,
         }
     }
@@ -479,12 +480,12 @@ impl Scene {
         let mut pdf = 0.0;
         for (index, light) in self.lights.iter().enumerate() {
             match light {
-                Light::Area {
+                Light::Area(AreaLight {
                     shape,
                     first,
                     count,
                     ..
-                } => {
+                }) => {
                     let own = &self.accel.primitives()[*first as usize..(first + count) as usize];
                     let nearest = own
                         .iter()
@@ -516,20 +517,18 @@ impl Scene {
         self.bounding_sphere
     }
 
-    /// Primitive of an area light's `first ..` chosen by area (`areas`,
-    /// when it has several) with `u[0]`, and `u` made uniform again.
+    /// A primitive of `area` chosen by area with `u[0]`, and `u` made
+    /// uniform again.
     #[inline]
-    fn pick_primitive(
-        &self,
-        first: u32,
-        areas: Option<&Discrete1D>,
-        u: [f32; 2],
-    ) -> (&Primitive, [f32; 2]) {
-        let (k, u0) = match areas {
+    fn pick_primitive(&self, area: &AreaLight, u: [f32; 2]) -> (&Primitive, [f32; 2]) {
+        let (k, u0) = match &area.areas {
             Some(a) => a.sample_reuse(u[0]),
             None => (0, u[0]),
         };
-        (&self.accel.primitives()[first as usize + k], [u0, u[1]])
+        (
+            &self.accel.primitives()[area.first as usize + k],
+            [u0, u[1]],
+        )
     }
 
     /// Where light starts, for light tracing: a light chosen by power
@@ -551,20 +550,13 @@ impl Scene {
                     choice: pmf,
                 })
             }
-            Light::Area {
-                shape,
-                first,
-                areas,
-                total_area,
-                radiance,
-                ..
-            } => {
-                let (primitive, u2) = self.pick_primitive(*first, areas.as_ref(), [u[1], u[2]]);
+            Light::Area(area) => {
+                let (primitive, u2) = self.pick_primitive(area, [u[1], u[2]]);
                 Some(Emission::Surface {
-                    shape: *shape,
+                    shape: area.shape,
                     point: primitive.sample(u2),
-                    pdf: pmf / total_area,
-                    radiance: *radiance,
+                    pdf: pmf / area.total_area,
+                    radiance: area.radiance,
                 })
             }
         }
@@ -600,15 +592,8 @@ impl Scene {
                     point: None,
                 })
             }
-            Light::Area {
-                shape,
-                first,
-                areas,
-                total_area,
-                radiance,
-                ..
-            } => {
-                let (primitive, u2) = self.pick_primitive(*first, areas.as_ref(), [u[1], u[2]]);
+            Light::Area(area) => {
+                let (primitive, u2) = self.pick_primitive(area, [u[1], u[2]]);
                 // A sphere seen from outside: by the cone it subtends.
                 let (y, cone_pdf) = match primitive {
                     Primitive::Sphere(s) => match s.sample_cone(x, u2) {
@@ -624,13 +609,13 @@ impl Scene {
                 }
                 let d = to_light / dist;
                 let cos = -y.ng.dot(d);
-                let pdf = cone_pdf.unwrap_or(dist * dist / (cos * total_area));
+                let pdf = cone_pdf.unwrap_or(dist * dist / (cos * area.total_area));
                 (cos > 0.0 && pdf.is_finite()).then_some(LightSample {
                     d,
                     dist,
                     pdf: pmf * pdf,
-                    radiance: *radiance,
-                    point: Some((y, *shape)),
+                    radiance: area.radiance,
+                    point: Some((y, area.shape)),
                 })
             }
         }

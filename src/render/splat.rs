@@ -36,9 +36,14 @@ pub struct Splat {
     pub film: [f32; 2],
     /// The value `c` (RGB).
     pub value: [f32; 3],
+    /// Which image it goes to (0: the render; others: images of parts of
+    /// it, such as bidirectional path tracing's strategies), each of the
+    /// film's size, one after the other.
+    pub channel: u32,
 }
 
-/// A path's value `Y` at one pixel (the pixel's index, row-major).
+/// A path's value `Y` at one pixel (the pixel's index, row-major, plus
+/// `channel · P`).
 pub type Entry = (u32, [f32; 3]);
 
 /// Spreads a path's splats over pixels.
@@ -71,20 +76,23 @@ impl Splatter {
     /// each pixel its `splats` reach, each pixel once, in pixel order.
     pub fn path(&mut self, splats: &[Splat], out: &mut Vec<Entry>) {
         self.entries.clear();
+        let pixels = (self.size[0] * self.size[1]) as u32;
         for s in splats {
             axis_weights(&self.filter, s.film[0], self.size[0], &mut self.xs);
             axis_weights(&self.filter, s.film[1], self.size[1], &mut self.ys);
             for &(y, wy) in &self.ys {
                 for &(x, wx) in &self.xs {
                     let w = self.scale * wx * wy;
-                    let pixel = y * self.size[0] as u32 + x;
+                    let pixel = s.channel * pixels + y * self.size[0] as u32 + x;
                     self.entries.push((pixel, s.value.map(|v| v * w)));
                 }
             }
         }
         self.entries.sort_unstable_by_key(|e| e.0);
+        // Only this path's entries are merged.
+        let start = out.len();
         for &(pixel, v) in &self.entries {
-            match out.last_mut() {
+            match out[start..].last_mut() {
                 Some((last, acc)) if *last == pixel => {
                     *acc = std::array::from_fn(|k| acc[k] + v[k]);
                 }
@@ -149,7 +157,7 @@ pub struct Developed {
 }
 
 impl SplatFilm {
-    /// An empty film of `pixels` pixels. With `per_path`, the sums are
+    /// An empty film of `pixels` pixels (of all its channels). With `per_path`, the sums are
     /// those of each path's values `Y` (the module's text); else of each
     /// sample index's total at the pixel, `X_q = Σ_paths Σ c w_q` (whose
     /// mean over the sample indices is the pixel's estimate, and whose
@@ -268,6 +276,7 @@ mod tests {
         let at = |x: f32, y: f32, v: f32| Splat {
             film: [x, y],
             value: [v; 3],
+            channel: 0,
         };
         s.path(
             &[at(0.9, 0.9, 1.0), at(0.1, 0.1, 2.0), at(0.95, 0.6, 3.0)],

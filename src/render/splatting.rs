@@ -27,6 +27,10 @@ pub trait Paths: Sync {
     /// no path belongs to a pixel); else over the sample indices (a
     /// camera path contributes to its own pixel only).
     const PER_PATH: bool;
+    /// Images the paths splat onto ([`Splat::channel`]): 1, the render.
+    fn channels(&self) -> u32 {
+        1
+    }
     /// Fresh buffers.
     fn scratch(&self) -> Self::Scratch;
     /// Appends the splats of path `pixel`, drawing from `stream` (at the
@@ -62,7 +66,21 @@ pub fn render<P: Paths>(
         .step_by(CHUNK)
         .map(|a| a..(a + CHUNK).min(pixels))
         .collect();
-    let mut film = SplatFilm::new(pixels, P::PER_PATH);
+    // Entries index a pixel of a channel in 32 bits.
+    let channels = paths.channels() as usize;
+    let Some(values) = pixels
+        .checked_mul(channels)
+        .filter(|&n| n <= u32::MAX as usize)
+    else {
+        return Err(crate::Error::Argument {
+            arg: "strategies",
+            message: format!(
+                "{channels} images of {pixels} pixels are too many: ask for fewer (a smaller \
+                 max_depth or film)"
+            ),
+        });
+    };
+    let mut film = SplatFilm::new(values, P::PER_PATH);
     let scale = if P::PER_PATH { pixels as f32 } else { 1.0 };
     parallel::install(|| -> Result<()> {
         for index in samples.first..samples.first + u64::from(samples.count) {

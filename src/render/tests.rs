@@ -121,6 +121,7 @@ fn settings(integrator: Integrator, strategy: Strategy) -> Settings {
         rr_depth: 5,
         hide_emitters: false,
         sampler: Sampler::Independent,
+        strategies: false,
     }
 }
 

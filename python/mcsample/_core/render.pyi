@@ -47,7 +47,10 @@ def render(
     callback: Callable[[int], object] | None = None,
     sampler: Literal["independent", "stratified", "multijitter", "sobol", "zsobol"] = "independent",
     first_sample: int | None = None, total_spp: int | None = None, keep_sums: bool = False,
+    strategies: bool = False,
 ) -> _Film: ...
+
+def bdpt_strategies(max_depth: int) -> list[tuple[int, int]]: ...
 
 #: image, variance, luminance variance (flat float32), blocks as (start,
 #: length), sums (flat float64, 8 per pixel and block; None unless kept).

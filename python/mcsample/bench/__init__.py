@@ -15,7 +15,7 @@ import mcsample as mcs
 
 from .kernels import (suite_distr, suite_envmap, suite_phong, suite_qmc, suite_rng,
                       suite_warps)
-from .renders import suite_convergence, suite_render, suite_samplers
+from .renders import suite_bidirectional, suite_convergence, suite_render, suite_samplers
 from .timing import Timing, _mitsuba, measure, measure_alternating, measure_side_by_side
 
 __all__ = ["SUITES", "Timing", "main", "measure", "measure_alternating",
@@ -32,6 +32,7 @@ SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
     "convergence": suite_convergence,
     "qmc": suite_qmc,
     "samplers": suite_samplers,
+    "bidirectional": suite_bidirectional,
 }
 
 

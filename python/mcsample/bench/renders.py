@@ -76,30 +76,47 @@ def suite_convergence(n: int, repeat: int, mi, target: float = 0.01, spp: int = 
     from ..demo import demo_scene
 
     scene = mcs.Scene.from_mitsuba(demo_scene(240, 90))
+    ours = {f"mcsample {s}": {"integrator": "direct", "strategy": s}
+            for s in ("bsdf", "emitter", "mis")}
+    return _time_to_relmse(scene, ours, ours["mcsample mis"], ("MIS", {"type": "direct"}),
+                           (mi, repeat), (target, "demo"), (spp, ref_spp))
+
+
+def _time_to_relmse(scene: mcs.Scene, ours: dict[str, dict], reference: dict,
+                    mitsuba: tuple[str, dict], runner: tuple, case: tuple[float, str],
+                    counts: tuple[int, int]) -> list[Timing]:
+    """Each render's time to relMSE ``target`` on ``scene``: mcsample's
+    renders with the keywords of ``ours`` (name → keywords) and, with
+    ``mi``, Mitsuba's with the integrator ``mitsuba`` = (label, dict).
+    relMSE falls as C / spp for an unbiased renderer, so C is measured at
+    ``spp`` against a ``ref_spp`` reference rendered with ``reference``
+    (less the reference's own share, measured between two independent
+    references), and the time to the target is (C / target) spp at the
+    measured seconds per spp; the "samples" column is the pixel samples
+    that takes."""
+    (mi, repeat), (target, name), (spp, ref_spp) = runner, case, counts
     h, w = scene.shape
 
-    def render(strategy: str, count: int, seed: int):
-        return mcs.render(scene, count, integrator="direct", strategy=strategy, seed=seed,
-                          progress=False)
+    def render(keywords: dict, count: int, seed: int):
+        return mcs.render(scene, count, seed=seed, progress=False, **keywords)
 
-    ref_a, ref_b = render("mis", ref_spp, 1), render("mis", ref_spp, 2)
+    ref_a, ref_b = render(reference, ref_spp, 1), render(reference, ref_spp, 2)
     floor = mcs.stats.relmse(ref_a.image, ref_b.image) / 2
     runs: dict[str, tuple[np.ndarray, float]] = {}
-    for strategy in ("bsdf", "emitter", "mis"):
-        seconds = measure(lambda strategy=strategy: render(strategy, spp, 3), repeat, 1)
-        runs[f"mcsample {strategy}"] = (render(strategy, spp, 4).image, seconds)
+    for label, keywords in ours.items():
+        seconds = measure(lambda keywords=keywords: render(keywords, spp, 3), repeat, 1)
+        runs[label] = (render(keywords, spp, 4).image, seconds)
     if mi is not None:
         mi_scene = mi.load_dict(scene.to_mitsuba(spp=spp))
-        mi_int = mi.load_dict({"type": "direct"})
+        mi_int = mi.load_dict(mitsuba[1])
         seconds = measure(lambda: np.asarray(mi.render(mi_scene, integrator=mi_int, spp=spp)),
                           repeat, 2)
         image = np.asarray(mi.render(mi_scene, integrator=mi_int, spp=spp, seed=5))
-        runs["Mitsuba 3 llvm (MIS)"] = (image[..., :3], seconds)
+        runs[f"Mitsuba 3 llvm ({mitsuba[0]})"] = (image[..., :3], seconds)
     out = []
-    for name, (image, seconds) in runs.items():
-        c = max(mcs.stats.relmse(image, ref_a.image) - floor, 1e-12) * spp
-        needed = c / target
-        out.append(Timing(f"time to relMSE {target:g}, demo", name, "float32",
+    for label, (image, seconds) in runs.items():
+        needed = max(mcs.stats.relmse(image, ref_a.image) - floor, 1e-12) * spp / target
+        out.append(Timing(f"time to relMSE {target:g}, {name}", label, "float32",
                           int(needed * w * h), needed * seconds / spp))
     return out
 
@@ -189,3 +206,43 @@ def suite_samplers(n: int, repeat: int, mi) -> list[Timing]:
         print(f"{spp:5d} {sampler:12s} {ours:9.5f}   {theirs.get(sampler, '-'):12s} "
               + (f"{other:9.5f}" if other is not None else f"{'-':>9s}"))
     return out
+
+
+def difficult_room(width: int = 96, height: int = 72, max_depth: int = 8) -> dict:
+    """Seed 003's difficult case: a closed room (the cube [-1, 1]³ seen from
+    inside, diffuse walls) lit only by a small area light 0.2 under the
+    ceiling that faces it, so that everything the camera sees is lit by
+    the patch of ceiling above the light: paths of three segments or more,
+    which next-event estimation from the walls finds only through that
+    patch."""
+    t = np.radians(-90.0)
+    turn = np.array([[1, 0, 0], [0, np.cos(t), -np.sin(t)], [0, np.sin(t), np.cos(t)]])
+    light = np.eye(4)
+    light[:3, :3] = turn @ np.diag([0.15, 0.1, 1.0])
+    light[:3, 3] = [0.1, 0.8, -0.2]
+    return {"type": "scene",
+            "sensor": {"type": "perspective", "fov": 70.0,
+                       "to_world": mcs.look_at([0.0, -0.2, 0.95], [0.0, 0.1, -1.0], [0, 1, 0]),
+                       "film": {"type": "hdrfilm", "width": width, "height": height,
+                                "rfilter": {"type": "box"}}},
+            "integrator": {"type": "path", "max_depth": max_depth},
+            "room": {"type": "cube", "flip_normals": True,
+                     "bsdf": {"type": "diffuse", "reflectance": [0.7, 0.6, 0.5]}},
+            "light": {"type": "rectangle", "to_world": light,
+                      "emitter": {"type": "area", "radiance": 20.0},
+                      "bsdf": {"type": "diffuse", "reflectance": 0.3}}}
+
+
+def suite_bidirectional(n: int, repeat: int, mi, target: float = 0.05, spp: int = 16,
+                        ref_spp: int = 1024) -> list[Timing]:
+    """Time to relMSE ``target`` on :func:`difficult_room` by path tracing,
+    bidirectional path tracing and light tracing, and by Mitsuba's path
+    tracer: relMSE ≈ C / spp (C measured at ``spp`` against a ``ref_spp``
+    bidirectional reference, less the reference's own share measured
+    between two of them), the time (C / target) spp at the measured
+    seconds per spp."""
+    scene = mcs.Scene.from_mitsuba(difficult_room())
+    ours = {f"mcsample {i}": {"integrator": i} for i in ("path", "bdpt", "ptracer")}
+    return _time_to_relmse(scene, ours, ours["mcsample bdpt"],
+                           ("path", {"type": "path", "max_depth": 8}), (mi, repeat),
+                           (target, "room"), (spp, ref_spp))
