@@ -6,15 +6,16 @@ its own; MIS weights them into one image. So:
 - against mcsample's path tracer (which shares only the scene): area lights
   near, far and grazing, a sphere light, the sky seen directly and through
   light subpaths, Phong lobes, a glossy sphere in a mirror-like Phong
-  floor, a thin lens, motion blur, a two-sided mesh with vertex normals,
-  and a closed room lit through its ceiling (also with unbounded paths and
+  floor, a constant environment, a thin lens, motion blur, a two-sided
+  mesh with vertex normals, and a closed room lit through its ceiling (also with unbounded paths and
   Russian roulette), with the power and the balance heuristic;
 - against Mitsuba 3's ``path``: the cross-renderer scenes of
-  test_vs_mitsuba_render, the room and the mirror floor;
-- each strategy's unweighted image against every other of its path
-  length (each is an unbiased estimate of the same light: a strategy whose
-  own estimate is wrong stands out even where its MIS weight is small),
-  and the weighted images adding up to the render.
+  test_vs_mitsuba_render, the room and the mirror floor (and light tracing
+  on four of them);
+- each strategy's unweighted image mean against the best-sampled one of
+  its path length (each is an unbiased estimate of the same light: a
+  strategy whose own estimate is wrong stands out even where its MIS
+  weight is small), and the weighted images adding up to the render.
 
 ``stats.render_ztest`` compares whole-image means and 8×8 blocks in
 standard errors; the sample counts keep the image mean's relative standard
@@ -62,13 +63,14 @@ SCENES = {name: (make, 512, 1024, {}) if name == "grazing rectangle"
           else (make, 64, path_spp, INTEGRATOR.get(name, {}))
           for name, (make, _, path_spp) in LIGHT_TRACING_SCENES.items()}
 SCENES["mirror floor"] = (lambda tmp: mirror_floor(), 64, 256, {})
+SCENES["sphere on plane under a constant sky"] = (
+    lambda tmp: sphere_on_plane({"type": "constant", "radiance": [0.8, 0.9, 1.0]}), 64, 256, {})
 SCENES["two-sided mesh with vertex normals"] = (_blob, 64, 256, {})
 
 
 def _scene(name: str, tmp_path, **keys) -> tuple[mcs.Scene, int, int]:
     make, spp, path_spp, integrator = SCENES[name]
-    d = make(tmp_path) if name in ("mirror floor", "two-sided mesh with vertex normals") \
-        else make()
+    d = make() if name in LIGHT_TRACING_SCENES else make(tmp_path)
     d["integrator"] = {"type": "path", "max_depth": 6, **integrator, **keys}
     return mcs.Scene.from_mitsuba(d), spp, path_spp
 
@@ -92,6 +94,37 @@ def test_balance_heuristic_too(name, tmp_path):
     path = mcs.render(scene, path_spp, seed=4, progress=False, integrator="path")
     t = stats.render_ztest(ours, path, alpha=ALPHA)
     assert t.passed, t.message
+
+
+def test_hidden_emitters_as_light_tracing_hides_them(tmp_path):
+    """With hide_emitters, bidirectional path tracing leaves out the light
+    the camera receives straight from a light, as light tracing (Mitsuba's
+    ptracer) does: area lights still block and reflect (the path tracer
+    instead sees through them)."""
+    scene, _, _ = _scene("room lit through the ceiling", tmp_path, hide_emitters=True)
+    ours = mcs.render(scene, 128, seed=6, progress=False, integrator="bdpt")
+    light = mcs.render(scene, 512, seed=7, progress=False, integrator="ptracer")
+    t = stats.render_ztest(ours, light, alpha=ALPHA)
+    assert t.passed, t.message
+    assert t.relative_se < 0.006
+
+
+def test_gaussian_filter_splats_as_light_tracing(tmp_path):
+    """Under the Gaussian filter, camera samples are splatted with the
+    light connections' normalised weights: the image is light tracing's,
+    compared with region variances from independent runs."""
+    from test_ptracer import runs
+
+    d = sphere_on_plane(sunless_sky())
+    d["sensor"]["film"] = dict(d["sensor"]["film"], rfilter={"type": "gaussian"})
+    d["integrator"] = {"type": "path", "max_depth": 6}
+    scene = mcs.Scene.from_mitsuba(d)
+    ours = runs(scene, 256, seed=8, integrator="bdpt")
+    light = runs(scene, 2048, seed=9, integrator="ptracer")
+    t = stats.render_ztest(ours, light, alpha=ALPHA)
+    print(t.message)
+    assert t.passed, t.message
+    assert t.relative_se < 0.01
 
 
 def _mean_and_se(luminance: np.ndarray, variance: np.ndarray) -> tuple[float, float]:
@@ -168,23 +201,36 @@ def _cross_renderer(tmp_path) -> dict:
     return d
 
 
+#: Mitsuba's references, shared by the bidirectional and light tracers.
+_references: dict = {}
+
+
 @pytest.mark.mitsuba
-@pytest.mark.parametrize("name, spp", [
-    ("diffuse sphere, default sky", 64),
-    ("phong spheres n = 1..1000, sky with sun", 2048),
-    ("sphere on plane, sky + area light", 64),
-    ("triangle mesh from PLY", 64),
-    ("angular sky", 64),
-    ("room lit through the ceiling", 64),
-    ("mirror floor", 64),
+@pytest.mark.parametrize("name, integrator, spp", [
+    ("diffuse sphere, default sky", "bdpt", 64),
+    ("phong spheres n = 1..1000, sky with sun", "bdpt", 2048),
+    ("sphere on plane, sky + area light", "bdpt", 64),
+    ("triangle mesh from PLY", "bdpt", 64),
+    ("angular sky", "bdpt", 64),
+    ("room lit through the ceiling", "bdpt", 64),
+    ("mirror floor", "bdpt", 64),
+    # Light tracing, where it finds the light the camera sees often enough.
+    ("diffuse sphere, default sky", "ptracer", 1024),
+    ("sphere on plane, sky + area light", "ptracer", 2048),
+    ("triangle mesh from PLY", "ptracer", 2048),
+    ("room lit through the ceiling", "ptracer", 512),
 ])
-def test_bdpt_matches_mitsubas_path_tracer(mi, tmp_path, name, spp):
+def test_bidirectional_and_light_tracing_match_mitsubas_path_tracer(mi, tmp_path, name,
+                                                                     integrator, spp):
     d = _cross_renderer(tmp_path)[name]
     d.setdefault("integrator", {"type": "path", "max_depth": 6})
     scene = mcs.Scene.from_mitsuba(d)
     ref_spp = 16384 if name.startswith("phong") else 1024
-    ref = mcs.mitsuba.render_reference(scene, ref_spp, seed=11, integrator="path")
-    ours = mcs.render(scene, spp, seed=12, progress=False, integrator="bdpt")
+    if name not in _references:
+        _references[name] = mcs.mitsuba.render_reference(scene, ref_spp, seed=11,
+                                                          integrator="path")
+    ref = _references[name]
+    ours = mcs.render(scene, spp, seed=12, progress=False, integrator=integrator)
     t = stats.render_ztest(ours, ref, alpha=ALPHA)
     print(f"{name}: {t.message}")
     assert t.passed, t.message

@@ -147,7 +147,7 @@ def test_scene_errors_name_the_key(patch, message):
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    ({"spp": 0}, "spp"), ({"integrator": "bdpt"}, "integrator"),
+    ({"spp": 0}, "spp"), ({"integrator": "bidir"}, "integrator"),
     ({"strategy": "guided"}, "strategy"), ({"heuristic": "max"}, "heuristic"),
     ({"max_depth": -2}, "max_depth"), ({"seed": -1}, "seed"),
 ])

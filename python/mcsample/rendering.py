@@ -73,7 +73,11 @@ def render(scene: Scene, spp: int | None = None, *,
         the ways; its light connections and camera samples are splatted
         alike (with the Gaussian filter, the normalised splat of
         "ptracer"), and each pixel's variance comes from its per-sample
-        totals. ``strategy`` does not apply to "ptracer" and "bdpt".
+        totals. Under "ptracer" and "bdpt" a light path reaches several
+        pixels, so neighbouring pixels' errors are slightly correlated: a
+        region's variance taken as the sum of its pixels' understates it a
+        little (measured within about 20 %). ``strategy`` does not apply to
+        "ptracer" and "bdpt".
         Default: the scene dict's integrator, else "path".
     strategy : "bsdf", "emitter" or "mis"
         How light is found: BSDF sampling, emitter sampling (envmap

@@ -7,7 +7,6 @@ use std::sync::mpsc;
 use std::time::Duration;
 
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use glam::Vec3A;
@@ -470,16 +469,22 @@ pub fn render<'py>(
         strategies,
     };
     let bounded = settings.max_depth.is_some_and(|d| (1..=64).contains(&d));
+    let refuse = |message: &str| {
+        Err(Error::Argument {
+            arg: "strategies",
+            message: message.into(),
+        })
+    };
     if strategies && (settings.integrator != Integrator::Bdpt || !bounded) {
-        return Err(PyValueError::new_err(
+        return refuse(
             "strategies=True needs integrator='bdpt' and a max_depth in [1, 64] (its images \
              are one per strategy of each path length)",
-        ));
+        )?;
     }
     if strategies && keep_sums {
-        return Err(PyValueError::new_err(
+        return refuse(
             "strategies=True renders whole images: it does not combine with first_sample",
-        ));
+        )?;
     }
     let scene = Arc::clone(&scene.get().0);
     let progress = Arc::new(Progress::default());
@@ -577,13 +582,17 @@ type Chunk<'py> = (Vec<(u64, u64)>, PyReadonlyArray1<'py, f64>);
 /// ``paths_per_sample`` is 1, or ``pixels`` for light tracing (whose
 /// sample index holds one light path per pixel).
 #[pyfunction]
-#[pyo3(signature = (chunks, pixels, paths_per_sample = 1))]
+#[pyo3(signature = (chunks, pixels, paths_per_sample = None))]
 pub fn merge<'py>(
     py: Python<'py>,
     chunks: Vec<Chunk<'py>>,
     pixels: usize,
-    paths_per_sample: u64,
+    paths_per_sample: Option<Obj<'py>>,
 ) -> PyResult<Film<'py>> {
+    let per_sample = match paths_per_sample {
+        Some(n) => index_arg(&n, "paths_per_sample", 1, u64::from(u32::MAX))?,
+        None => 1,
+    };
     let mut parts = Vec::with_capacity(chunks.len());
     for (blocks, sums) in &chunks {
         let blocks = blocks
@@ -592,7 +601,7 @@ pub fn merge<'py>(
             .collect::<Result<Vec<_>, _>>()?;
         parts.push((blocks, sums.as_slice()?));
     }
-    let merged = py.detach(|| film::merge(&parts, pixels, paths_per_sample.max(1)))?;
+    let merged = py.detach(|| film::merge(&parts, pixels, per_sample))?;
     Ok(film(
         py,
         [merged.mean, merged.variance, merged.luminance_variance],

@@ -308,9 +308,12 @@ impl Camera {
     /// shutter.
     #[inline]
     pub fn ray(&self, film: [f32; 2], lens: [f32; 2], tau: f32) -> Ray {
-        let mut out = [Ray::default()];
-        self.rays_into(&[[film[0], film[1], lens[0], lens[1]]], &[tau], &mut out);
-        out[0]
+        let m = match &self.motion {
+            Some(motion) => columns(affine_f32(motion.at(f64::from(tau)))),
+            None => self.to_world,
+        };
+        let u = [film[0], film[1], lens[0], lens[1]];
+        ray_from_row(self.ray_row(u, self.has_lens(), &m))
     }
 
     /// [`Camera::ray`] of `u = (film x, film y, lens x, lens y)` as the row

@@ -304,6 +304,12 @@ pub fn merge(chunks: &[(Vec<Block>, &[f64])], pixels: usize, per_sample: u64) ->
         layout.push(*block, (), |_, _| ())?;
     }
     let (_, count) = layout.span();
+    let Some(estimates) = count.checked_mul(per_sample) else {
+        return Err(Error::Argument {
+            arg: "results",
+            message: format!("{count} samples of {per_sample} paths each are too many"),
+        });
+    };
     if count == 0 {
         return Err(Error::Argument {
             arg: "results",
@@ -342,7 +348,7 @@ pub fn merge(chunks: &[(Vec<Block>, &[f64])], pixels: usize, per_sample: u64) ->
                     }
                     block_sums.clear();
                     block_sums.extend(tree.nodes().iter().map(|(_, s)| *s));
-                    finish_pixel(block_sums, count * per_sample, (mean, var), lum, sums);
+                    finish_pixel(block_sums, estimates, (mean, var), lum, sums);
                 },
             );
     })?;

@@ -27,6 +27,7 @@ use super::scene::{LightSample, Scene};
 use super::shape::Ray;
 use crate::alloc;
 use crate::frame::Frame;
+use crate::phong::PhongView;
 use crate::sampler::{Sampler, Stream};
 
 /// The dimensions of a sample, in this order: the camera's, then
@@ -106,11 +107,16 @@ pub struct Settings {
     /// Longest path in segments (Mitsuba's `max_depth`); `None`: unbounded.
     /// The direct integrator uses 2.
     pub max_depth: Option<u32>,
-    /// Russian roulette starts at this depth (path only).
+    /// Russian roulette starts at this depth (not for the direct
+    /// integrator).
     pub rr_depth: u32,
     /// Whether emitters seen straight from the camera are left out, as by
-    /// Mitsuba's `hide_emitters`: camera rays pass through area lights
-    /// ([`skip_emitters`]) and see no environment.
+    /// Mitsuba's `hide_emitters`: under the direct and path integrators,
+    /// camera rays pass through area lights ([`skip_emitters`]) and see no
+    /// environment; under light tracing and bidirectional path tracing,
+    /// as in Mitsuba's `ptracer`, only the light a camera ray or
+    /// connection receives straight from a light is left out (area lights
+    /// still block and reflect light).
     pub hide_emitters: bool,
     /// Where each pixel's random numbers come from.
     pub sampler: Sampler,
@@ -172,6 +178,28 @@ pub(crate) fn shadow_ray(p: Vec3A, n: Vec3A, ls: &LightSample) -> Ray {
             }
         }
     }
+}
+
+/// The shading frame at a point of shape `shape` with shading normal `ns`
+/// seen from the unit direction `from` (a two-sided material turns its
+/// front toward it; seen from the back, a one-sided material is black),
+/// and the BSDF's view of `from` in that frame.
+#[inline]
+pub(super) fn shading(
+    scene: &Scene,
+    shape: u32,
+    ns: Vec3A,
+    from: Vec3A,
+) -> (Frame<f32>, PhongView<f32>) {
+    let material = scene.material(shape);
+    let ns = if material.two_sided && ns.dot(from) < 0.0 {
+        -ns
+    } else {
+        ns
+    };
+    let frame = Frame::from_normal(ns.to_array());
+    let view = material.bsdf.view(frame.to_local(from.to_array()));
+    (frame, view)
 }
 
 /// Whether nothing blocks the segment from `o` to `end` at time `tau`
@@ -354,14 +382,7 @@ fn path(
         if depth + 1 >= max_depth {
             break;
         }
-        let material = scene.material(shape);
-        let ns = if material.two_sided && sp.ns.dot(wi) < 0.0 {
-            -sp.ns
-        } else {
-            sp.ns
-        };
-        let frame = Frame::from_normal(ns.to_array());
-        let view = material.bsdf.view(frame.to_local(wi.to_array()));
+        let (frame, view) = shading(scene, shape, sp.ns, wi);
 
         if settings.strategy != Strategy::Bsdf {
             let choice = stream.get1(dims::bounce(depth, dims::LIGHT_CHOICE));

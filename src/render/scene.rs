@@ -121,15 +121,19 @@ pub enum Emission {
     },
 }
 
-/// The sphere of [`Scene::bounding_sphere`].
+/// The sphere of [`Scene::bounding_sphere`]: around the box that holds
+/// the still shapes' box and the moving shapes' spheres.
 fn bounding_sphere(accel: &Accel, movers: &[Mover]) -> (Vec3A, f32) {
-    let spheres = accel
+    let moving = movers
+        .iter()
+        .filter_map(Mover::bounding_sphere)
+        .map(|(c, r)| (c - Vec3A::splat(r), c + Vec3A::splat(r)));
+    match accel
         .bounds()
-        .map(|(lo, hi)| (0.5 * (lo + hi), 0.5 * (hi - lo).length()))
         .into_iter()
-        .chain(movers.iter().filter_map(Mover::bounding_sphere));
-    let boxes = spheres.map(|(c, r)| (c - Vec3A::splat(r), c + Vec3A::splat(r)));
-    match boxes.reduce(|(a, b), (c, d)| (a.min(c), b.max(d))) {
+        .chain(moving)
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+    {
         Some((lo, hi)) => (0.5 * (lo + hi), 0.5 * (hi - lo).length()),
         None => (Vec3A::ZERO, 1.0),
     }
@@ -509,9 +513,9 @@ impl Scene {
     }
 
     /// A sphere around every shape at every time of the shutter: the
-    /// sphere around the still shapes' bounding box and the moving shapes'
-    /// spheres ([`Mover::bounding_sphere`]); a unit sphere at the origin
-    /// for an empty scene. Light from the environment enters the scene
+    /// sphere around the box of the still shapes' box and the moving
+    /// shapes' spheres ([`Mover::bounding_sphere`]); a unit sphere at the
+    /// origin for an empty scene. Light from the environment enters the scene
     /// through it ([`Scene::sample_emission`]).
     pub fn bounding_sphere(&self) -> (Vec3A, f32) {
         self.bounding_sphere

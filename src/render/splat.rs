@@ -51,6 +51,8 @@ pub type Entry = (u32, [f32; 3]);
 pub struct Splatter {
     filter: Filter,
     size: [usize; 2],
+    /// Images on the film.
+    channels: u32,
     /// `P`, the film's pixels, or 1 (see [`SplatFilm::new`]).
     scale: f32,
     xs: Vec<(u32, f32)>,
@@ -59,12 +61,14 @@ pub struct Splatter {
 }
 
 impl Splatter {
-    /// For a film of `width × height` pixels and `filter`, values scaled
-    /// by `scale` (`P` for a per-path variance, else 1).
-    pub fn new(filter: Filter, (width, height): (usize, usize), scale: f32) -> Self {
+    /// For a film of `width × height` pixels and `channels` images, and
+    /// `filter`, values scaled by `scale` (`P` for a per-path variance,
+    /// else 1).
+    pub fn new(filter: Filter, (width, height): (usize, usize), channels: u32, scale: f32) -> Self {
         Splatter {
             filter,
             size: [width, height],
+            channels,
             scale,
             xs: Vec::new(),
             ys: Vec::new(),
@@ -74,10 +78,15 @@ impl Splatter {
 
     /// Appends to `out` one path's values `Y` (see the module's text) at
     /// each pixel its `splats` reach, each pixel once, in pixel order.
+    /// Splats that are not finite or name a channel the film does not have
+    /// are left out.
     pub fn path(&mut self, splats: &[Splat], out: &mut Vec<Entry>) {
         self.entries.clear();
         let pixels = (self.size[0] * self.size[1]) as u32;
-        for s in splats {
+        let kept = splats
+            .iter()
+            .filter(|s| s.channel < self.channels && s.value.iter().all(|v| v.is_finite()));
+        for s in kept {
             axis_weights(&self.filter, s.film[0], self.size[0], &mut self.xs);
             axis_weights(&self.filter, s.film[1], self.size[1], &mut self.ys);
             for &(y, wy) in &self.ys {
@@ -156,8 +165,39 @@ pub struct Developed {
     pub sums: Vec<f64>,
 }
 
+/// The paths of one sample index on a [`SplatFilm`], added entry by entry
+/// in a fixed order (the same whatever the threads, so the same bits).
+#[derive(Debug)]
+pub enum Leaf {
+    /// Per pixel, the sums of the paths' values (per-path variance).
+    Sums(Vec<Sums>),
+    /// Per pixel, the sample index's total (per-sample variance).
+    Totals(Vec<[f64; 3]>),
+}
+
+impl Leaf {
+    /// Adds `entries`.
+    pub fn add(&mut self, entries: &[Entry]) {
+        match self {
+            Leaf::Sums(sums) => {
+                for &(pixel, y) in entries {
+                    let s = &mut sums[pixel as usize];
+                    *s = film::add(s, &film::sums_of(y));
+                }
+            }
+            Leaf::Totals(totals) => {
+                for &(pixel, x) in entries {
+                    let t = &mut totals[pixel as usize];
+                    *t = std::array::from_fn(|k| t[k] + f64::from(x[k]));
+                }
+            }
+        }
+    }
+}
+
 impl SplatFilm {
-    /// An empty film of `pixels` pixels (of all its channels). With `per_path`, the sums are
+    /// An empty film of `pixels` pixels (of all its channels). With
+    /// `per_path`, the sums are
     /// those of each path's values `Y` (the module's text); else of each
     /// sample index's total at the pixel, `X_q = Σ_paths Σ c w_q` (whose
     /// mean over the sample indices is the pixel's estimate, and whose
@@ -172,34 +212,32 @@ impl SplatFilm {
         }
     }
 
-    /// Adds the `P` paths of sample index `index`: their entries, in the
-    /// order given (the same order whatever the threads, so the same bits).
+    /// An empty leaf for the paths of one sample index.
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when it does not fit in memory.
+    pub fn leaf(&self) -> Result<Leaf> {
+        const WHAT: &str = "the splatting film";
+        Ok(if self.per_path {
+            Leaf::Sums(alloc::filled(self.pixels, Sums::default(), WHAT)?)
+        } else {
+            Leaf::Totals(alloc::filled(self.pixels, [0.0f64; 3], WHAT)?)
+        })
+    }
+
+    /// Adds `leaf`, the paths of sample index `index`.
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the film does not fit in memory.
-    pub fn add_sample<'a>(
-        &mut self,
-        index: u64,
-        parts: impl Iterator<Item = &'a [Entry]>,
-    ) -> Result<()> {
-        const WHAT: &str = "the splatting film";
-        let mut leaf = alloc::filled(self.pixels, Sums::default(), WHAT)?;
-        if self.per_path {
-            for &(pixel, y) in parts.flatten() {
-                let s = &mut leaf[pixel as usize];
-                *s = film::add(s, &film::sums_of(y));
-            }
-        } else {
-            let mut totals = alloc::filled(self.pixels, [0.0f64; 3], WHAT)?;
-            for &(pixel, x) in parts.flatten() {
-                let t = &mut totals[pixel as usize];
-                *t = std::array::from_fn(|k| t[k] + f64::from(x[k]));
-            }
-            for (s, t) in leaf.iter_mut().zip(&totals) {
-                *s = film::sums_of(t.map(|v| v as f32));
-            }
-        }
-        self.tree.push_into(Block::sample(index), leaf, |a, b| {
+    pub fn push(&mut self, index: u64, leaf: Leaf) -> Result<()> {
+        let sums = match leaf {
+            Leaf::Sums(sums) => sums,
+            Leaf::Totals(totals) => alloc::collect(
+                totals.iter().map(|t| film::sums_of(t.map(|v| v as f32))),
+                "the splatting film",
+            )?,
+        };
+        self.tree.push_into(Block::sample(index), sums, |a, b| {
             a.par_iter_mut()
                 .zip(b)
                 .for_each(|(a, b)| *a = film::add(a, &b));
@@ -218,7 +256,7 @@ impl SplatFilm {
         let nodes = self.tree.nodes();
         let count: u64 = nodes.iter().map(|(b, _)| b.len).sum();
         let per_pixel = if keep_sums { nodes.len() * 8 } else { 0 };
-        const WHAT: &str = "the light tracer's image";
+        const WHAT: &str = "the splatting film's image";
         let mut out = Developed {
             mean: alloc::filled(pixels * 3, 0.0f32, WHAT)?,
             variance: alloc::filled(pixels * 3, 0.0f32, WHAT)?,
@@ -271,7 +309,7 @@ mod tests {
 
     #[test]
     fn a_path_adds_its_values_at_a_pixel_before_they_are_squared() {
-        let mut s = Splatter::new(Filter::Box, (4, 2), 8.0);
+        let mut s = Splatter::new(Filter::Box, (4, 2), 1, 8.0);
         let mut out = Vec::new();
         let at = |x: f32, y: f32, v: f32| Splat {
             film: [x, y],
@@ -285,8 +323,10 @@ mod tests {
         // P = 8: pixel 0 gets 2·8, pixel 7 gets (1 + 3)·8.
         assert_eq!(out, [(0, [16.0; 3]), (7, [32.0; 3])]);
         let mut film = SplatFilm::new(8, true);
-        film.add_sample(0, [&out[..]].into_iter()).unwrap();
-        film.add_sample(1, std::iter::empty()).unwrap();
+        let mut leaf = film.leaf().unwrap();
+        leaf.add(&out);
+        film.push(0, leaf).unwrap();
+        film.push(1, film.leaf().unwrap()).unwrap();
         let d = film.develop(8, false).unwrap();
         // 16 paths: pixel 7's mean 32/16 = 2 = (1 + 3)/2 samples.
         assert_eq!(d.mean[21], 2.0);

@@ -47,6 +47,9 @@ pub trait Paths: Sync {
 /// Paths per parallel task.
 const CHUNK: usize = 512;
 
+/// Tasks whose entries are held at once (about 32,768 paths).
+const BATCH: usize = 64;
+
 /// Renders samples `samples.first ..` of `scene` with `paths`;
 /// [`Progress::samples`] counts paths, and the render stops between
 /// sample indices when cancelled.
@@ -73,45 +76,53 @@ pub fn render<P: Paths>(
         .filter(|&n| n <= u32::MAX as usize)
     else {
         return Err(crate::Error::Argument {
-            arg: "strategies",
+            arg: "film",
             message: format!(
-                "{channels} images of {pixels} pixels are too many: ask for fewer (a smaller \
-                 max_depth or film)"
+                "{channels} images of {pixels} pixels are too many for one render: ask for \
+                 fewer (a smaller film, or fewer strategy images)"
             ),
         });
     };
     let mut film = SplatFilm::new(values, P::PER_PATH);
     let scale = if P::PER_PATH { pixels as f32 } else { 1.0 };
+    let channels = channels as u32;
     parallel::install(|| -> Result<()> {
         for index in samples.first..samples.first + u64::from(samples.count) {
-            let parts: Vec<Vec<Entry>> = chunks
-                .par_iter()
-                .map_init(
-                    || {
-                        let splatter = Splatter::new(scene.filter().filter(), scene.film(), scale);
-                        (paths.scratch(), splatter, Vec::new())
-                    },
-                    |(scratch, splatter, splats), range| {
-                        let mut out = Vec::new();
-                        if progress.cancel.load(Ordering::Relaxed) {
-                            return out;
-                        }
-                        for j in range.clone() {
-                            let mut stream =
-                                stream_of(scene, settings.sampler, (seed, samples.total), j);
-                            start_sample(&mut stream, mix(seed, j as u64), j as u64, index);
-                            splats.clear();
-                            paths.trace(scratch, &mut stream, j, splats);
-                            splatter.path(splats, &mut out);
-                        }
-                        out
-                    },
-                )
-                .collect();
+            let mut leaf = film.leaf()?;
+            // A bounded batch of chunks at a time: their entries are held
+            // until added to the leaf, in chunk order.
+            for batch in chunks.chunks(BATCH) {
+                let parts: Vec<Vec<Entry>> = batch
+                    .par_iter()
+                    .map_init(
+                        || {
+                            let filter = scene.filter().filter();
+                            let splatter = Splatter::new(filter, scene.film(), channels, scale);
+                            (paths.scratch(), splatter, Vec::new())
+                        },
+                        |(scratch, splatter, splats), range| {
+                            let mut out = Vec::new();
+                            if progress.cancel.load(Ordering::Relaxed) {
+                                return out;
+                            }
+                            for j in range.clone() {
+                                let mut stream =
+                                    stream_of(scene, settings.sampler, (seed, samples.total), j);
+                                start_sample(&mut stream, mix(seed, j as u64), j as u64, index);
+                                splats.clear();
+                                paths.trace(scratch, &mut stream, j, splats);
+                                splatter.path(splats, &mut out);
+                            }
+                            out
+                        },
+                    )
+                    .collect();
+                parts.iter().for_each(|part| leaf.add(part));
+            }
             if progress.cancel.load(Ordering::Relaxed) {
                 break;
             }
-            film.add_sample(index, parts.iter().map(Vec::as_slice))?;
+            film.push(index, leaf)?;
             progress.samples.fetch_add(pixels as u64, Ordering::Relaxed);
         }
         Ok(())

@@ -58,5 +58,5 @@ _Film = tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32],
              list[tuple[int, int]], NDArray[np.float64] | None]
 
 def merge(chunks: list[tuple[list[tuple[int, int]], NDArray[np.float64]]],
-          pixels: int, paths_per_sample: int = 1) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32],
+          pixels: int, paths_per_sample: int | None = None) -> tuple[NDArray[np.float32], NDArray[np.float32], NDArray[np.float32],
                                 list[tuple[int, int]], NDArray[np.float64]]: ...

@@ -234,7 +234,7 @@ def difficult_room(width: int = 96, height: int = 72, max_depth: int = 8) -> dic
 
 
 def suite_bidirectional(n: int, repeat: int, mi, target: float = 0.05, spp: int = 16,
-                        ref_spp: int = 1024) -> list[Timing]:
+                        ref_spp: int = 256) -> list[Timing]:
     """Time to relMSE ``target`` on :func:`difficult_room` by path tracing,
     bidirectional path tracing and light tracing, and by Mitsuba's path
     tracer: relMSE ≈ C / spp (C measured at ``spp`` against a ``ref_spp``

@@ -78,39 +78,16 @@ pub(super) fn connect(
 ) -> Option<([f32; 3], f32, Option<[f32; 2]>)> {
     let scene = ctx.scene;
     let pt = &cam[t - 1];
-    // A camera path that left the scene joins nothing.
-    if t > 1 && s != 0 && pt.kind == Kind::Environment {
-        return None;
-    }
     let mut sampled = None;
     let mut at = None;
     let value: [f32; 3] = if s == 0 {
         let le = emitted(ctx, pt, &cam[t - 2])?;
         std::array::from_fn(|c| le[c] * pt.beta[c])
     } else if t == 1 {
-        let qs = &light[s - 1];
-        if !matches!(qs.kind, Kind::Surface { .. }) {
-            return None;
-        }
-        let k = s as u32 - 2;
-        let u = stream.get2(dims::at(k, dims::LIGHT_LENS));
-        let c = scene.camera().sample_direction(qs.p, u, ctx.tau)?;
-        let lens = Vertex {
-            kind: Kind::Camera,
-            p: c.lens,
-            ng: -c.d,
-            ns: -c.d,
-            beta: [c.weight; 3],
-            pdf_fwd: 0.0,
-            pdf_rev: 0.0,
-        };
-        let f = scatter(ctx, qs, &light[s - 2], &lens, true);
-        if f.iter().all(|&v| v == 0.0) || !visible(scene, qs, &lens, ctx.tau) {
-            return None;
-        }
+        let (value, film, lens) = to_camera(ctx, light, s, stream)?;
         sampled = Some(lens);
-        at = Some(c.film);
-        std::array::from_fn(|i| qs.beta[i] * f[i] * c.weight)
+        at = Some(film);
+        value
     } else if s == 1 {
         if !matches!(pt.kind, Kind::Surface { .. }) {
             return None;
@@ -173,6 +150,42 @@ pub(super) fn connect(
     Some((value, mis_weight(ctx, cam, light, sampled, s, t), at))
 }
 
+/// The `t = 1` strategy for light vertex `y_{s−1}` (`s ≥ 2`): a lens point
+/// drawn for it, the light it sends there (`β_s f |cos| K W`, not weighted),
+/// where on the film it lands, and the lens point as a camera vertex.
+/// Light tracing is this strategy alone.
+pub(in crate::render) fn to_camera(
+    ctx: &Ctx,
+    light: &[Vertex],
+    s: usize,
+    stream: &mut Stream,
+) -> Option<([f32; 3], [f32; 2], Vertex)> {
+    let qs = &light[s - 1];
+    if !matches!(qs.kind, Kind::Surface { .. }) {
+        return None;
+    }
+    let u = stream.get2(dims::at(s as u32 - 2, dims::LIGHT_LENS));
+    let c = ctx.scene.camera().sample_direction(qs.p, u, ctx.tau)?;
+    let lens = Vertex {
+        kind: Kind::Camera,
+        p: c.lens,
+        ng: -c.d,
+        ns: -c.d,
+        beta: [c.weight; 3],
+        pdf_fwd: 0.0,
+        pdf_rev: 0.0,
+    };
+    let f = scatter(ctx, qs, &light[s - 2], &lens, true);
+    if f.iter().all(|&v| v == 0.0) || !visible(ctx.scene, qs, &lens, ctx.tau) {
+        return None;
+    }
+    Some((
+        std::array::from_fn(|i| qs.beta[i] * f[i] * c.weight),
+        c.film,
+        lens,
+    ))
+}
+
 /// Whether surface vertex `a` sees vertex `b` (a surface or the lens).
 pub(super) fn visible(scene: &Scene, a: &Vertex, b: &Vertex, tau: f32) -> bool {
     let d = direction(a, b);
@@ -230,19 +243,21 @@ pub(super) fn mis_weight(
     if let (Some(qm), Some(q)) = (&mut qs_minus, &qs) {
         qm.pdf_rev = pdf(ctx, q, Some(&pt), qm);
     }
-    let power = |x: f32| match ctx.settings.heuristic {
+    // In f64: products of many ratios (squared for the power heuristic)
+    // overflow f32.
+    let power = |x: f64| match ctx.settings.heuristic {
         Heuristic::Balance => x,
         Heuristic::Power => x * x,
     };
     let ratio = |v: &Vertex| {
         if v.pdf_fwd > 0.0 {
-            power(v.pdf_rev / v.pdf_fwd)
+            power(f64::from(v.pdf_rev) / f64::from(v.pdf_fwd))
         } else {
             0.0
         }
     };
-    let mut sum = 0.0f32;
-    let mut r = 1.0f32;
+    let mut sum = 0.0f64;
+    let mut r = 1.0f64;
     for i in (1..t).rev() {
         let v = if i == t - 1 {
             &pt
@@ -266,5 +281,8 @@ pub(super) fn mis_weight(
         r *= ratio(v);
         sum += r;
     }
-    1.0 / (1.0 + sum)
+    // A path no other strategy can make has weight 1; one that others make
+    // infinitely more likely, weight 0 (never NaN).
+    let w = 1.0 / (1.0 + sum);
+    if w.is_finite() { w as f32 } else { 0.0 }
 }

@@ -42,11 +42,16 @@ use super::splat::Splat;
 use super::splatting::Paths;
 use crate::sampler::Stream;
 use connect::connect_all;
-use subpath::{Vertex, camera_subpath, light_subpath};
+pub(super) use connect::to_camera;
+use subpath::camera_subpath;
+pub(super) use subpath::{Vertex, light_subpath};
 
 /// The dimensions of a sample, in this order: the camera's, the light
-/// subpath's start, then [`dims::PER_DEPTH`] per depth `k` ([`dims::at`]):
-/// the camera subpath's `k`-th vertex, then the light subpath's.
+/// subpath's start, light tracing's connection of a light to the camera
+/// (light tracing only), then [`dims::PER_DEPTH`] per depth `k`
+/// ([`dims::at`]): the camera subpath's vertex `z_{k+1}`, then the light
+/// subpath's `y_{k+1}`. Light tracing ([`ptracer`](super::ptracer)) takes
+/// the same dimensions for its light subpaths.
 pub mod dims {
     /// Film position in the pixel (2D).
     pub const FILM: u32 = 0;
@@ -60,8 +65,14 @@ pub mod dims {
     pub const EMITTER_POSITION: u32 = 6;
     /// The first ray's direction, or its point on the disk (2D).
     pub const EMITTER_DIRECTION: u32 = 8;
+    /// Light tracing: the light joined straight to the camera.
+    pub const DIRECT_CHOICE: u32 = 10;
+    /// Light tracing: its point, or the film point for the environment (2D).
+    pub const DIRECT_POSITION: u32 = 11;
+    /// Light tracing: the lens point of that connection (2D).
+    pub const DIRECT_LENS: u32 = 13;
     /// Dimensions before depth 0.
-    pub const START: u32 = 10;
+    pub const START: u32 = 15;
     /// Camera vertex: the BSDF sample (3D).
     pub const CAMERA_BSDF: u32 = 0;
     /// Camera vertex: next-event estimation's light and point (3D).
@@ -78,7 +89,7 @@ pub mod dims {
     pub const PER_DEPTH: u32 = 13;
 
     /// Dimension `offset` at depth `k` (the camera's vertex `z_{k+1}`,
-    /// the light's `y_k`).
+    /// the light's `y_{k+1}`).
     #[inline]
     pub fn at(k: u32, offset: u32) -> u32 {
         START
@@ -88,8 +99,8 @@ pub mod dims {
 }
 
 /// The strategies `(s, t)` of paths of at most `max_depth` segments (at
-/// most 64), in the order of their images: by depth `s + t − 2`, then by
-/// `s`.
+/// most 64), in the order of their images: by length `s + t − 1`
+/// segments, then by `s`.
 pub fn strategies(max_depth: u32) -> Vec<(u32, u32)> {
     (0..max_depth.min(64))
         .flat_map(|k| (0..=k + 1).map(move |s| (s, k + 2 - s)))
@@ -97,19 +108,22 @@ pub fn strategies(max_depth: u32) -> Vec<(u32, u32)> {
         .collect()
 }
 
-/// The position of strategy `(s, t)` in [`strategies`]: depth `k`'s
-/// first is preceded by `Σ_{j<k} (j + 2) − 1` (the `(1, 1)` strategy left
-/// out).
+/// The position of strategy `(s, t)` in [`strategies`]: with `k = s + t
+/// − 2`, the first of length `k + 1` is preceded by `Σ_{j<k} (j + 2) − 1`
+/// (the `(1, 1)` strategy left out).
 fn strategy_index(s: usize, t: usize) -> usize {
     let k = s + t - 2;
     if k == 0 { 0 } else { k * (k + 3) / 2 - 1 + s }
 }
 
 /// What the walks and connections need.
-struct Ctx<'a> {
-    scene: &'a Scene,
-    settings: &'a Settings,
-    tau: f32,
+pub(super) struct Ctx<'a> {
+    /// The scene.
+    pub(super) scene: &'a Scene,
+    /// The settings.
+    pub(super) settings: &'a Settings,
+    /// The sample's time in the shutter.
+    pub(super) tau: f32,
 }
 
 /// Bidirectional path tracing as a [`Paths`] integrator.

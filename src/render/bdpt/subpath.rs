@@ -4,18 +4,17 @@
 
 use glam::Vec3A;
 
-use super::super::integrator::offset;
-use super::super::ptracer::{shading_correction, start_light_path};
+use super::super::integrator::{offset, shading};
 use super::super::scene::{Emission, Scene};
 use super::super::shape::Ray;
 use super::{Ctx, dims};
 use crate::frame::Frame;
-use crate::phong::PhongView;
 use crate::sampler::Stream;
+use crate::warp;
 
 /// What a vertex is.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum Kind {
+pub enum Kind {
     /// The lens point.
     Camera,
     /// A point on a surface of shape `shape` (which may emit).
@@ -29,7 +28,7 @@ pub(super) enum Kind {
 
 /// A vertex of a subpath.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Vertex {
+pub struct Vertex {
     pub(super) kind: Kind,
     /// Position (for the environment: the unit direction toward it).
     pub(super) p: Vec3A,
@@ -78,7 +77,7 @@ pub(super) fn camera_subpath(
 
 /// The light subpath: `y₀` on a light (or the environment), then up to
 /// `max_depth − 1` vertices.
-pub(super) fn light_subpath(ctx: &Ctx, stream: &mut Stream, out: &mut Vec<Vertex>) {
+pub(in crate::render) fn light_subpath(ctx: &Ctx, stream: &mut Stream, out: &mut Vec<Vertex>) {
     out.clear();
     let scene = ctx.scene;
     let start = (
@@ -181,7 +180,7 @@ pub(super) fn walk(
             return;
         }
         let from = -ray.d;
-        let (frame, view) = bsdf(scene, &v, shape, from);
+        let (frame, view) = shading(scene, shape, v.ns, from);
         let (bsdf_u, rr_u) = if light {
             (dims::LIGHT_BSDF, dims::LIGHT_ROULETTE)
         } else {
@@ -197,23 +196,17 @@ pub(super) fn walk(
             return;
         }
         let d = Vec3A::from(frame.to_world(s.wo)).normalize();
-        let fix = if light {
-            match adjoint(&v, from, d) {
-                Some(fix) => fix,
-                None => return,
-            }
-        } else {
-            1.0
+        let Some(fix) = side_factor(&v, from, d, light) else {
+            return;
         };
         beta = std::array::from_fn(|c| beta[c] * s.weight[c] * fix);
         // The density of sampling `from` had the walk come the other way.
-        let rev = bsdf(scene, &v, shape, d)
-            .1
-            .eval_pdf_one(frame_local(&frame, from))
-            .1;
+        let (back, view_back) = shading(scene, shape, v.ns, d);
+        let rev = view_back.eval_pdf_one(frame_local(&back, from)).1;
         let n = path.len();
         path[n - 2].pdf_rev = convert(rev, &v, &path[n - 2]);
-        if n as u32 - 1 > ctx.settings.rr_depth {
+        // Past vertex `rr_depth` (`v` is vertex `n − 1`).
+        if n as u32 > ctx.settings.rr_depth {
             let q = beta.iter().copied().fold(0.0f32, f32::max).min(0.95);
             if stream.get1::<f32>(dims::at(k, rr_u)) >= q {
                 return;
@@ -234,29 +227,14 @@ pub(super) fn frame_local(frame: &Frame<f32>, v: Vec3A) -> [f32; 3] {
     frame.to_local(v.to_array())
 }
 
-/// The shading frame and the BSDF at surface vertex `v` of shape `shape`
-/// seen from `from` (a two-sided material faces it).
-pub(super) fn bsdf(
-    scene: &Scene,
-    v: &Vertex,
-    shape: u32,
-    from: Vec3A,
-) -> (Frame<f32>, PhongView<f32>) {
-    let material = scene.material(shape);
-    let ns = if material.two_sided && v.ns.dot(from) < 0.0 {
-        -v.ns
-    } else {
-        v.ns
-    };
-    let frame = Frame::from_normal(ns.to_array());
-    let view = material.bsdf.view(frame_local(&frame, from));
-    (frame, view)
-}
-
-/// Veach's shading-normal correction at `v` for light arriving from
-/// `from` and leaving toward `to` ([`shading_correction`]).
-pub(super) fn adjoint(v: &Vertex, from: Vec3A, to: Vec3A) -> Option<f32> {
-    shading_correction(v.ns, v.ng, from, to)
+/// The factor of the BSDF at `v` for light between `from` and `to`: on a
+/// light subpath Veach's correction `K` ([`shading_correction`]), on a
+/// camera subpath 1; `None` for a direction on different sides of the
+/// shading and the geometric normal (a light leak, refused on both
+/// subpaths alike, so that every strategy agrees on which paths exist).
+fn side_factor(v: &Vertex, from: Vec3A, to: Vec3A, light: bool) -> Option<f32> {
+    let k = shading_correction(v.ns, v.ng, from, to)?;
+    Some(if light { k } else { 1.0 })
 }
 
 /// A density per steradian at `from` toward `to`, per unit area at `to`
@@ -299,7 +277,7 @@ pub(super) fn pdf(ctx: &Ctx, v: &Vertex, prev: Option<&Vertex>, next: &Vertex) -
                 return pdf_light(ctx, v, next);
             };
             let from = direction(v, prev);
-            let (frame, view) = bsdf(ctx.scene, v, shape, from);
+            let (frame, view) = shading(ctx.scene, shape, v.ns, from);
             view.eval_pdf_one(frame_local(&frame, to)).1
         }
         Kind::Light { .. } | Kind::Environment => return pdf_light(ctx, v, next),
@@ -350,8 +328,8 @@ pub(super) fn emitted(ctx: &Ctx, v: &Vertex, toward: &Vertex) -> Option<[f32; 3]
 }
 
 /// `f · |cos θ_out|` at surface vertex `v` for light between `prev` and
-/// `next` (`light`: on a light subpath, light arrives from `prev`, with
-/// the shading-normal correction; else from `next`).
+/// `next`, times [`side_factor`] (`light`: on a light subpath, where light
+/// arrives from `prev`; else it arrives from `next`).
 pub(super) fn scatter(
     ctx: &Ctx,
     v: &Vertex,
@@ -363,17 +341,87 @@ pub(super) fn scatter(
         return [0.0; 3];
     };
     let (from, to) = (direction(v, prev), direction(v, next));
-    let fix = if light {
-        match adjoint(v, from, to) {
-            Some(fix) => fix,
-            None => return [0.0; 3],
-        }
-    } else {
-        1.0
+    let Some(fix) = side_factor(v, from, to, light) else {
+        return [0.0; 3];
     };
-    let (frame, view) = bsdf(ctx.scene, v, shape, from);
+    let (frame, view) = shading(ctx.scene, shape, v.ns, from);
     let wo = frame_local(&frame, to);
     let f = view.eval_pdf_one(wo).0;
     let s = wo[2].abs() * fix;
     f.map(|x| x * s)
+}
+
+/// The start of a light path from `stream`: the light, and its point or
+/// direction ([`Scene::sample_emission`]), drawn from dimensions `choice`
+/// (1) and `position` (2), and the first ray with its weight
+/// ([`emitted_ray`]) from dimensions `direction` (2).
+pub(super) fn start_light_path(
+    scene: &Scene,
+    stream: &mut Stream,
+    (choice, position, direction): (u32, u32, u32),
+) -> Option<(Emission, Ray, [f32; 3])> {
+    let u = [
+        stream.get1(choice),
+        stream.get1(position),
+        stream.get1(position + 1),
+    ];
+    let emission = scene.sample_emission(u)?;
+    let (ray, beta) = emitted_ray(scene, emission, stream.get2(direction));
+    Some((emission, ray, beta))
+}
+
+/// The first ray of a light path and its weight `β₀` (see the module's
+/// text), `u` drawing its direction (area light) or its point on the disk
+/// (environment).
+fn emitted_ray(scene: &Scene, emission: Emission, u: [f32; 2]) -> (Ray, [f32; 3]) {
+    match emission {
+        Emission::Surface {
+            point,
+            pdf,
+            radiance,
+            ..
+        } => {
+            let frame = Frame::from_normal(point.ng.to_array());
+            let local = warp::square_to_cosine_hemisphere(u);
+            let d = Vec3A::from(frame.to_world(local)).normalize();
+            let s = std::f32::consts::PI / pdf;
+            (
+                Ray {
+                    o: offset(point.p, point.ng, d),
+                    d,
+                    tmax: f32::INFINITY,
+                },
+                radiance.map(|l| l * s),
+            )
+        }
+        Emission::Environment {
+            d, pdf, radiance, ..
+        } => {
+            let (center, radius) = scene.bounding_sphere();
+            let frame = Frame::from_normal(d.to_array());
+            let [a, b] = warp::square_to_uniform_disk_concentric(u);
+            let o = center + Vec3A::from(frame.to_world([a * radius, b * radius, radius]));
+            let s = std::f32::consts::PI * radius * radius / pdf;
+            (
+                Ray {
+                    o,
+                    d: -d,
+                    tmax: f32::INFINITY,
+                },
+                radiance.map(|l| l * s),
+            )
+        }
+    }
+}
+
+/// Veach's correction of the adjoint BSDF for shading normals at a point
+/// with shading normal `ns` and geometric normal `ng`, for light arriving
+/// from `from` and leaving toward `to` (unit vectors away from the point):
+/// `|(ns·from)(ng·to)| / |(ns·to)(ng·from)|`; `None` when either direction
+/// lies on different sides of the two normals (light leaks).
+#[inline]
+pub(super) fn shading_correction(ns: Vec3A, ng: Vec3A, from: Vec3A, to: Vec3A) -> Option<f32> {
+    let (si, so) = (ns.dot(from), ns.dot(to));
+    let (gi, go) = (ng.dot(from), ng.dot(to));
+    (si * gi > 0.0 && so * go > 0.0).then(|| ((si * go) / (so * gi)).abs())
 }
