@@ -6,7 +6,8 @@ its own; MIS weights them into one image. So:
 - against mcsample's path tracer (which shares only the scene): area lights
   near, far and grazing, a sphere light, the sky seen directly and through
   light subpaths, Phong lobes, a glossy sphere in a mirror-like Phong
-  floor, a constant environment, a thin lens, motion blur, a two-sided
+  floor, a constant and a cube-mapped environment, a thin lens, a moving
+  sphere and a moving camera, a two-sided
   mesh with vertex normals, and a closed room lit through its ceiling (also with unbounded paths and
   Russian roulette), with the power and the balance heuristic;
 - against Mitsuba 3's ``path``: the cross-renderer scenes of

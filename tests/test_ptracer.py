@@ -3,9 +3,10 @@
 The light tracer and the path tracer share nothing but the scene: paths
 start on the lights and are connected to the camera, splatted onto the
 film. So each scene below (area lights near, far and grazing, a sphere
-light, the environment seen directly and through light paths that enter
-by the scene's bounding disk, Phong lobes, a thin lens, motion blur, and a
-closed room lit through its ceiling, also with unbounded paths and Russian
+light, the environment (lat-long and cube-mapped) seen directly and
+through light paths that enter by the scene's bounding disk, Phong lobes,
+a thin lens, a moving sphere and a moving camera, and a closed room lit
+through its ceiling, also with unbounded paths and Russian
 roulette) is rendered by both and compared by
 ``stats.render_ztest`` (the whole image's mean and 8×8 blocks, in standard
 errors): the sample counts keep the image mean's relative standard error
@@ -55,6 +56,18 @@ def _thin_lens(d: dict) -> dict:
     return d
 
 
+def _moving_camera(d: dict) -> dict:
+    d = dict(d)
+    end = np.asarray(d["sensor"]["to_world"], dtype=float).copy()
+    end[:3, 3] += [0.4, 0.1, 0.0]
+    d["sensor"] = dict(d["sensor"], shutter_open=0.0, shutter_close=1.0, to_world_end=end)
+    return d
+
+
+def _cube_sky(d: dict) -> dict:
+    return dict(d, sky=mcs.EnvMap(np.asarray(sunless_sky().image)).convert("cube", 48))
+
+
 def _moving(d: dict) -> dict:
     d = dict(d)
     d["sensor"] = dict(d["sensor"], shutter_open=0.0, shutter_close=1.0)
@@ -74,6 +87,8 @@ SCENES = {
     "sphere on plane, sky and light": (lambda: sphere_on_plane(sunless_sky()), 1024, 256),
     "thin lens": (lambda: _thin_lens(sphere_on_plane(sunless_sky())), 1024, 256),
     "motion blur": (lambda: _moving(sphere_on_plane(sunless_sky())), 1024, 256),
+    "moving camera": (lambda: _moving_camera(sphere_on_plane(sunless_sky())), 1024, 256),
+    "cube-mapped sky": (lambda: _cube_sky(sphere_on_plane()), 1024, 256),
     "room lit through the ceiling": (lambda: lit_room(), 512, 1024),
     "room, unbounded paths, roulette from depth 2": (lambda: lit_room(), 512, 1024),
 }
