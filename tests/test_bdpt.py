@@ -12,7 +12,9 @@ its own; MIS weights them into one image. So:
   Russian roulette), with the power and the balance heuristic;
 - against Mitsuba 3's ``path``: the cross-renderer scenes of
   test_vs_mitsuba_render, the room and the mirror floor (and light tracing
-  on four of them);
+  on four of them: not on glossy lobes under the sun, a mirror floor, or a
+  30 × 30 floor of which the camera sees a corner, where light paths reach
+  the pixels too rarely to converge in a test);
 - each strategy's unweighted image mean against the best-sampled one of
   its path length (each is an unbiased estimate of the same light: a
   strategy whose own estimate is wrong stands out even where its MIS
