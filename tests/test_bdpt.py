@@ -104,7 +104,8 @@ def test_hidden_emitters_as_light_tracing_hides_them(tmp_path):
     the camera receives straight from a light, as light tracing (Mitsuba's
     ptracer) does: area lights still block and reflect (the path tracer
     instead sees through them)."""
-    scene, _, _ = _scene("room lit through the ceiling", tmp_path, hide_emitters=True)
+    # A sphere light, seen by the camera from its emitting side.
+    scene, _, _ = _scene("near sphere", tmp_path, hide_emitters=True)
     ours = mcs.render(scene, 128, seed=6, progress=False, integrator="bdpt")
     light = mcs.render(scene, 512, seed=7, progress=False, integrator="ptracer")
     t = stats.render_ztest(ours, light, alpha=ALPHA)
