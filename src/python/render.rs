@@ -300,6 +300,13 @@ impl PyScene {
         self.0.film()
     }
 
+    /// What traces the scene's triangle meshes: ``"embree 3.13.5"``
+    /// (Intel Embree 3, loaded at run time) or ``"obvhs"``.
+    #[getter]
+    fn ray_tracer(&self) -> String {
+        self.0.ray_tracer()
+    }
+
     /// The camera seen from points ``x`` (N, 3) or (3,), as light tracing
     /// connects to it (Mitsuba's ``sensor.sample_direction``), with
     /// uniform ``u`` (N, 2) or (2,) placing the point on a thin lens's

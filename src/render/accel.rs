@@ -1,8 +1,15 @@
-//! The acceleration structure: every primitive of the scene (triangles,
-//! spheres, disks) in one compressed wide BVH (obvhs' CWBVH, built by PLOC).
-//! A scene of at most [`LEAF_MAX`] primitives is a single leaf, which costs a
-//! fraction of a wide-node traversal: its triangles are tested four at a time
-//! ([`Triangles4`]), its other primitives one after the other.
+//! The acceleration structure. When Embree is there ([`super::embree`]),
+//! the scene's triangles (more than [`LEAF_MAX`] of them) are traced by it
+//! and the other primitives (spheres, disks) by obvhs beside it; without
+//! it, every primitive by obvhs. obvhs holds its primitives in one
+//! compressed wide BVH (CWBVH, built by PLOC), or, when there are at most
+//! [`LEAF_MAX`], as a single leaf, which costs a fraction of a wide-node
+//! traversal: its triangles are tested four at a time ([`Triangles4`]),
+//! its other primitives one after the other. Through the
+//! BVH, the leaves' primitives are read from a copy in the BVH's order
+//! ([`Packed`]: a triangle's vertex and edges in 40 bytes), so that a leaf
+//! is a run of memory rather than a scatter over the scene's list of
+//! primitives (176 bytes each).
 
 use std::time::Duration;
 
@@ -12,7 +19,10 @@ use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbv
 use crate::alloc;
 use crate::error::Result;
 
-use super::shape::{Candidate, Disk, Ray, Sphere, SurfacePoint, Triangle, Triangles4};
+use super::embree::Triangles as Embree;
+use super::shape::{
+    Candidate, Disk, Ray, Sphere, SurfacePoint, Triangle, Triangles4, moller_trumbore,
+};
 
 /// Working memory of the BVH builder per primitive, checked before it
 /// starts: a scene's whole compilation peaks at about 212 bytes a triangle
@@ -110,13 +120,51 @@ pub struct Hit {
 /// The most primitives tested directly, without a BVH.
 pub const LEAF_MAX: usize = 8;
 
-/// Primitives, the shape each belongs to, and their BVH (none for a scene of
+/// A primitive as the BVH's leaves read it: a triangle's first vertex and
+/// edges, with its index in [`Accel::primitives`]; another shape only by
+/// its index, with [`Packed::OTHER`] set.
+#[derive(Clone, Copy, Debug)]
+struct Packed {
+    p0: [f32; 3],
+    primitive: u32,
+    e1: [f32; 3],
+    e2: [f32; 3],
+}
+
+impl Packed {
+    /// The bit of [`Packed::primitive`] that marks a shape other than a
+    /// triangle.
+    const OTHER: u32 = 1 << 31;
+
+    fn new(primitive: &Primitive, index: u32) -> Self {
+        match primitive {
+            Primitive::Triangle(t) => Packed {
+                p0: t.p0.to_array(),
+                primitive: index,
+                e1: t.e1.to_array(),
+                e2: t.e2.to_array(),
+            },
+            _ => Packed {
+                p0: [0.0; 3],
+                primitive: index | Self::OTHER,
+                e1: [0.0; 3],
+                e2: [0.0; 3],
+            },
+        }
+    }
+}
+
+/// Primitives, the shape each belongs to, their Embree scene (the
+/// triangles, when Embree traces them) and the BVH of the others (none for
 /// at most [`LEAF_MAX`] primitives).
 pub struct Accel {
     primitives: Vec<Primitive>,
     shape_of: Vec<u32>,
     bounds: Option<Aabb>,
+    embree: Option<Embree>,
     bvh: Option<CwBvh>,
+    /// The primitives in the order of the BVH's leaves.
+    packed: Vec<Packed>,
     /// The primitives as one leaf, when there is no BVH.
     leaf: Leaf,
 }
@@ -131,13 +179,14 @@ struct Leaf {
 }
 
 impl Leaf {
-    /// Sorts `primitives` into packs of triangles and the others.
-    fn new(primitives: &[Primitive]) -> Self {
+    /// Sorts the primitives `ids` of `primitives` into packs of triangles
+    /// and the others.
+    fn new(primitives: &[Primitive], ids: &[u32]) -> Self {
         let (mut triangles, mut others) = (Vec::new(), Vec::new());
-        for (i, p) in primitives.iter().enumerate() {
-            match p {
-                Primitive::Triangle(t) => triangles.push((*t, i as u32)),
-                _ => others.push(i as u32),
+        for &i in ids {
+            match &primitives[i as usize] {
+                Primitive::Triangle(t) => triangles.push((*t, i)),
+                _ => others.push(i),
             }
         }
         let packs = triangles
@@ -167,32 +216,75 @@ impl Accel {
         let mut prims = alloc::with_capacity(n, WHAT)?;
         prims.extend(primitives.into_iter().map(|p| p.0));
         let primitives = prims;
-        let aabbs = alloc::collect(primitives.iter().map(Primitive::bounds), WHAT)?;
+        let bounds = primitives
+            .iter()
+            .map(Primitive::bounds)
+            .reduce(|a, b| a.union(&b));
+        let triangles = primitives
+            .iter()
+            .filter(|p| matches!(p, Primitive::Triangle(_)))
+            .count();
+        let embree = if triangles > LEAF_MAX {
+            let mut list = alloc::with_capacity(triangles, WHAT)?;
+            list.extend(primitives.iter().enumerate().filter_map(|(i, p)| match p {
+                Primitive::Triangle(t) => Some((*t, i as u32)),
+                _ => None,
+            }));
+            Embree::new(&list)?
+        } else {
+            None
+        };
+        // What obvhs traces: all, or what Embree does not.
+        let mut ids = alloc::with_capacity(n, WHAT)?;
+        ids.extend((0..n as u32).filter(|&i| {
+            embree.is_none() || !matches!(primitives[i as usize], Primitive::Triangle(_))
+        }));
+        let aabbs = alloc::collect(
+            ids.iter().map(|&i| primitives[i as usize].bounds()),
+            WHAT,
+        )?;
         // The builder allocates as it goes, infallibly: check first that
         // its working memory is there.
-        if n > LEAF_MAX {
-            alloc::probe::<u8>(n.saturating_mul(BUILD_BYTES_PER_PRIMITIVE), WHAT)?;
+        if ids.len() > LEAF_MAX {
+            alloc::probe::<u8>(ids.len().saturating_mul(BUILD_BYTES_PER_PRIMITIVE), WHAT)?;
         }
-        let bounds = aabbs.iter().copied().reduce(|a, b| a.union(&b));
-        let bvh = (primitives.len() > LEAF_MAX).then(|| {
+        let bvh = (ids.len() > LEAF_MAX).then(|| {
             build_cwbvh(
                 &aabbs,
                 BvhBuildParams::medium_build(),
                 &mut Duration::default(),
             )
         });
-        let leaf = if bvh.is_some() {
-            Default::default()
-        } else {
-            Leaf::new(&primitives)
+        let (leaf, packed) = match &bvh {
+            Some(bvh) => (
+                Default::default(),
+                alloc::collect(
+                    bvh.primitive_indices.iter().map(|&j| {
+                        let i = ids[j as usize];
+                        Packed::new(&primitives[i as usize], i)
+                    }),
+                    WHAT,
+                )?,
+            ),
+            None => (Leaf::new(&primitives, &ids), Vec::new()),
         };
         Ok(Accel {
             primitives,
             shape_of,
             bounds,
+            embree,
             bvh,
+            packed,
             leaf,
         })
+    }
+
+    /// What traces the triangles: `"embree 3.13.5"` (its version) or
+    /// `"obvhs"`.
+    pub fn ray_tracer(&self) -> String {
+        self.embree
+            .as_ref()
+            .map_or_else(|| "obvhs".into(), Embree::name)
     }
 
     /// The primitives, in the order they were given.
@@ -211,10 +303,31 @@ impl Accel {
     /// would cost a good part of it).
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        match self.bvh.as_ref() {
-            None => self.intersect_leaf(ray),
-            Some(bvh) => self.intersect_bvh(bvh, ray),
+        match (self.embree.as_ref(), self.bvh.as_ref()) {
+            (None, None) => self.intersect_leaf(ray),
+            (None, Some(bvh)) => self.intersect_bvh(bvh, ray),
+            (Some(embree), _) => self.intersect_embree(embree, ray),
         }
+    }
+
+    /// [`Accel::intersect`] when Embree traces the triangles: its nearest
+    /// hit, then the others' nearer than it.
+    #[inline(never)]
+    fn intersect_embree(&self, embree: &Embree, ray: &Ray) -> Option<Hit> {
+        let hit = embree.intersect(ray).map(|(primitive, t, bary)| Hit {
+            t,
+            primitive,
+            bary,
+        });
+        let shrunk = Ray {
+            tmax: hit.map_or(ray.tmax, |h| h.t),
+            ..*ray
+        };
+        let other = match self.bvh.as_ref() {
+            None => self.intersect_leaf(&shrunk),
+            Some(bvh) => self.intersect_bvh(bvh, &shrunk),
+        };
+        other.or(hit)
     }
 
     /// [`Accel::intersect`] in a scene without a BVH: every primitive.
@@ -257,13 +370,12 @@ impl Accel {
         let mut hit = RayHit::none();
         let query = obvhs::ray::Ray::new(ray.o, ray.d, 0.0, ray.tmax);
         bvh.ray_traverse(query, &mut hit, |r, id| {
-            let primitive = bvh.primitive_indices[id];
             let shrunk = Ray {
                 tmax: r.tmax,
                 ..*ray
             };
-            match self.primitives[primitive as usize].intersect(&shrunk) {
-                Some(c) => {
+            match self.intersect_packed(id, &shrunk) {
+                Some((primitive, c)) => {
                     best = Hit {
                         t: c.t,
                         primitive,
@@ -277,9 +389,30 @@ impl Accel {
         (best.t < ray.tmax).then_some(best)
     }
 
+    /// The hit of `ray` on the primitive at position `id` of the BVH's
+    /// leaves, with that primitive's index.
+    #[inline(always)]
+    fn intersect_packed(&self, id: usize, ray: &Ray) -> Option<(u32, Candidate)> {
+        let p = &self.packed[id];
+        if p.primitive & Packed::OTHER != 0 {
+            let primitive = p.primitive & !Packed::OTHER;
+            let c = self.primitives[primitive as usize].intersect(ray)?;
+            return Some((primitive, c));
+        }
+        let scaled = moller_trumbore(ray.o.to_array(), ray.d.to_array(), p.p0, p.e1, p.e2);
+        if !scaled.inside {
+            return None;
+        }
+        let (ahead, t, bary) = scaled.hit(ray.tmax);
+        ahead.then_some((p.primitive, Candidate { t, bary }))
+    }
+
     /// Whether anything lies on the ray in `(0, ray.tmax)`.
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
+        if self.embree.as_ref().is_some_and(|e| e.occluded(ray)) {
+            return true;
+        }
         let Some(bvh) = self.bvh.as_ref() else {
             let Leaf { packs, others } = &self.leaf;
             return packs.iter().any(|(pack, _)| pack.occludes(ray))
@@ -289,10 +422,8 @@ impl Accel {
         };
         let query = obvhs::ray::Ray::new(ray.o, ray.d, 0.0, ray.tmax);
         !bvh.ray_traverse_miss(query, |_, id| {
-            let primitive = bvh.primitive_indices[id] as usize;
-            self.primitives[primitive]
-                .intersect(ray)
-                .map_or(f32::INFINITY, |c| c.t)
+            self.intersect_packed(id, ray)
+                .map_or(f32::INFINITY, |(_, c)| c.t)
         })
     }
 

@@ -51,8 +51,8 @@ fn vertex_normals(vertices: &[Vec3A], faces: &[[usize; 3]]) -> Result<Vec<Vec3A>
 }
 
 /// Primitives a scene may hold (and faces or vertices a mesh may have):
-/// they are numbered in 32 bits.
-pub const MAX_PRIMITIVES: usize = u32::MAX as usize;
+/// they are numbered in 31 bits (the BVH's leaves keep a flag in the 32nd).
+pub const MAX_PRIMITIVES: usize = (1 << 31) - 1;
 
 /// Checks a count of `arg` against [`MAX_PRIMITIVES`].
 pub(crate) fn check_primitives(arg: &'static str, len: usize) -> Result<()> {

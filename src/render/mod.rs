@@ -35,6 +35,7 @@
 pub mod accel;
 pub mod bdpt;
 pub mod camera;
+pub mod embree;
 pub mod environment;
 pub mod film;
 pub mod filter;

@@ -159,6 +159,11 @@ impl Mover {
         }
     }
 
+    /// Its primitives and their BVH, where they are at `shutter_open`.
+    pub fn accel(&self) -> &Accel {
+        &self.accel
+    }
+
     /// Numbers its primitives from `first` in the scene's hits; returns the
     /// number after its last.
     pub fn number_from(&mut self, first: u32) -> u32 {

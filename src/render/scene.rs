@@ -378,6 +378,16 @@ impl Scene {
         &self.accel
     }
 
+    /// What traces the scene's triangles: `"embree 3.13.5"` when Embree
+    /// traces any of them (see [`super::embree`]), otherwise `"obvhs"`.
+    pub fn ray_tracer(&self) -> String {
+        std::iter::once(&self.accel)
+            .chain(self.movers.iter().map(Mover::accel))
+            .map(Accel::ray_tracer)
+            .find(|name| name != "obvhs")
+            .unwrap_or_else(|| "obvhs".into())
+    }
+
     /// The material of shape `shape`.
     #[inline]
     pub fn material(&self, shape: u32) -> &Material {

@@ -58,12 +58,12 @@ import numpy as np
 
 from .._core.render import CompiledScene, SceneBuilder
 from ..results import EmitterSample, SensorSample
-from .meshes import icosphere
+from .meshes import bumpy_sphere, icosphere
 from .parse import Camera, ShapeRecord, look_at, parse_scene
 from .serialized import read_serialized
 from .xml import read_xml, read_xml_located
 
-__all__ = ["EmitterSample", "Scene", "SensorSample", "icosphere", "look_at", "read_serialized", "read_xml"]
+__all__ = ["EmitterSample", "Scene", "SensorSample", "bumpy_sphere", "icosphere", "look_at", "read_serialized", "read_xml"]
 
 
 @dataclass
@@ -166,6 +166,18 @@ class Scene:
             b.set_filter(c.rfilter, c.stddev, c.sample_border)
             self._compiled = b.build()
         return self._compiled
+
+    @property
+    def ray_tracer(self) -> str:
+        """What traces the scene's triangle meshes: ``"embree 3.13.5"``
+        (Intel Embree 3, the kernels Mitsuba 3 traces with, loaded at run
+        time when ``libembree3.so.3`` is installed: Debian's
+        ``libembree3-3``) or ``"obvhs"`` (mcsample's own BVH, always
+        there). The environment variable ``MCSAMPLE_RAY_TRACER`` chooses
+        when the scene is first used: ``"embree"`` (a ``ValueError`` if
+        it cannot be loaded), ``"obvhs"``, or ``"auto"`` / unset (Embree
+        when it loads). Spheres and disks are always traced by obvhs."""
+        return self.compiled.ray_tracer
 
     def sample_emitter(self, x: Any, u: Any) -> "EmitterSample":
         """Emitter sampling as the renderer's next-event estimation does it.

@@ -1,10 +1,10 @@
-"""Meshes to render: :func:`icosphere`."""
+"""Meshes to render: :func:`icosphere`, :func:`bumpy_sphere`."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["icosphere"]
+__all__ = ["bumpy_sphere", "icosphere"]
 
 
 def icosphere(subdivisions: int = 2) -> tuple[np.ndarray, np.ndarray]:
@@ -36,3 +36,35 @@ def icosphere(subdivisions: int = 2) -> tuple[np.ndarray, np.ndarray]:
              ([a, mid(a, b), mid(c, a)], [b, mid(b, c), mid(a, b)],
               [c, mid(c, a), mid(b, c)], [mid(a, b), mid(b, c), mid(c, a)])]
     return np.array(verts), np.array(f, dtype=np.int64)
+
+
+def bumpy_sphere(rows: int = 251, cols: int = 400, bumps: float = 0.05,
+                 frequency: int = 12) -> tuple[np.ndarray, np.ndarray]:
+    """A unit sphere with smooth bumps as a latitude-longitude triangle
+    mesh: ``rows`` rings of vertices from pole to pole (the poles one vertex
+    each), ``cols`` vertices a ring, the radius at polar angle θ and azimuth
+    φ being ``1 + bumps · sin(frequency θ) · cos(frequency φ)``.
+
+    Returns (vertices ((rows - 2) * cols + 2, 3) float64, faces
+    (2 * cols * (rows - 2), 3) int64), counter-clockwise seen from outside:
+    the defaults give 199,200 triangles, ``rows=502, cols=1000`` 10^6.
+    Generated, not read: the mesh benchmarks need no data file."""
+    if rows < 3 or cols < 3:
+        raise ValueError(f"bumpy_sphere needs rows >= 3 and cols >= 3, got {rows}, {cols}")
+    theta = np.linspace(0.0, np.pi, rows)[1:-1, None]
+    phi = np.linspace(0.0, 2 * np.pi, cols, endpoint=False)[None, :]
+    r = 1 + bumps * np.sin(frequency * theta) * np.cos(frequency * phi)
+    ring = np.stack([r * np.sin(theta) * np.cos(phi), r * np.cos(theta),
+                     -r * np.sin(theta) * np.sin(phi)], axis=-1).reshape(-1, 3)
+    north, south = len(ring), len(ring) + 1
+    vertices = np.concatenate([ring, [[0.0, 1.0, 0.0], [0.0, -1.0, 0.0]]])
+    j = np.arange(cols)
+    j1 = (j + 1) % cols
+    i = np.arange(rows - 3)[:, None] * cols
+    a, b, c, d = i + j, i + j1, i + cols + j, i + cols + j1
+    quads = np.concatenate([np.stack([a, c, b], -1).reshape(-1, 3),
+                            np.stack([b, c, d], -1).reshape(-1, 3)])
+    last = (rows - 3) * cols
+    caps = np.concatenate([np.stack([np.full(cols, north), j, j1], -1),
+                           np.stack([last + j, np.full(cols, south), last + j1], -1)])
+    return vertices, np.concatenate([quads, caps]).astype(np.int64)

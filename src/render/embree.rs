@@ -1,0 +1,364 @@
+//! Intel Embree 3, the ray-tracing kernels Mitsuba 3 traces with on the
+//! CPU, loaded at run time. When `libembree3.so.3` is on the system
+//! (Debian and Ubuntu: `libembree3-3`), a scene's triangles are traced by
+//! it; without it, by obvhs ([`super::accel`]). Nothing links against it,
+//! so one wheel serves both.
+//!
+//! The environment variable `MCSAMPLE_RAY_TRACER`, read when a scene is
+//! built, chooses: `embree` (an error when the library cannot be
+//! loaded), `obvhs`, or `auto` / unset (Embree when it loads).
+//!
+//! The one module of the crate that calls foreign code: every call into
+//! Embree is `unsafe`, each with the argument that makes it sound.
+#![allow(unsafe_code)]
+
+use std::ffi::{c_char, c_void};
+use std::sync::OnceLock;
+
+use libloading::Library;
+
+use super::shape::{Ray, Triangle};
+use crate::error::{Error, Result};
+
+/// The names tried, in order.
+const LIBRARIES: [&str; 2] = ["libembree3.so.3", "libembree3.so"];
+
+/// The variable that chooses the ray tracer.
+pub const VARIABLE: &str = "MCSAMPLE_RAY_TRACER";
+
+type Handle = *mut c_void;
+
+/// `RTCIntersectContext` of Embree 3.13 as Debian builds it (one instance
+/// level, no minimum width).
+#[repr(C)]
+struct Context {
+    flags: u32,
+    filter: *const c_void,
+    inst_id: [u32; 1],
+}
+
+/// `RTCRay`.
+#[repr(C, align(16))]
+#[derive(Clone, Copy)]
+struct RtcRay {
+    org: [f32; 3],
+    tnear: f32,
+    dir: [f32; 3],
+    time: f32,
+    tfar: f32,
+    mask: u32,
+    id: u32,
+    flags: u32,
+}
+
+/// `RTCHit`.
+#[repr(C, align(16))]
+struct RtcHit {
+    ng: [f32; 3],
+    u: f32,
+    v: f32,
+    prim_id: u32,
+    geom_id: u32,
+    inst_id: [u32; 1],
+}
+
+/// `RTCRayHit`.
+#[repr(C)]
+struct RayHit {
+    ray: RtcRay,
+    hit: RtcHit,
+}
+
+/// `RTC_INVALID_GEOMETRY_ID`.
+const INVALID: u32 = u32::MAX;
+/// `RTC_ERROR_OUT_OF_MEMORY`.
+const OUT_OF_MEMORY: u32 = 4;
+
+/// The entry points used, and the device every scene is made on.
+struct Api {
+    version: String,
+    device: Handle,
+    device_error: unsafe extern "C" fn(Handle) -> u32,
+    new_scene: unsafe extern "C" fn(Handle) -> Handle,
+    set_scene_flags: unsafe extern "C" fn(Handle, u32),
+    set_build_quality: unsafe extern "C" fn(Handle, u32),
+    new_geometry: unsafe extern "C" fn(Handle, u32) -> Handle,
+    new_buffer: unsafe extern "C" fn(Handle, u32, u32, u32, usize, usize) -> *mut c_void,
+    commit_geometry: unsafe extern "C" fn(Handle),
+    attach_geometry: unsafe extern "C" fn(Handle, Handle) -> u32,
+    release_geometry: unsafe extern "C" fn(Handle),
+    commit_scene: unsafe extern "C" fn(Handle),
+    release_scene: unsafe extern "C" fn(Handle),
+    intersect1: unsafe extern "C" fn(Handle, *mut Context, *mut RayHit),
+    occluded1: unsafe extern "C" fn(Handle, *mut Context, *mut RtcRay),
+    /// Kept loaded for the process's life: the pointers above point into it.
+    _library: Library,
+}
+
+// SAFETY: Embree's device and committed scenes may be used from any
+// thread at once (its API's documented thread safety); the function
+// pointers are plain code addresses.
+unsafe impl Send for Api {}
+unsafe impl Sync for Api {}
+
+impl Api {
+    /// Loads the library and makes a device, or says why not.
+    fn load() -> std::result::Result<Api, String> {
+        // SAFETY: loading a shared library runs its initialisers: Embree's
+        // are its own static constructors, safe to run at any time.
+        let library = LIBRARIES
+            .iter()
+            .find_map(|name| unsafe { Library::new(name) }.ok())
+            .ok_or_else(|| format!("{} not found", LIBRARIES[0]))?;
+        macro_rules! entry {
+            ($name:literal) => {
+                // SAFETY: the symbol has the C signature of Embree 3's
+                // header, which the field's type restates.
+                *unsafe { library.get(concat!($name, "\0").as_bytes()) }
+                    .map_err(|e| format!("{}: {e}", $name))?
+            };
+        }
+        let new_device: unsafe extern "C" fn(*const c_char) -> Handle = entry!("rtcNewDevice");
+        let property: unsafe extern "C" fn(Handle, u32) -> isize =
+            entry!("rtcGetDeviceProperty");
+        // SAFETY: a null configuration string is Embree's default.
+        let device = unsafe { new_device(std::ptr::null()) };
+        if device.is_null() {
+            return Err("rtcNewDevice failed (an unsupported CPU?)".into());
+        }
+        // RTC_DEVICE_PROPERTY_VERSION (0): major * 10000 + minor * 100 + patch.
+        // SAFETY: a valid device and property.
+        let v = unsafe { property(device, 0) };
+        Ok(Api {
+            version: format!("{}.{}.{}", v / 10000, v / 100 % 100, v % 100),
+            device,
+            device_error: entry!("rtcGetDeviceError"),
+            new_scene: entry!("rtcNewScene"),
+            set_scene_flags: entry!("rtcSetSceneFlags"),
+            set_build_quality: entry!("rtcSetSceneBuildQuality"),
+            new_geometry: entry!("rtcNewGeometry"),
+            new_buffer: entry!("rtcSetNewGeometryBuffer"),
+            commit_geometry: entry!("rtcCommitGeometry"),
+            attach_geometry: entry!("rtcAttachGeometry"),
+            release_geometry: entry!("rtcReleaseGeometry"),
+            commit_scene: entry!("rtcCommitScene"),
+            release_scene: entry!("rtcReleaseScene"),
+            intersect1: entry!("rtcIntersect1"),
+            occluded1: entry!("rtcOccluded1"),
+            _library: library,
+        })
+    }
+
+    /// The library, loaded on first use, or why it could not be.
+    fn get() -> std::result::Result<&'static Api, &'static str> {
+        static API: OnceLock<std::result::Result<Api, String>> = OnceLock::new();
+        API.get_or_init(Api::load).as_ref().map_err(String::as_str)
+    }
+
+    /// The device's pending error, as [`Error`] (`what` being built).
+    fn check(&self, what: &str, bytes: u128) -> Result<()> {
+        // SAFETY: a valid device.
+        match unsafe { (self.device_error)(self.device) } {
+            0 => Ok(()),
+            OUT_OF_MEMORY => Err(Error::Memory {
+                what: "Embree's BVH",
+                bytes,
+            }),
+            code => Err(Error::Argument {
+                arg: "scene",
+                message: format!("Embree failed to build {what} (RTCError {code})"),
+            }),
+        }
+    }
+}
+
+/// The ray tracer `MCSAMPLE_RAY_TRACER` asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Choice {
+    Auto,
+    Embree,
+    Obvhs,
+}
+
+fn choice() -> Result<Choice> {
+    match std::env::var(VARIABLE).as_deref() {
+        Err(_) | Ok("" | "auto") => Ok(Choice::Auto),
+        Ok("embree") => Ok(Choice::Embree),
+        Ok("obvhs") => Ok(Choice::Obvhs),
+        Ok(other) => Err(Error::Argument {
+            arg: VARIABLE,
+            message: format!(
+                "{VARIABLE} = {other:?}: must be \"embree\", \"obvhs\" or \"auto\""
+            ),
+        }),
+    }
+}
+
+/// The Embree library when the scenes built now should use it: `None`
+/// under `obvhs`, or under `auto` without the library.
+///
+/// # Errors
+/// [`Error::Argument`] for an unknown `MCSAMPLE_RAY_TRACER`, or when it
+/// asks for `embree` and the library does not load.
+fn wanted() -> Result<Option<&'static Api>> {
+    match choice()? {
+        Choice::Obvhs => Ok(None),
+        Choice::Auto => Ok(Api::get().ok()),
+        Choice::Embree => Api::get().map(Some).map_err(|why| Error::Argument {
+            arg: VARIABLE,
+            message: format!("{VARIABLE} = \"embree\", but Embree 3 cannot be loaded: {why}"),
+        }),
+    }
+}
+
+/// Triangles in an Embree scene (one triangle mesh of unshared vertices),
+/// with the index of each in the scene's list of primitives.
+pub struct Triangles {
+    api: &'static Api,
+    scene: Handle,
+    primitive: Vec<u32>,
+}
+
+// SAFETY: a committed Embree scene is read-only and may be traced from
+// any thread (see `Api`).
+unsafe impl Send for Triangles {}
+unsafe impl Sync for Triangles {}
+
+impl Drop for Triangles {
+    fn drop(&mut self) {
+        // SAFETY: the scene was made by `new` and is released once.
+        unsafe { (self.api.release_scene)(self.scene) }
+    }
+}
+
+impl Triangles {
+    /// The triangles of `triangles` (each with its primitive index) in an
+    /// Embree scene, or `None` when Embree is not to be used.
+    ///
+    /// # Errors
+    /// [`Error::Memory`] when Embree runs out of memory; [`Error::Argument`]
+    /// as [`wanted`], or when Embree fails otherwise.
+    pub fn new(triangles: &[(Triangle, u32)]) -> Result<Option<Self>> {
+        let Some(api) = wanted()? else {
+            return Ok(None);
+        };
+        let n = triangles.len();
+        let primitive = crate::alloc::collect(triangles.iter().map(|t| t.1), "Embree's BVH")?;
+        // About what Embree allocates: its copy of the vertices and
+        // indices, and a BVH of some 100 bytes a triangle.
+        let bytes = n as u128 * 160;
+        // SAFETY: calls on a valid device, in the order Embree's API
+        // requires (buffers filled before the geometry is committed,
+        // attached, released; the scene committed before it is traced).
+        // The buffers Embree returns hold 3n vertices and n triangles.
+        unsafe {
+            let scene = (api.new_scene)(api.device);
+            let release_on_error = Triangles {
+                api,
+                scene,
+                primitive,
+            };
+            api.check("a scene", bytes)?;
+            // RTC_SCENE_FLAG_ROBUST: no optimisation that could let a ray
+            // slip between two triangles sharing an edge.
+            (api.set_scene_flags)(scene, 1 << 2);
+            // RTC_BUILD_QUALITY_HIGH: a scene is built once and traced
+            // billions of times.
+            (api.set_build_quality)(scene, 2);
+            let geometry = (api.new_geometry)(api.device, 0);
+            api.check("a triangle mesh", bytes)?;
+            // RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3: 3n vertices.
+            let vertices = (api.new_buffer)(geometry, 1, 0, 0x9003, 12, 3 * n).cast::<[f32; 3]>();
+            // RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3: n triangles.
+            let indices = (api.new_buffer)(geometry, 0, 0, 0x5003, 12, n).cast::<[u32; 3]>();
+            if vertices.is_null() || indices.is_null() {
+                (api.release_geometry)(geometry);
+                api.check("a triangle mesh", bytes)?;
+                return Err(Error::Memory {
+                    what: "Embree's BVH",
+                    bytes,
+                });
+            }
+            let vertices = std::slice::from_raw_parts_mut(vertices, 3 * n);
+            let indices = std::slice::from_raw_parts_mut(indices, n);
+            for (i, (t, _)) in triangles.iter().enumerate() {
+                let v = 3 * i as u32;
+                indices[i] = [v, v + 1, v + 2];
+                vertices[3 * i] = t.p0.to_array();
+                vertices[3 * i + 1] = (t.p0 + t.e1).to_array();
+                vertices[3 * i + 2] = (t.p0 + t.e2).to_array();
+            }
+            (api.commit_geometry)(geometry);
+            (api.attach_geometry)(scene, geometry);
+            (api.release_geometry)(geometry);
+            (api.commit_scene)(scene);
+            api.check("the BVH", bytes)?;
+            Ok(Some(release_on_error))
+        }
+    }
+
+    /// `"embree"` and the library's version, as `"embree 3.13.5"`.
+    pub fn name(&self) -> String {
+        format!("embree {}", self.api.version)
+    }
+
+    fn ray(ray: &Ray) -> RtcRay {
+        RtcRay {
+            org: ray.o.to_array(),
+            tnear: 0.0,
+            dir: ray.d.to_array(),
+            time: 0.0,
+            tfar: ray.tmax,
+            mask: u32::MAX,
+            id: 0,
+            flags: 0,
+        }
+    }
+
+    fn context() -> Context {
+        // rtcInitIntersectContext: incoherent rays, no filter.
+        Context {
+            flags: 0,
+            filter: std::ptr::null(),
+            inst_id: [INVALID],
+        }
+    }
+
+    /// The nearest hit of `ray` in `[0, ray.tmax]`: the primitive's index,
+    /// the distance and the barycentrics `(b1, b2)` of `p0 + b1 e1 + b2 e2`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<(u32, f32, [f32; 2])> {
+        let mut rh = RayHit {
+            ray: Self::ray(ray),
+            hit: RtcHit {
+                ng: [0.0; 3],
+                u: 0.0,
+                v: 0.0,
+                prim_id: INVALID,
+                geom_id: INVALID,
+                inst_id: [INVALID],
+            },
+        };
+        let mut context = Self::context();
+        // SAFETY: a committed scene, a context and a ray-hit laid out as
+        // Embree's header declares them.
+        unsafe { (self.api.intersect1)(self.scene, &mut context, &mut rh) };
+        (rh.hit.geom_id != INVALID).then(|| {
+            (
+                self.primitive[rh.hit.prim_id as usize],
+                rh.ray.tfar,
+                [rh.hit.u, rh.hit.v],
+            )
+        })
+    }
+
+    /// Whether a triangle lies on `ray` in `[0, ray.tmax]`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        let mut r = Self::ray(ray);
+        let mut context = Self::context();
+        // SAFETY: as in `intersect`.
+        unsafe { (self.api.occluded1)(self.scene, &mut context, &mut r) };
+        r.tfar == f32::NEG_INFINITY
+    }
+}
