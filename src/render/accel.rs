@@ -209,6 +209,12 @@ impl Accel {
     /// # Errors
     /// [`crate::Error::Memory`] when the BVH's memory cannot be had.
     pub fn new(primitives: Vec<(Primitive, u32)>) -> Result<Self> {
+        Self::build(primitives, true)
+    }
+
+    /// [`Accel::new`], with Embree only if `embree` (and as
+    /// `MCSAMPLE_RAY_TRACER` says).
+    fn build(primitives: Vec<(Primitive, u32)>, embree: bool) -> Result<Self> {
         const WHAT: &str = "the BVH";
         let n = primitives.len();
         let mut shape_of = alloc::with_capacity(n, WHAT)?;
@@ -224,7 +230,7 @@ impl Accel {
             .iter()
             .filter(|p| matches!(p, Primitive::Triangle(_)))
             .count();
-        let embree = if triangles > LEAF_MAX {
+        let embree = if embree && triangles > LEAF_MAX {
             let mut list = alloc::with_capacity(triangles, WHAT)?;
             list.extend(primitives.iter().enumerate().filter_map(|(i, p)| match p {
                 Primitive::Triangle(t) => Some((*t, i as u32)),
@@ -473,6 +479,57 @@ mod tests {
             let (lo, hi) = accel.bounds().unwrap();
             assert!((lo.z + 3.0 * count as f32 + 1.0).abs() < 1e-4 && (hi.z + 2.0).abs() < 1e-4);
         }
+    }
+
+    /// Embree and obvhs find the same hits on a cloud of 2,000 random
+    /// triangles, 5,000 rays from random points, and the same occlusion.
+    /// Where Embree cannot be loaded only obvhs runs, except under CI,
+    /// which installs it.
+    #[test]
+    fn embree_and_obvhs_agree() {
+        let mut rng = crate::rng::Rng::new(7, 11);
+        let mut u = || rng.next_float::<f32>();
+        let mut point = |scale: f32| Vec3A::new(u() - 0.5, u() - 0.5, u() - 0.5) * scale;
+        let prims: Vec<(Primitive, u32)> = (0..2000)
+            .map(|i| {
+                let t = Triangle {
+                    p0: point(4.0),
+                    e1: point(0.6),
+                    e2: point(0.6),
+                    normals: None,
+                };
+                (Primitive::Triangle(t), i)
+            })
+            .collect();
+        let rays: Vec<Ray> = (0..5000)
+            .map(|i| Ray {
+                o: point(6.0),
+                d: point(1.0),
+                tmax: if i % 2 == 0 { f32::INFINITY } else { 3.0 },
+            })
+            .collect();
+        let embree = Accel::new(prims.clone()).unwrap();
+        let obvhs = Accel::build(prims, false).unwrap();
+        assert_eq!(obvhs.ray_tracer(), "obvhs");
+        if std::env::var_os("CI").is_some() {
+            assert!(embree.ray_tracer().starts_with("embree"));
+        }
+        let (mut hits, mut occluded) = (0, 0);
+        for ray in &rays {
+            let (a, b) = (embree.intersect(ray), obvhs.intersect(ray));
+            assert_eq!(a.is_some(), b.is_some(), "{ray:?}");
+            if let (Some(a), Some(b)) = (a, b) {
+                assert_eq!(a.primitive, b.primitive, "{ray:?}");
+                assert!((a.t - b.t).abs() <= 1e-5 * (1.0 + a.t), "{} {}", a.t, b.t);
+                for k in 0..2 {
+                    assert!((a.bary[k] - b.bary[k]).abs() < 1e-4, "{:?} {:?}", a.bary, b.bary);
+                }
+                hits += 1;
+            }
+            assert_eq!(embree.occluded(ray), obvhs.occluded(ray));
+            occluded += usize::from(obvhs.occluded(ray));
+        }
+        assert!(hits > 1000 && occluded == hits, "{hits} {occluded}");
     }
 
     #[test]
