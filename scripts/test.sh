@@ -9,11 +9,14 @@ cd "$(dirname "$0")/.."
 ROOT=$PWD
 
 # A libLLVM >= 16 lets Mitsuba 3 run its llvm_ad_rgb variant (Dr.Jit finds
-# it by itself); without one the suite falls back to scalar_rgb.
-if ! dpkg -s libllvm19 >/dev/null 2>&1 && command -v apt-get >/dev/null; then
+# it by itself); without one the suite falls back to scalar_rgb. Embree 3
+# traces mcsample's meshes when it loads (the suite checks both tracers,
+# and under CI that Embree loads).
+if ! { dpkg -s libllvm19 && dpkg -s libembree3-3; } >/dev/null 2>&1 \
+    && command -v apt-get >/dev/null; then
   SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
   $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq libllvm19 >/dev/null
+  $SUDO apt-get install -y -qq libllvm19 libembree3-3 >/dev/null
 fi
 
 python -m pip install --quiet --upgrade pip "maturin>=1.7,<2"

@@ -8,7 +8,8 @@
 //!   for `K = 1`) gives an unbatched result, and in a pair of inputs a
 //!   single point or a single row serves every row of the other;
 //! - shape and value errors name the argument and the first offending index;
-//! - outputs are fresh numpy arrays, or the caller's `out` ([`output`]).
+//! - outputs are fresh numpy arrays (over recycled memory when large:
+//!   [`fresh`]), or the caller's `out` ([`output`]).
 
 use super::args::type_name;
 use crate::alloc;
@@ -23,7 +24,7 @@ use pyo3::types::PyTuple;
 
 /// A float type the bindings compute in: `f32` or `f64`, readable from
 /// Python and storable in numpy arrays.
-pub trait PyFloat: Element + Real + for<'a, 'py> FromPyObject<'a, 'py> {}
+pub trait PyFloat: Element + Real + bytemuck::Pod + for<'a, 'py> FromPyObject<'a, 'py> {}
 impl PyFloat for f32 {}
 impl PyFloat for f64 {}
 
@@ -291,6 +292,25 @@ pub fn zeros<'py, F: Element>(
     Ok(array.cast_into::<PyArrayDyn<F>>()?)
 }
 
+/// A fresh numpy array of `shape` for a kernel that writes every element:
+/// at least [`super::recycle::MIN_BYTES`], over recycled memory
+/// ([`super::recycle`]: an earlier array's values until written), else
+/// [`zeros`].
+pub fn fresh<'py, F: Element + bytemuck::Pod>(
+    py: Python<'py>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyArrayDyn<F>>> {
+    let bytes = shape
+        .iter()
+        .product::<usize>()
+        .saturating_mul(size_of::<F>());
+    if bytes >= super::recycle::MIN_BYTES {
+        super::recycle::array(py, shape)
+    } else {
+        zeros(py, shape)
+    }
+}
+
 /// `array` as returned to Python: a numpy scalar when it is 0-d.
 pub fn finish<'py, F: Element>(array: Bound<'py, PyArrayDyn<F>>) -> PyResult<Obj<'py>> {
     if array.ndim() == 0 {
@@ -303,14 +323,14 @@ pub fn finish<'py, F: Element>(array: Bound<'py, PyArrayDyn<F>>) -> PyResult<Obj
 /// The array results go to: `out` (argument `arg`) when given, checked as
 /// numpy's ufuncs check theirs (a numpy array of dtype `T` and of `shape`,
 /// C-ordered and writeable; each failure says which), else a fresh one.
-pub fn output<'py, T: Element>(
+pub fn output<'py, T: Element + bytemuck::Pod>(
     py: Python<'py>,
     shape: &[usize],
     out: Out<'_, 'py>,
     arg: &'static str,
 ) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     let Some(out) = out.filter(|o| !o.is_none()) else {
-        return zeros::<T>(py, shape);
+        return fresh::<T>(py, shape);
     };
     let array = out.cast::<PyUntypedArray>().map_err(|_| {
         PyTypeError::new_err(format!(

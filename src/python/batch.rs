@@ -5,7 +5,7 @@
 //! after the pass, naming the first offending index.
 
 use super::arrays::{Check, Indices, Points, PyFloat, broadcast, finish, output, result_shape};
-use super::arrays::{writable, zeros};
+use super::arrays::{fresh, writable};
 use super::parallel::run_batch;
 use crate::python::{Obj, Out};
 use crate::simd::{STREAM_MIN_BYTES, map_rows};
@@ -24,9 +24,9 @@ pub fn map_each<'py, F, T, const K: usize, const M: usize>(
 ) -> PyResult<Obj<'py>>
 where
     F: PyFloat,
-    T: Element + Copy + Default + Send,
+    T: Element + bytemuck::Pod + Default + Send,
 {
-    let out = zeros::<T>(py, &x.out_shape(M))?;
+    let out = fresh::<T>(py, &x.out_shape(M))?;
     {
         let mut guard = out.readwrite();
         let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
@@ -58,9 +58,9 @@ pub fn map_chunks<'py, F, T, const K: usize>(
 ) -> PyResult<Obj<'py>>
 where
     F: PyFloat,
-    T: Element + Copy + Default + Send,
+    T: Element + bytemuck::Pod + Default + Send,
 {
-    let out = zeros::<T>(py, &x.out_shape(1))?;
+    let out = fresh::<T>(py, &x.out_shape(1))?;
     {
         let mut guard = out.readwrite();
         let in_rows = x.rows();
@@ -92,7 +92,7 @@ pub fn map_into<'py, F, T, const K: usize, const M: usize>(
 ) -> PyResult<Obj<'py>>
 where
     F: PyFloat,
-    T: Element + Copy + Default + Send,
+    T: Element + bytemuck::Pod + Default + Send,
 {
     let out = output::<T>(py, &x.out_shape(M), out, "out")?;
     {
@@ -159,12 +159,12 @@ pub fn map_pair<'py, F, T, const KA: usize, const KB: usize, const M: usize>(
 ) -> PyResult<Obj<'py>>
 where
     F: PyFloat,
-    T: Element + Copy + Default + Send,
+    T: Element + bytemuck::Pod + Default + Send,
 {
     let ((a, check_a), (b, check_b)) = (a, b);
     let batch = pair_shape(a, b)?;
     let n = batch.iter().product();
-    let out = zeros::<T>(py, &result_shape(&batch, M))?;
+    let out = fresh::<T>(py, &result_shape(&batch, M))?;
     {
         let mut guard = out.readwrite();
         let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
@@ -226,11 +226,11 @@ pub fn map2<'py, F, T, S, const K: usize, const M: usize, const L: usize>(
 ) -> PyResult<(Obj<'py>, Obj<'py>)>
 where
     F: PyFloat,
-    T: Element + Copy + Default + Send,
-    S: Element + Copy + Default + Send,
+    T: Element + bytemuck::Pod + Default + Send,
+    S: Element + bytemuck::Pod + Default + Send,
 {
-    let first = zeros::<T>(py, &x.out_shape(M))?;
-    let second = zeros::<S>(py, &x.out_shape(L))?;
+    let first = fresh::<T>(py, &x.out_shape(M))?;
+    let second = fresh::<S>(py, &x.out_shape(L))?;
     {
         let (mut g1, mut g2) = (first.readwrite(), second.readwrite());
         let rows1 = g1.as_slice_mut()?.as_chunks_mut::<M>().0;
@@ -258,7 +258,7 @@ pub fn map_indices<'py, const K: usize>(
     indices: &Indices<K>,
     f: impl Fn([usize; K]) -> f64 + Sync + Send,
 ) -> PyResult<Obj<'py>> {
-    let out = zeros::<f64>(py, &indices.batch)?;
+    let out = fresh::<f64>(py, &indices.batch)?;
     {
         let mut guard = out.readwrite();
         let values = guard.as_slice_mut()?;

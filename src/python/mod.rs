@@ -17,6 +17,7 @@ mod phong;
 mod pickle;
 mod qmc;
 mod records;
+mod recycle;
 mod render;
 mod rng;
 mod warp;

@@ -3,7 +3,7 @@
 //! `mcsample.qmc` (scipy's interface, their position, seeds) wrap them.
 
 use super::args::{choice, index_arg, seed};
-use super::arrays::zeros;
+use super::arrays::fresh;
 use super::parallel::detached;
 use super::pickle::reduce;
 use super::rng::wants_float32;
@@ -94,13 +94,13 @@ fn draw<'py>(
 }
 
 /// A fresh array of `shape` filled by `engine` from `start`, GIL released.
-fn filled<'py, F: Element + Real>(
+fn filled<'py, F: Element + Real + bytemuck::Pod>(
     py: Python<'py>,
     engine: &Engine,
     start: u64,
     shape: [usize; 2],
 ) -> PyResult<Obj<'py>> {
-    let out: Bound<'py, PyArrayDyn<F>> = zeros(py, &shape)?;
+    let out: Bound<'py, PyArrayDyn<F>> = fresh(py, &shape)?;
     {
         let mut guard = out.readwrite();
         let flat = guard.as_slice_mut()?;

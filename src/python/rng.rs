@@ -1,7 +1,7 @@
 //! `mcsample.Rng` and `mcsample.uniform`.
 
 use super::args::{index_arg, seed};
-use super::arrays::{finish, zeros};
+use super::arrays::{finish, fresh};
 use super::parallel::detached;
 use super::pickle::reduce;
 use crate::math::Real;
@@ -65,12 +65,12 @@ pub(super) fn wants_float32(py: Python<'_>, dtype: Option<&Obj<'_>>) -> PyResult
 
 /// The next `shape` floats of `rng` as a fresh array (a numpy scalar for
 /// shape `()`), filled on all cores with the GIL released.
-fn random_array<'py, F: Element + Real>(
+fn random_array<'py, F: Element + Real + bytemuck::Pod>(
     py: Python<'py>,
     rng: &mut Rng,
     shape: &[usize],
 ) -> PyResult<Obj<'py>> {
-    let out: Bound<'py, PyArrayDyn<F>> = zeros(py, shape)?;
+    let out: Bound<'py, PyArrayDyn<F>> = fresh(py, shape)?;
     {
         let mut guard = out.readwrite();
         let flat = guard.as_slice_mut()?;
@@ -197,7 +197,7 @@ impl PyRng {
         shape: Option<&Obj<'py>>,
     ) -> PyResult<Obj<'py>> {
         let shape = parse_shape(shape)?;
-        let out: Bound<'py, PyArrayDyn<u32>> = zeros(py, &shape)?;
+        let out: Bound<'py, PyArrayDyn<u32>> = fresh(py, &shape)?;
         {
             let mut guard = out.readwrite();
             let flat = guard.as_slice_mut()?;

@@ -245,10 +245,7 @@ impl Accel {
         ids.extend((0..n as u32).filter(|&i| {
             embree.is_none() || !matches!(primitives[i as usize], Primitive::Triangle(_))
         }));
-        let aabbs = alloc::collect(
-            ids.iter().map(|&i| primitives[i as usize].bounds()),
-            WHAT,
-        )?;
+        let aabbs = alloc::collect(ids.iter().map(|&i| primitives[i as usize].bounds()), WHAT)?;
         // The builder allocates as it goes, infallibly: check first that
         // its working memory is there.
         if ids.len() > LEAF_MAX {
@@ -320,11 +317,9 @@ impl Accel {
     /// hit, then the others' nearer than it.
     #[inline(never)]
     fn intersect_embree(&self, embree: &Embree, ray: &Ray) -> Option<Hit> {
-        let hit = embree.intersect(ray).map(|(primitive, t, bary)| Hit {
-            t,
-            primitive,
-            bary,
-        });
+        let hit = embree
+            .intersect(ray)
+            .map(|(primitive, t, bary)| Hit { t, primitive, bary });
         let shrunk = Ray {
             tmax: hit.map_or(ray.tmax, |h| h.t),
             ..*ray
@@ -522,7 +517,12 @@ mod tests {
                 assert_eq!(a.primitive, b.primitive, "{ray:?}");
                 assert!((a.t - b.t).abs() <= 1e-5 * (1.0 + a.t), "{} {}", a.t, b.t);
                 for k in 0..2 {
-                    assert!((a.bary[k] - b.bary[k]).abs() < 1e-4, "{:?} {:?}", a.bary, b.bary);
+                    assert!(
+                        (a.bary[k] - b.bary[k]).abs() < 1e-4,
+                        "{:?} {:?}",
+                        a.bary,
+                        b.bary
+                    );
                 }
                 hits += 1;
             }

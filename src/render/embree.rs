@@ -119,8 +119,7 @@ impl Api {
             };
         }
         let new_device: unsafe extern "C" fn(*const c_char) -> Handle = entry!("rtcNewDevice");
-        let property: unsafe extern "C" fn(Handle, u32) -> isize =
-            entry!("rtcGetDeviceProperty");
+        let property: unsafe extern "C" fn(Handle, u32) -> isize = entry!("rtcGetDeviceProperty");
         // SAFETY: a null configuration string is Embree's default.
         let device = unsafe { new_device(std::ptr::null()) };
         if device.is_null() {
@@ -187,9 +186,7 @@ fn choice() -> Result<Choice> {
         Ok("obvhs") => Ok(Choice::Obvhs),
         Ok(other) => Err(Error::Argument {
             arg: VARIABLE,
-            message: format!(
-                "{VARIABLE} = {other:?}: must be \"embree\", \"obvhs\" or \"auto\""
-            ),
+            message: format!("{VARIABLE} = {other:?}: must be \"embree\", \"obvhs\" or \"auto\""),
         }),
     }
 }

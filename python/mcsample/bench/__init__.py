@@ -15,7 +15,8 @@ import mcsample as mcs
 
 from .kernels import (suite_distr, suite_envmap, suite_phong, suite_qmc, suite_rng,
                       suite_warps)
-from .renders import suite_bidirectional, suite_convergence, suite_render, suite_samplers
+from .renders import (suite_bidirectional, suite_convergence, suite_meshes, suite_render,
+                      suite_samplers)
 from .timing import Timing, _mitsuba, measure, measure_alternating, measure_side_by_side
 
 __all__ = ["SUITES", "Timing", "main", "measure", "measure_alternating",
@@ -33,6 +34,7 @@ SUITES: dict[str, Callable[[int, int, object], list[Timing]]] = {
     "qmc": suite_qmc,
     "samplers": suite_samplers,
     "bidirectional": suite_bidirectional,
+    "meshes": suite_meshes,
 }
 
 

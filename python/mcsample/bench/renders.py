@@ -246,3 +246,122 @@ def suite_bidirectional(n: int, repeat: int, mi, target: float = 0.05, spp: int 
     return _time_to_relmse(scene, ours, ours["mcsample bdpt"],
                            ("path", {"type": "path", "max_depth": 8}), (mi, repeat),
                            (target, "room"), (spp, ref_spp))
+
+
+#: The mesh benchmarks' bumpy spheres: (rows, cols) of bumpy_sphere, and
+#: their triangles.
+MESHES = {"2e5": (251, 400), "1e6": (502, 1000)}
+
+
+def bumpy_scene(rows: int, cols: int, size: int = 256, mesh: dict | None = None) -> dict:
+    """The mesh benchmark: a Phong bumpy sphere (:func:`~mcsample.scene.bumpy_sphere`
+    of ``rows`` × ``cols``, radius 0.7) on a diffuse ground, lit by the
+    packaged sky and a small sphere area light, seen at ``size`` ×
+    ``size`` through a box filter. ``mesh`` replaces the mesh's shape
+    entry (a ``ply`` file of the same mesh)."""
+    from ..scene import bumpy_sphere
+
+    if mesh is None:
+        v, f = bumpy_sphere(rows, cols)
+        mesh = {"type": "mesh", "vertices": v * 0.7 + [0, 0.75, 0], "faces": f}
+    sensor = {"type": "perspective", "fov": 35,
+              "to_world": mcs.look_at([0, 1.2, 4.5], [0, 0.7, 0], [0, 1, 0]),
+              "film": {"type": "hdrfilm", "width": size, "height": size,
+                       "rfilter": {"type": "box"}}}
+    floor = _render_scenes()["sphere on plane"]["floor"]
+    return {"type": "scene", "sensor": sensor, "sky": mcs.EnvMap(), "floor": floor,
+            "mesh": {**mesh, "bsdf": {"type": "mcsample_phong",
+                                      "diffuse_reflectance": [0.3, 0.2, 0.1],
+                                      "specular_reflectance": [0.6, 0.6, 0.6],
+                                      "exponent": 30.0}},
+            "lamp": {"type": "sphere", "center": [1.5, 2.5, 1.0], "radius": 0.3,
+                     "emitter": {"type": "area", "radiance": [30.0, 28.0, 25.0]}}}
+
+
+def _peak_rss(code: str) -> float:
+    """Peak resident memory (MiB) of a fresh Python process running
+    ``code``."""
+    import subprocess
+    import sys
+
+    script = code + ("\nimport resource\n"
+                     "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)")
+    out = subprocess.run([sys.executable, "-c", script], check=True, capture_output=True,
+                         text=True).stdout
+    return int(out.split()[-1]) / 1024
+
+
+def _mitsuba_ply(mi, scene: "mcs.Scene", ply: str, spp: int) -> dict:
+    """``scene.to_mitsuba()`` with its largest mesh read by Mitsuba's own
+    ``ply`` plugin from ``ply`` (same BSDF and normals)."""
+    d = scene.to_mitsuba(spp=spp)
+    key = max((k for k, v in d.items() if isinstance(v, mi.Mesh)),
+              key=lambda k: d[k].face_count())
+    d[key] = {"type": "ply", "filename": ply, "bsdf": d[key].bsdf(),
+              "face_normals": not d[key].has_vertex_normals()}
+    return d
+
+
+def suite_meshes(n: int, repeat: int, mi, spp: int = 64) -> list[Timing]:
+    """The bumpy-sphere mesh scenes (:func:`bumpy_scene`, 2·10^5 and 10^6
+    triangles): samples per second at 256 × 256, 64 spp, direct and path
+    (max_depth 5), side by side with Mitsuba 3; the scene's build (BVH and
+    all) from numpy arrays and from a PLY file (the "samples" column
+    counting triangles), side by side with Mitsuba's ``load_dict`` (of
+    ``to_mitsuba()``'s dict, and of its ``ply`` plugin); and the peak
+    memory of a fresh process that loads the PLY scene and renders it once
+    (printed). mcsample's rows name the ray tracer that ran."""
+    import os
+    import tempfile
+
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for label, (rows, cols) in MESHES.items():
+            d = bumpy_scene(rows, cols)
+            triangles = len(d["mesh"]["faces"])
+            ply = os.path.join(tmp, f"bumpy-{label}.ply")
+            mcs.io.write_ply(ply, d["mesh"]["vertices"], d["mesh"]["faces"])
+            from_ply = bumpy_scene(rows, cols, mesh={"type": "ply", "filename": ply})
+            scene = mcs.Scene.from_mitsuba(d)
+            ours = f"mcsample ({scene.ray_tracer})"
+            builds = {"arrays": [(ours, lambda: mcs.Scene.from_mitsuba(d).compiled)],
+                      "ply": [(ours, lambda: mcs.Scene.from_mitsuba(from_ply).compiled)]}
+            if mi is not None:
+                ply_dict = _mitsuba_ply(mi, scene, ply, spp)
+                builds["arrays"].append(("mitsuba llvm_ad_rgb", lambda: mi.load_dict(
+                    mcs.Scene.from_mitsuba(d).to_mitsuba(spp=spp))))
+                builds["ply"].append(("mitsuba llvm_ad_rgb", lambda: mi.load_dict(ply_dict)))
+            for source, runs in builds.items():
+                seconds = measure_side_by_side([r[1] for r in runs], min(repeat, 5), 1)
+                out += [Timing(f"build {label}-triangle scene from {source}", impl, "float32",
+                               triangles, t) for (impl, _), t in zip(runs, seconds)]
+            mi_scene = None if mi is None else mi.load_dict(scene.to_mitsuba(spp=spp))
+            h, w = scene.shape
+            for integrator, depth in (("direct", {}), ("path", {"max_depth": 5})):
+                runs = [(ours, lambda i=integrator, k=depth: mcs.render(
+                    scene, spp, integrator=i, progress=False, **k))]
+                if mi_scene is not None:
+                    mi_int = mi.load_dict({"type": integrator, **depth})
+                    runs.append(("mitsuba llvm_ad_rgb", lambda m=mi_int: np.asarray(
+                        mi.render(mi_scene, integrator=m, spp=spp))))
+                seconds = measure_side_by_side([r[1] for r in runs], min(repeat, 3), 2)
+                out += [Timing(f"render {label}-triangle mesh, {integrator}", impl, "float32",
+                               w * h * spp, t) for (impl, _), t in zip(runs, seconds)]
+            load = ("import mcsample as mcs\nfrom mcsample.bench.renders import bumpy_scene\n"
+                    f"scene = mcs.Scene.from_mitsuba(bumpy_scene({rows}, {cols}, "
+                    f"mesh={{'type': 'ply', 'filename': {ply!r}}}))\n")
+            rss = {ours: _peak_rss(load + f"mcs.render(scene, {spp}, progress=False)")}
+            if mi is not None:
+                # The scene's other parts from a stand-in of 6 triangles,
+                # the mesh read by Mitsuba's ply plugin.
+                rss["mitsuba llvm_ad_rgb"] = _peak_rss(
+                    "import mcsample as mcs\nfrom mcsample.bench.renders import bumpy_scene\n"
+                    "scene = mcs.Scene.from_mitsuba(bumpy_scene(3, 3))\n"
+                    "import numpy as np\nimport mitsuba as mi\n"
+                    f"mi.set_variant({mi.variant()!r})\n"
+                    "from mcsample.bench.renders import _mitsuba_ply\n"
+                    f"m = mi.load_dict(_mitsuba_ply(mi, scene, {ply!r}, {spp}))\n"
+                    f"np.asarray(mi.render(m, spp={spp}))")
+            print(f"peak RSS, {label}-triangle scene from PLY, one {spp}-spp render: "
+                  + ", ".join(f"{k} {v:.0f} MiB" for k, v in rss.items()))
+    return out
