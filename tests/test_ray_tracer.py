@@ -49,3 +49,19 @@ def test_embree_and_obvhs_render_the_same_image(integrator, monkeypatch):
     assert same.mean() > 0.98, same.mean()
     means = [im.mean() for im in images]
     assert abs(means[0] - means[1]) < 1e-3 * means[0], means
+
+
+@pytest.mark.parametrize("rows, cols", [(3, 3), (40, 60), (251, 400)])
+def test_bumpy_sphere_is_closed_outward_and_of_the_stated_size(rows, cols):
+    """The mesh benchmarks' generated mesh: 2·cols·(rows − 2) triangles
+    (199,200 for the defaults), every edge shared by exactly two faces,
+    every face wound counter-clockwise seen from outside."""
+    v, f = mcs.scene.bumpy_sphere(rows, cols)
+    assert f.shape == (2 * cols * (rows - 2), 3) and len(v) == (rows - 2) * cols + 2
+    p = v[f]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    assert (np.einsum("ij,ij->i", n, p.mean(axis=1)) > 0).all()
+    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    assert set(np.unique(edges, axis=0, return_counts=True)[1]) == {2}
+    with pytest.raises(ValueError, match="rows >= 3"):
+        mcs.scene.bumpy_sphere(2, 10)

@@ -9,7 +9,7 @@ import sys
 #: The benchmark suites (``mcsample.bench.SUITES``), listed here so that
 #: the command line does not import the benchmarks to parse its arguments.
 SUITE_NAMES = ("rng", "warps", "distr", "phong", "envmap", "render", "convergence", "qmc",
-               "samplers", "bidirectional")
+               "samplers", "bidirectional", "meshes")
 
 
 def _int(low: int, high: int | None = None):

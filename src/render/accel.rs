@@ -231,12 +231,7 @@ impl Accel {
             .filter(|p| matches!(p, Primitive::Triangle(_)))
             .count();
         let embree = if embree && triangles > LEAF_MAX {
-            let mut list = alloc::with_capacity(triangles, WHAT)?;
-            list.extend(primitives.iter().enumerate().filter_map(|(i, p)| match p {
-                Primitive::Triangle(t) => Some((*t, i as u32)),
-                _ => None,
-            }));
-            Embree::new(&list)?
+            Embree::new(&primitives, triangles)?
         } else {
             None
         };

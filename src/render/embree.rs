@@ -17,7 +17,8 @@ use std::sync::OnceLock;
 
 use libloading::Library;
 
-use super::shape::{Ray, Triangle};
+use super::accel::Primitive;
+use super::shape::Ray;
 use crate::error::{Error, Result};
 
 /// The names tried, in order.
@@ -229,18 +230,24 @@ impl Drop for Triangles {
 }
 
 impl Triangles {
-    /// The triangles of `triangles` (each with its primitive index) in an
-    /// Embree scene, or `None` when Embree is not to be used.
+    /// The triangles among `primitives` (`n` of them) in an Embree scene,
+    /// or `None` when Embree is not to be used.
     ///
     /// # Errors
     /// [`Error::Memory`] when Embree runs out of memory; [`Error::Argument`]
     /// as [`wanted`], or when Embree fails otherwise.
-    pub fn new(triangles: &[(Triangle, u32)]) -> Result<Option<Self>> {
+    pub fn new(primitives: &[Primitive], n: usize) -> Result<Option<Self>> {
         let Some(api) = wanted()? else {
             return Ok(None);
         };
-        let n = triangles.len();
-        let primitive = crate::alloc::collect(triangles.iter().map(|t| t.1), "Embree's BVH")?;
+        let triangles = || {
+            primitives.iter().enumerate().filter_map(|(i, p)| match p {
+                Primitive::Triangle(t) => Some((t, i as u32)),
+                _ => None,
+            })
+        };
+        let mut primitive = crate::alloc::with_capacity(n, "Embree's BVH")?;
+        primitive.extend(triangles().map(|t| t.1));
         // About what Embree allocates: its copy of the vertices and
         // indices, and a BVH of some 100 bytes a triangle.
         let bytes = n as u128 * 160;
@@ -278,7 +285,7 @@ impl Triangles {
             }
             let vertices = std::slice::from_raw_parts_mut(vertices, 3 * n);
             let indices = std::slice::from_raw_parts_mut(indices, n);
-            for (i, (t, _)) in triangles.iter().enumerate() {
+            for (i, (t, _)) in triangles().enumerate() {
                 let v = 3 * i as u32;
                 indices[i] = [v, v + 1, v + 2];
                 vertices[3 * i] = t.p0.to_array();

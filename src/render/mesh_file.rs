@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use ply_rs_bw::parser::{Parser, Reader};
-use ply_rs_bw::ply::{DefaultElement, Property};
+use ply_rs_bw::ply::{Property, PropertyAccess, PropertyAccessResult};
 
 use crate::alloc;
 use crate::error::{Error, Result};
@@ -50,23 +50,72 @@ pub fn read_mesh(path: &Path) -> Result<MeshData> {
     Ok(mesh)
 }
 
-fn scalar(e: &DefaultElement, key: &str) -> Option<f64> {
-    match e.get(key)? {
-        Property::Double(v) => Some(*v),
-        p => p.to_f32_lossy().map(f64::from),
+/// A PLY vertex as read: its position and normal, and which of the six
+/// (`x y z nx ny nz`) the file gave.
+#[derive(Default)]
+struct PlyVertex {
+    values: [f64; 6],
+    given: u8,
+}
+
+impl PropertyAccess for PlyVertex {
+    fn new() -> Self {
+        Self::default()
+    }
+
+    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
+        let Some(slot) = ["x", "y", "z", "nx", "ny", "nz"]
+            .iter()
+            .position(|&k| k == name)
+        else {
+            return PropertyAccessResult::Ignored;
+        };
+        let value = match property {
+            Property::Double(v) => v,
+            p => match p.to_f32_lossy() {
+                Some(v) => f64::from(v),
+                None => return PropertyAccessResult::UnsupportedType,
+            },
+        };
+        self.values[slot] = value;
+        self.given |= 1 << slot;
+        PropertyAccessResult::Set
     }
 }
 
-fn list(p: &Property) -> Option<Vec<i64>> {
-    Some(match p {
-        Property::ListChar(v) => v.iter().map(|&x| i64::from(x)).collect(),
-        Property::ListUChar(v) => v.iter().map(|&x| i64::from(x)).collect(),
-        Property::ListShort(v) => v.iter().map(|&x| i64::from(x)).collect(),
-        Property::ListUShort(v) => v.iter().map(|&x| i64::from(x)).collect(),
-        Property::ListInt(v) => v.iter().map(|&x| i64::from(x)).collect(),
-        Property::ListUInt(v) => v.iter().map(|&x| i64::from(x)).collect(),
-        _ => return None,
-    })
+/// A PLY face as read: its polygon's vertex indices.
+#[derive(Default)]
+struct PlyFace(Option<Vec<i64>>);
+
+impl PropertyAccess for PlyFace {
+    fn new() -> Self {
+        Self::default()
+    }
+
+    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
+        if name != "vertex_indices" && name != "vertex_index" {
+            return PropertyAccessResult::Ignored;
+        }
+        self.0 = Some(match property {
+            Property::ListChar(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListUChar(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListShort(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListUShort(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListInt(v) => v.into_iter().map(i64::from).collect(),
+            Property::ListUInt(v) => v.into_iter().map(i64::from).collect(),
+            _ => return PropertyAccessResult::UnsupportedType,
+        });
+        PropertyAccessResult::Set
+    }
+}
+
+/// An element of another kind, skipped.
+struct Skipped;
+
+impl PropertyAccess for Skipped {
+    fn new() -> Self {
+        Skipped
+    }
 }
 
 /// Splits the polygon `poly` into the fan `(p0, p_k, p_k+1)`.
@@ -76,18 +125,18 @@ fn fan(poly: &[i64], faces: &mut Vec<[i64; 3]>) {
     }
 }
 
-/// Memory the PLY parser takes per element it reads (a map of named
-/// properties), checked before it starts: reading a binary mesh of 0.66 M
-/// vertices and 1.3 M faces peaks at about 272 bytes an element.
-const PLY_BYTES_PER_ELEMENT: usize = 320;
+/// Memory the PLY reader takes per element it reads (a face's list of
+/// indices, twice), checked before it starts.
+const PLY_BYTES_PER_ELEMENT: usize = 128;
 
 fn read_ply(path: &Path) -> Result<MeshData> {
     let file = std::fs::File::open(path).map_err(|e| io_error(path, e.to_string()))?;
     let mut reader = Reader::new(std::io::BufReader::new(file));
     let unreadable =
         |e: ply_rs_bw::parser::ParseError| io_error(path, format!("not a readable PLY file: {e}"));
-    let parser = Parser::<DefaultElement>::new();
-    let header = parser.read_header(&mut reader).map_err(unreadable)?;
+    let header = Parser::<Skipped>::new()
+        .read_header(&mut reader)
+        .map_err(unreadable)?;
     // The header's counts, checked before the payload is read.
     let mut elements = 0usize;
     for (name, element) in &header.elements {
@@ -107,33 +156,48 @@ fn read_ply(path: &Path) -> Result<MeshData> {
         elements.saturating_mul(PLY_BYTES_PER_ELEMENT),
         "the PLY file's elements",
     )?;
-    let payload = parser
-        .read_payload(&mut reader, &header)
-        .map_err(unreadable)?;
-    let verts = payload
-        .get("vertex")
-        .ok_or_else(|| io_error(path, "PLY file without a 'vertex' element"))?;
+    // The elements in the header's order, each read by its own type.
+    let (mut verts, mut polys) = (None, Vec::new());
+    for (name, element) in &header.elements {
+        match name.as_str() {
+            "vertex" => {
+                verts = Some(
+                    Parser::<PlyVertex>::new()
+                        .read_payload_for_element(&mut reader, element, &header)
+                        .map_err(unreadable)?,
+                );
+            }
+            "face" => {
+                polys = Parser::<PlyFace>::new()
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(unreadable)?;
+            }
+            _ => {
+                Parser::<Skipped>::new()
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(unreadable)?;
+            }
+        }
+    }
+    let verts = verts.ok_or_else(|| io_error(path, "PLY file without a 'vertex' element"))?;
     let mut vertices = alloc::with_capacity(verts.len(), "the vertices")?;
     let mut normals = alloc::with_capacity(verts.len(), "the normals")?;
-    for v in verts {
-        let p = ["x", "y", "z"].map(|k| scalar(v, k));
-        let [Some(x), Some(y), Some(z)] = p else {
+    for v in &verts {
+        if v.given & 0b111 != 0b111 {
             return Err(io_error(path, "PLY vertices need x, y and z"));
-        };
+        }
+        let [x, y, z, a, b, c] = v.values;
         vertices.push([x, y, z]);
-        if let [Some(a), Some(b), Some(c)] = ["nx", "ny", "nz"].map(|k| scalar(v, k)) {
+        if v.given == 0b11_1111 {
             normals.push([a, b, c]);
         }
     }
-    let face_elements = payload.get("face").map_or(0, Vec::len);
-    let mut faces = alloc::with_capacity(face_elements, "the faces")?;
-    for f in payload.get("face").map(Vec::as_slice).unwrap_or_default() {
-        let poly = f
-            .get("vertex_indices")
-            .or_else(|| f.get("vertex_index"))
-            .and_then(list)
-            .ok_or_else(|| io_error(path, "PLY faces need a 'vertex_indices' list"))?;
-        fan(&poly, &mut faces);
+    let mut faces = alloc::with_capacity(polys.len(), "the faces")?;
+    for f in &polys {
+        let poly =
+            f.0.as_deref()
+                .ok_or_else(|| io_error(path, "PLY faces need a 'vertex_indices' list"))?;
+        fan(poly, &mut faces);
     }
     let normals = (normals.len() == vertices.len()).then_some(normals);
     Ok(MeshData {

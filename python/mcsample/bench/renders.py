@@ -280,12 +280,13 @@ def bumpy_scene(rows: int, cols: int, size: int = 256, mesh: dict | None = None)
 
 def _peak_rss(code: str) -> float:
     """Peak resident memory (MiB) of a fresh Python process running
-    ``code``."""
+    ``code``: its VmHWM (Linux; ``ru_maxrss`` would not do, as a child
+    keeps its parent's high-water mark across fork and exec)."""
     import subprocess
     import sys
 
-    script = code + ("\nimport resource\n"
-                     "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)")
+    script = code + ("\nprint(next(line.split()[1] for line in open('/proc/self/status')"
+                     " if line.startswith('VmHWM')))")
     out = subprocess.run([sys.executable, "-c", script], check=True, capture_output=True,
                          text=True).stdout
     return int(out.split()[-1]) / 1024
@@ -310,7 +311,7 @@ def suite_meshes(n: int, repeat: int, mi, spp: int = 64) -> list[Timing]:
     counting triangles), side by side with Mitsuba's ``load_dict`` (of
     ``to_mitsuba()``'s dict, and of its ``ply`` plugin); and the peak
     memory of a fresh process that loads the PLY scene and renders it once
-    (printed). mcsample's rows name the ray tracer that ran."""
+    (printed; direct illumination). mcsample's rows name the ray tracer that ran."""
     import os
     import tempfile
 
@@ -361,7 +362,8 @@ def suite_meshes(n: int, repeat: int, mi, spp: int = 64) -> list[Timing]:
                     f"mi.set_variant({mi.variant()!r})\n"
                     "from mcsample.bench.renders import _mitsuba_ply\n"
                     f"m = mi.load_dict(_mitsuba_ply(mi, scene, {ply!r}, {spp}))\n"
-                    f"np.asarray(mi.render(m, spp={spp}))")
+                    "direct = mi.load_dict({'type': 'direct'})\n"
+                    f"np.asarray(mi.render(m, integrator=direct, spp={spp}))")
             print(f"peak RSS, {label}-triangle scene from PLY, one {spp}-spp render: "
                   + ", ".join(f"{k} {v:.0f} MiB" for k, v in rss.items()))
     return out
