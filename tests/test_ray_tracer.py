@@ -35,6 +35,27 @@ def test_the_variable_chooses_and_unknown_names_are_refused(monkeypatch):
     assert _embree_or_skip(monkeypatch).ray_tracer.startswith("embree 3.")
     with pytest.raises(ValueError, match="MCSAMPLE_RAY_TRACER"):
         _scene("optix", monkeypatch)
+    # Also for a scene without a mesh to trace.
+    ball = {"type": "scene", "sensor": {"type": "perspective", "fov": 40.0},
+            "ball": {"type": "sphere"}}
+    with pytest.raises(ValueError, match="MCSAMPLE_RAY_TRACER"):
+        mcs.Scene.from_mitsuba(ball).compiled
+
+
+def test_embree_builds_the_same_image_every_time(monkeypatch):
+    """Embree builds its BVH on its own threads: two builds of one scene
+    must still give the same bits (1 and 2 render threads)."""
+    _embree_or_skip(monkeypatch)
+    images = []
+    for threads in (1, 2):
+        scene = _scene("embree", monkeypatch)
+        previous = mcs.get_num_threads()
+        mcs.set_num_threads(threads)
+        try:
+            images.append(mcs.render(scene, 4, seed=9, integrator="path", progress=False).image)
+        finally:
+            mcs.set_num_threads(previous)
+    np.testing.assert_array_equal(images[0], images[1])
 
 
 @pytest.mark.parametrize("integrator", ["direct", "path", "ptracer"])

@@ -19,6 +19,12 @@ def _address(a: np.ndarray) -> int:
     return a.__array_interface__["data"][0]
 
 
+def _spoil(a: np.ndarray) -> None:
+    """Marks a freed output's memory (all bits set: NaN as floats), so
+    that a kernel that leaves an element unwritten shows it."""
+    a.view(np.uint8)[...] = 0xFF
+
+
 def _u(seed: int, dim: int = 2, dtype=np.float32) -> np.ndarray:
     return np.random.default_rng(seed).random((N, dim)).astype(dtype)
 
@@ -28,12 +34,13 @@ def test_a_freed_output_is_reused_and_rewritten():
     first = warp(_u(1))
     assert type(first.base).__name__ == "RecycledBlock"
     address = _address(first)
+    _spoil(first)
     del first
     gc.collect()
     u = _u(2)
     second = warp(u)
     assert _address(second) == address
-    out = np.empty_like(second)
+    out = np.zeros_like(second)
     warp(u, out=out)
     np.testing.assert_array_equal(second, out)
 
@@ -75,6 +82,16 @@ def test_plain_calls_over_recycled_blocks_equal_fresh_results(case):
     for seed in (7, 8):
         expected = np.array(call(seed), copy=True)
         garbage = call(seed + 100)  # another output of the same size, then freed
+        _spoil(garbage)
         del garbage
         gc.collect()
         np.testing.assert_array_equal(call(seed), expected)
+
+
+def test_results_of_more_than_32_dimensions_are_refused():
+    """rust-numpy reads at most 32 dimensions: 32 work, 33 are a
+    ValueError (it was a panic)."""
+    a = mcs.Rng(1).random((1,) * 31 + (N,))
+    assert a.shape == (1,) * 31 + (N,) and ((a >= 0) & (a < 1)).all()
+    with pytest.raises(ValueError, match="at most 32"):
+        mcs.Rng(1).random((1,) * 33 + (N,))

@@ -285,6 +285,17 @@ pub fn zeros<'py, F: Element>(
     py: Python<'py>,
     shape: &[usize],
 ) -> PyResult<Bound<'py, PyArrayDyn<F>>> {
+    if shape.len() > 32 {
+        // rust-numpy reads at most 32 dimensions (numpy 2 allows 64).
+        return Err(Error::Argument {
+            arg: "shape",
+            message: format!(
+                "a result of {} dimensions: at most 32 are supported",
+                shape.len()
+            ),
+        }
+        .into());
+    }
     let array = py
         .import("numpy")?
         .getattr("zeros")?
@@ -295,7 +306,7 @@ pub fn zeros<'py, F: Element>(
 /// A fresh numpy array of `shape` for a kernel that writes every element:
 /// at least [`super::recycle::MIN_BYTES`], over recycled memory
 /// ([`super::recycle`]: an earlier array's values until written), else
-/// [`zeros`].
+/// [`zeros`] (which refuses more than 32 dimensions, as rust-numpy does).
 pub fn fresh<'py, F: Element + bytemuck::Pod>(
     py: Python<'py>,
     shape: &[usize],
@@ -304,7 +315,7 @@ pub fn fresh<'py, F: Element + bytemuck::Pod>(
         .iter()
         .product::<usize>()
         .saturating_mul(size_of::<F>());
-    if bytes >= super::recycle::MIN_BYTES {
+    if bytes >= super::recycle::MIN_BYTES && shape.len() <= 32 {
         super::recycle::array(py, shape)
     } else {
         zeros(py, shape)

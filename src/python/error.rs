@@ -13,7 +13,12 @@ impl From<Error> for PyErr {
     fn from(e: Error) -> PyErr {
         match e {
             Error::Io { .. } => PyOSError::new_err(e.to_string()),
-            Error::Memory { .. } => PyMemoryError::new_err(e.to_string()),
+            Error::Memory { .. } => {
+                // Memory is short: the recycled outputs' cache gives its
+                // blocks back, so that the next request may succeed.
+                super::recycle::clear();
+                PyMemoryError::new_err(e.to_string())
+            }
             Error::ThreadPool { .. } => PyRuntimeError::new_err(e.to_string()),
             Error::InvalidWeight { .. }
             | Error::AllZero { .. }

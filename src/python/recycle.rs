@@ -10,7 +10,8 @@
 //! [`MAX_BLOCKS`] blocks and [`MAX_BYTES`] in all (the oldest leave
 //! first). A request the cache cannot serve is allocated fresh, after the
 //! cache is emptied if memory is short: a request too big for memory is
-//! still a `MemoryError`. Only kernels that write every element of their
+//! still a `MemoryError`, and every `MemoryError` mcsample raises empties
+//! the cache too. Only kernels that write every element of their
 //! output take these arrays ([`super::arrays::fresh`]): a recycled block
 //! holds an earlier array's values.
 
@@ -61,6 +62,11 @@ fn take(lines: usize) -> Result<Vec<Line>> {
     drop(cache);
     block.resize(lines, Line([0; 64]));
     Ok(block)
+}
+
+/// Empties the cache (when memory is short: see [`super::error`]).
+pub fn clear() {
+    CACHE.lock().unwrap_or_else(PoisonError::into_inner).clear();
 }
 
 /// Returns `block` to the cache, making room for it.

@@ -19,15 +19,16 @@ use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbv
 use crate::alloc;
 use crate::error::Result;
 
-use super::embree::Triangles as Embree;
+use super::embree::{self, Triangles as Embree};
 use super::shape::{
-    Candidate, Disk, Ray, Sphere, SurfacePoint, Triangle, Triangles4, moller_trumbore,
+    Candidate, Disk, Ray, Sphere, SurfacePoint, Triangle, Triangles4, triangle_hit,
 };
 
 /// Working memory of the BVH builder per primitive, checked before it
-/// starts: a scene's whole compilation peaks at about 212 bytes a triangle
-/// (a 1.3 M-triangle mesh).
-const BUILD_BYTES_PER_PRIMITIVE: usize = 256;
+/// starts: a scene's whole compilation peaked at about 212 bytes a
+/// triangle (a 1.3 M-triangle mesh), before the leaves' copy of 40 bytes
+/// ([`Packed`]) was added.
+const BUILD_BYTES_PER_PRIMITIVE: usize = 300;
 
 /// A primitive and the index of the shape (in the scene's list) it belongs
 /// to.
@@ -116,6 +117,9 @@ pub struct Hit {
     /// Barycentrics (triangles).
     pub bary: [f32; 2],
 }
+
+/// The name of obvhs as a ray tracer ([`Accel::ray_tracer`]).
+pub const OBVHS: &str = "obvhs";
 
 /// The most primitives tested directly, without a BVH.
 pub const LEAF_MAX: usize = 8;
@@ -213,7 +217,7 @@ impl Accel {
     }
 
     /// [`Accel::new`], with Embree only if `embree` (and as
-    /// `MCSAMPLE_RAY_TRACER` says).
+    /// `MCSAMPLE_RAY_TRACER` says): `false` lets the tests compare the two.
     fn build(primitives: Vec<(Primitive, u32)>, embree: bool) -> Result<Self> {
         const WHAT: &str = "the BVH";
         let n = primitives.len();
@@ -226,14 +230,14 @@ impl Accel {
             .iter()
             .map(Primitive::bounds)
             .reduce(|a, b| a.union(&b));
+        let library = if embree { embree::wanted()? } else { None };
         let triangles = primitives
             .iter()
             .filter(|p| matches!(p, Primitive::Triangle(_)))
             .count();
-        let embree = if embree && triangles > LEAF_MAX {
-            Embree::new(&primitives, triangles)?
-        } else {
-            None
+        let embree = match library {
+            Some(library) if triangles > LEAF_MAX => Embree::new(library, &primitives)?,
+            _ => None,
         };
         // What obvhs traces: all, or what Embree does not.
         let mut ids = alloc::with_capacity(n, WHAT)?;
@@ -282,7 +286,7 @@ impl Accel {
     pub fn ray_tracer(&self) -> String {
         self.embree
             .as_ref()
-            .map_or_else(|| "obvhs".into(), Embree::name)
+            .map_or_else(|| OBVHS.into(), Embree::name)
     }
 
     /// The primitives, in the order they were given.
@@ -395,12 +399,7 @@ impl Accel {
             let c = self.primitives[primitive as usize].intersect(ray)?;
             return Some((primitive, c));
         }
-        let scaled = moller_trumbore(ray.o.to_array(), ray.d.to_array(), p.p0, p.e1, p.e2);
-        if !scaled.inside {
-            return None;
-        }
-        let (ahead, t, bary) = scaled.hit(ray.tmax);
-        ahead.then_some((p.primitive, Candidate { t, bary }))
+        triangle_hit(ray, p.p0, p.e1, p.e2).map(|c| (p.primitive, c))
     }
 
     /// Whether anything lies on the ray in `(0, ray.tmax)`.

@@ -8,9 +8,12 @@
 //! built, chooses: `embree` (an error when the library cannot be
 //! loaded), `obvhs`, or `auto` / unset (Embree when it loads).
 //!
-//! The one module of the crate that calls foreign code: every call into
-//! Embree is `unsafe`, each with the argument that makes it sound.
-#![allow(unsafe_code)]
+//! The structures passed to Embree are restated from its 3.13 headers as
+//! Debian builds them (one instance level, no minimum width): only
+//! version 3.13 and later 3.x are used. Embree's device and the TBB
+//! threads it builds with belong to the process that loaded it: a process
+//! forked after that traces with obvhs. Every call into Embree is
+//! `unsafe`, each with the argument that makes it sound.
 
 use std::ffi::{c_char, c_void};
 use std::sync::OnceLock;
@@ -78,6 +81,8 @@ const OUT_OF_MEMORY: u32 = 4;
 /// The entry points used, and the device every scene is made on.
 struct Api {
     version: String,
+    /// The process that loaded it.
+    pid: u32,
     device: Handle,
     device_error: unsafe extern "C" fn(Handle) -> u32,
     new_scene: unsafe extern "C" fn(Handle) -> Handle,
@@ -99,11 +104,14 @@ struct Api {
 // SAFETY: Embree's device and committed scenes may be used from any
 // thread at once (its API's documented thread safety); the function
 // pointers are plain code addresses.
+#[allow(unsafe_code)]
 unsafe impl Send for Api {}
+#[allow(unsafe_code)]
 unsafe impl Sync for Api {}
 
 impl Api {
     /// Loads the library and makes a device, or says why not.
+    #[allow(unsafe_code)]
     fn load() -> std::result::Result<Api, String> {
         // SAFETY: loading a shared library runs its initialisers: Embree's
         // are its own static constructors, safe to run at any time.
@@ -129,8 +137,12 @@ impl Api {
         // RTC_DEVICE_PROPERTY_VERSION (0): major * 10000 + minor * 100 + patch.
         // SAFETY: a valid device and property.
         let v = unsafe { property(device, 0) };
+        if !(31300..40000).contains(&v) {
+            return Err(format!("version {v} is not 3.13 or a later 3.x"));
+        }
         Ok(Api {
             version: format!("{}.{}.{}", v / 10000, v / 100 % 100, v % 100),
+            pid: std::process::id(),
             device,
             device_error: entry!("rtcGetDeviceError"),
             new_scene: entry!("rtcNewScene"),
@@ -152,10 +164,18 @@ impl Api {
     /// The library, loaded on first use, or why it could not be.
     fn get() -> std::result::Result<&'static Api, &'static str> {
         static API: OnceLock<std::result::Result<Api, String>> = OnceLock::new();
-        API.get_or_init(Api::load).as_ref().map_err(String::as_str)
+        let api = API
+            .get_or_init(Api::load)
+            .as_ref()
+            .map_err(String::as_str)?;
+        if api.pid != std::process::id() {
+            return Err("it was loaded before this process was forked");
+        }
+        Ok(api)
     }
 
     /// The device's pending error, as [`Error`] (`what` being built).
+    #[allow(unsafe_code)]
     fn check(&self, what: &str, bytes: u128) -> Result<()> {
         // SAFETY: a valid device.
         match unsafe { (self.device_error)(self.device) } {
@@ -171,6 +191,10 @@ impl Api {
         }
     }
 }
+
+/// Embree 3, loaded, as [`wanted`] hands it out for [`Triangles::new`].
+#[derive(Clone, Copy)]
+pub struct Library3(&'static Api);
 
 /// The ray tracer `MCSAMPLE_RAY_TRACER` asks for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -193,19 +217,23 @@ fn choice() -> Result<Choice> {
 }
 
 /// The Embree library when the scenes built now should use it: `None`
-/// under `obvhs`, or under `auto` without the library.
+/// under `obvhs`, or under `auto` without the library. Every scene's build
+/// asks, whether it has triangles or not, so that a wrong setting is
+/// always an error.
 ///
 /// # Errors
 /// [`Error::Argument`] for an unknown `MCSAMPLE_RAY_TRACER`, or when it
 /// asks for `embree` and the library does not load.
-fn wanted() -> Result<Option<&'static Api>> {
+pub fn wanted() -> Result<Option<Library3>> {
     match choice()? {
         Choice::Obvhs => Ok(None),
-        Choice::Auto => Ok(Api::get().ok()),
-        Choice::Embree => Api::get().map(Some).map_err(|why| Error::Argument {
-            arg: VARIABLE,
-            message: format!("{VARIABLE} = \"embree\", but Embree 3 cannot be loaded: {why}"),
-        }),
+        Choice::Auto => Ok(Api::get().ok().map(Library3)),
+        Choice::Embree => Api::get()
+            .map(|a| Some(Library3(a)))
+            .map_err(|why| Error::Argument {
+                arg: VARIABLE,
+                message: format!("{VARIABLE} = \"embree\", but Embree 3 cannot be loaded: {why}"),
+            }),
     }
 }
 
@@ -219,44 +247,59 @@ pub struct Triangles {
 
 // SAFETY: a committed Embree scene is read-only and may be traced from
 // any thread (see `Api`).
+#[allow(unsafe_code)]
 unsafe impl Send for Triangles {}
+#[allow(unsafe_code)]
 unsafe impl Sync for Triangles {}
 
 impl Drop for Triangles {
+    #[allow(unsafe_code)]
     fn drop(&mut self) {
-        // SAFETY: the scene was made by `new` and is released once.
+        // SAFETY: the scene was made by `new` (not null) and is released
+        // once.
         unsafe { (self.api.release_scene)(self.scene) }
     }
 }
 
 impl Triangles {
-    /// The triangles among `primitives` (`n` of them) in an Embree scene,
-    /// or `None` when Embree is not to be used.
+    /// The triangles among `primitives` in an Embree scene of `library`,
+    /// or `None` when there are more than Embree numbers
+    /// (`u32::MAX / 3`: their vertices are numbered in 32 bits).
     ///
     /// # Errors
-    /// [`Error::Memory`] when Embree runs out of memory; [`Error::Argument`]
-    /// as [`wanted`], or when Embree fails otherwise.
-    pub fn new(primitives: &[Primitive], n: usize) -> Result<Option<Self>> {
-        let Some(api) = wanted()? else {
-            return Ok(None);
-        };
+    /// [`Error::Memory`] when the memory cannot be had or Embree runs out
+    /// of it; [`Error::Argument`] when Embree fails otherwise.
+    #[allow(unsafe_code)]
+    pub fn new(library: Library3, primitives: &[Primitive]) -> Result<Option<Self>> {
+        const WHAT: &str = "Embree's BVH";
+        let api = library.0;
         let triangles = || {
             primitives.iter().enumerate().filter_map(|(i, p)| match p {
                 Primitive::Triangle(t) => Some((t, i as u32)),
                 _ => None,
             })
         };
-        let mut primitive = crate::alloc::with_capacity(n, "Embree's BVH")?;
+        let n = triangles().count();
+        if n > (u32::MAX / 3) as usize {
+            return Ok(None);
+        }
+        let mut primitive = crate::alloc::with_capacity(n, WHAT)?;
         primitive.extend(triangles().map(|t| t.1));
-        // About what Embree allocates: its copy of the vertices and
-        // indices, and a BVH of some 100 bytes a triangle.
+        // About what Embree allocates: its copy of the vertices (36 bytes
+        // a triangle) and indices (12), and a BVH of some 100 bytes a
+        // triangle; Embree allocates as it goes, so check first.
         let bytes = n as u128 * 160;
+        crate::alloc::probe::<u8>(n.saturating_mul(160), WHAT)?;
         // SAFETY: calls on a valid device, in the order Embree's API
         // requires (buffers filled before the geometry is committed,
         // attached, released; the scene committed before it is traced).
         // The buffers Embree returns hold 3n vertices and n triangles.
         unsafe {
             let scene = (api.new_scene)(api.device);
+            if scene.is_null() {
+                api.check("a scene", bytes)?;
+                return Err(Error::Memory { what: WHAT, bytes });
+            }
             let release_on_error = Triangles {
                 api,
                 scene,
@@ -278,10 +321,7 @@ impl Triangles {
             if vertices.is_null() || indices.is_null() {
                 (api.release_geometry)(geometry);
                 api.check("a triangle mesh", bytes)?;
-                return Err(Error::Memory {
-                    what: "Embree's BVH",
-                    bytes,
-                });
+                return Err(Error::Memory { what: WHAT, bytes });
             }
             let vertices = std::slice::from_raw_parts_mut(vertices, 3 * n);
             let indices = std::slice::from_raw_parts_mut(indices, n);
@@ -306,13 +346,16 @@ impl Triangles {
         format!("embree {}", self.api.version)
     }
 
+    /// `ray` for Embree, which keeps hits at `t ≤ tfar`: `tfar` is the
+    /// float below `ray.tmax`, as the other primitives' tests keep `t <
+    /// tmax`.
     fn ray(ray: &Ray) -> RtcRay {
         RtcRay {
             org: ray.o.to_array(),
             tnear: 0.0,
             dir: ray.d.to_array(),
             time: 0.0,
-            tfar: ray.tmax,
+            tfar: ray.tmax.next_down(),
             mask: u32::MAX,
             id: 0,
             flags: 0,
@@ -328,9 +371,10 @@ impl Triangles {
         }
     }
 
-    /// The nearest hit of `ray` in `[0, ray.tmax]`: the primitive's index,
+    /// The nearest hit of `ray` in `[0, ray.tmax)`: the primitive's index,
     /// the distance and the barycentrics `(b1, b2)` of `p0 + b1 e1 + b2 e2`.
     #[inline]
+    #[allow(unsafe_code)]
     pub fn intersect(&self, ray: &Ray) -> Option<(u32, f32, [f32; 2])> {
         let mut rh = RayHit {
             ray: Self::ray(ray),
@@ -356,8 +400,9 @@ impl Triangles {
         })
     }
 
-    /// Whether a triangle lies on `ray` in `[0, ray.tmax]`.
+    /// Whether a triangle lies on `ray` in `[0, ray.tmax)`.
     #[inline]
+    #[allow(unsafe_code)]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let mut r = Self::ray(ray);
         let mut context = Self::context();

@@ -74,6 +74,8 @@ impl PropertyAccess for PlyVertex {
             Property::Double(v) => v,
             p => match p.to_f32_lossy() {
                 Some(v) => f64::from(v),
+                // A list: no coordinate (the normals are then left out).
+                None if slot >= 3 => return PropertyAccessResult::Ignored,
                 None => return PropertyAccessResult::UnsupportedType,
             },
         };
@@ -83,9 +85,13 @@ impl PropertyAccess for PlyVertex {
     }
 }
 
-/// A PLY face as read: its polygon's vertex indices.
+/// A PLY face as read: its polygon's vertex indices, from
+/// `vertex_indices`, or `vertex_index` when it has no `vertex_indices`.
 #[derive(Default)]
-struct PlyFace(Option<Vec<i64>>);
+struct PlyFace {
+    indices: Option<Vec<i64>>,
+    index: Option<Vec<i64>>,
+}
 
 impl PropertyAccess for PlyFace {
     fn new() -> Self {
@@ -93,10 +99,12 @@ impl PropertyAccess for PlyFace {
     }
 
     fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
-        if name != "vertex_indices" && name != "vertex_index" {
-            return PropertyAccessResult::Ignored;
-        }
-        self.0 = Some(match property {
+        let slot = match name {
+            "vertex_indices" => &mut self.indices,
+            "vertex_index" => &mut self.index,
+            _ => return PropertyAccessResult::Ignored,
+        };
+        *slot = Some(match property {
             Property::ListChar(v) => v.into_iter().map(i64::from).collect(),
             Property::ListUChar(v) => v.into_iter().map(i64::from).collect(),
             Property::ListShort(v) => v.into_iter().map(i64::from).collect(),
@@ -125,9 +133,11 @@ fn fan(poly: &[i64], faces: &mut Vec<[i64; 3]>) {
     }
 }
 
-/// Memory the PLY reader takes per element it reads (a face's list of
-/// indices, twice), checked before it starts.
-const PLY_BYTES_PER_ELEMENT: usize = 128;
+/// Memory the PLY reader takes per vertex or face it reads, checked before
+/// it starts: a vertex as read (56 bytes, twice while its list grows) and
+/// as kept (48), a face as read (56, twice, and its list of indices) and
+/// as kept (24).
+const PLY_BYTES_PER_ELEMENT: usize = 192;
 
 fn read_ply(path: &Path) -> Result<MeshData> {
     let file = std::fs::File::open(path).map_err(|e| io_error(path, e.to_string()))?;
@@ -137,7 +147,8 @@ fn read_ply(path: &Path) -> Result<MeshData> {
     let header = Parser::<Skipped>::new()
         .read_header(&mut reader)
         .map_err(unreadable)?;
-    // The header's counts, checked before the payload is read.
+    // The header's counts, checked before the payload is read (other
+    // elements are skipped, kept nowhere).
     let mut elements = 0usize;
     for (name, element) in &header.elements {
         if name == "vertex" || name == "face" {
@@ -149,8 +160,8 @@ fn read_ply(path: &Path) -> Result<MeshData> {
                 },
                 element.count,
             )?;
+            elements = elements.saturating_add(element.count);
         }
-        elements = elements.saturating_add(element.count);
     }
     alloc::probe::<u8>(
         elements.saturating_mul(PLY_BYTES_PER_ELEMENT),
@@ -194,9 +205,11 @@ fn read_ply(path: &Path) -> Result<MeshData> {
     }
     let mut faces = alloc::with_capacity(polys.len(), "the faces")?;
     for f in &polys {
-        let poly =
-            f.0.as_deref()
-                .ok_or_else(|| io_error(path, "PLY faces need a 'vertex_indices' list"))?;
+        let poly = f
+            .indices
+            .as_deref()
+            .or(f.index.as_deref())
+            .ok_or_else(|| io_error(path, "PLY faces need a 'vertex_indices' list"))?;
         fan(poly, &mut faces);
     }
     let normals = (normals.len() == vertices.len()).then_some(normals);
@@ -272,6 +285,60 @@ mod tests {
         assert_eq!(m.vertices.len(), 4);
         assert_eq!(m.faces, vec![[0, 1, 2], [0, 2, 3]]);
         assert_eq!(m.normals.unwrap()[2], [0.0, 0.0, 1.0]);
+    }
+
+    /// A binary PLY (either byte order) with an element between the
+    /// vertices and the faces and `vertex_index` as the list's name; a
+    /// file without `z` is refused.
+    #[test]
+    fn binary_ply_in_either_byte_order_with_another_element() {
+        let dir = tempfile::tempdir().unwrap();
+        for big in [false, true] {
+            let order = if big { "big" } else { "little" };
+            let mut bytes = format!(
+                "ply\nformat binary_{order}_endian 1.0\nelement vertex 3\nproperty float x\n\
+                 property float y\nproperty float z\nelement edge 1\nproperty int a\n\
+                 property int b\nelement face 1\nproperty list uchar uint vertex_index\n\
+                 end_header\n"
+            )
+            .into_bytes();
+            let f32s = |v: f32| {
+                if big {
+                    v.to_be_bytes()
+                } else {
+                    v.to_le_bytes()
+                }
+            };
+            let u32s = |v: u32| {
+                if big {
+                    v.to_be_bytes()
+                } else {
+                    v.to_le_bytes()
+                }
+            };
+            for v in [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 2.0, 0.5] {
+                bytes.extend(f32s(v));
+            }
+            bytes.extend(u32s(0).into_iter().chain(u32s(1)));
+            bytes.push(3);
+            for i in [2, 1, 0] {
+                bytes.extend(u32s(i));
+            }
+            let path = dir.path().join(format!("{order}.ply"));
+            std::fs::write(&path, &bytes).unwrap();
+            let m = read_mesh(&path).unwrap();
+            assert_eq!(m.vertices[2], [0.0, 2.0, 0.5], "{order}");
+            assert_eq!(m.faces, vec![[2, 1, 0]], "{order}");
+            assert!(m.normals.is_none());
+        }
+        let path = dir.path().join("no_z.ply");
+        std::fs::write(
+            &path,
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+             end_header\n0 0\n",
+        )
+        .unwrap();
+        assert!(matches!(read_mesh(&path), Err(Error::Io { .. })));
     }
 
     #[test]

@@ -384,8 +384,8 @@ impl Scene {
         std::iter::once(&self.accel)
             .chain(self.movers.iter().map(Mover::accel))
             .map(Accel::ray_tracer)
-            .find(|name| name != "obvhs")
-            .unwrap_or_else(|| "obvhs".into())
+            .find(|name| name != super::accel::OBVHS)
+            .unwrap_or_else(|| super::accel::OBVHS.into())
     }
 
     /// The material of shape `shape`.

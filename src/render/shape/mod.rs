@@ -12,7 +12,7 @@ mod triangle;
 
 pub use disk::Disk;
 pub use sphere::Sphere;
-pub use triangle::{Lanes, Scaled, Triangle, Triangles4, moller_trumbore};
+pub use triangle::{Lanes, Scaled, Triangle, Triangles4, moller_trumbore, triangle_hit};
 
 use glam::Vec3A;
 

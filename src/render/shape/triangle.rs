@@ -26,13 +26,8 @@ impl Triangle {
     /// `(0, tmax)`, if any (see [`moller_trumbore`]).
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Candidate> {
-        let [o, d, p0, e1, e2] = [ray.o, ray.d, self.p0, self.e1, self.e2].map(|v| v.to_array());
-        let scaled = moller_trumbore(o, d, p0, e1, e2);
-        if !scaled.inside {
-            return None;
-        }
-        let (ahead, t, bary) = scaled.hit(ray.tmax);
-        ahead.then_some(Candidate { t, bary })
+        let [p0, e1, e2] = [self.p0, self.e1, self.e2].map(|v| v.to_array());
+        triangle_hit(ray, p0, e1, e2)
     }
 
     /// Area, `|e1 × e2| / 2`.
@@ -187,6 +182,18 @@ pub fn moller_trumbore<L: Lanes>(
         b2,
         t: sign * dot(e2, q),
     }
+}
+
+/// The hit of `ray` in `(0, ray.tmax)` on the triangle `p0 + b1 e1 + b2
+/// e2` ([`moller_trumbore`] for one ray), if any.
+#[inline(always)]
+pub fn triangle_hit(ray: &Ray, p0: [f32; 3], e1: [f32; 3], e2: [f32; 3]) -> Option<Candidate> {
+    let scaled = moller_trumbore(ray.o.to_array(), ray.d.to_array(), p0, e1, e2);
+    if !scaled.inside {
+        return None;
+    }
+    let (ahead, t, bary) = scaled.hit(ray.tmax);
+    ahead.then_some(Candidate { t, bary })
 }
 
 /// Up to four triangles side by side, component by component, tested
