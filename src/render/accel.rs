@@ -7,7 +7,7 @@
 //! traversal: its triangles are tested four at a time ([`Triangles4`]),
 //! its other primitives one after the other. Through the
 //! BVH, the leaves' primitives are read from a copy in the BVH's order
-//! ([`Packed`]: a triangle's vertex and edges in 40 bytes), so that a leaf
+//! (`Packed`: a triangle's vertex and edges in 40 bytes), so that a leaf
 //! is a run of memory rather than a scatter over the scene's list of
 //! primitives (176 bytes each).
 
