@@ -19,7 +19,7 @@ use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbv
 use crate::alloc;
 use crate::error::Result;
 
-use super::embree::{self, Triangles as Embree};
+use super::embree::{self, Stream as EmbreeStream, Triangles as Embree};
 use super::shape::{
     Candidate, Disk, Ray, Sphere, SurfacePoint, Triangle, Triangles4, triangle_hit,
 };
@@ -316,9 +316,13 @@ impl Accel {
     /// hit, then the others' nearer than it.
     #[inline(never)]
     fn intersect_embree(&self, embree: &Embree, ray: &Ray) -> Option<Hit> {
-        let hit = embree
-            .intersect(ray)
-            .map(|(primitive, t, bary)| Hit { t, primitive, bary });
+        self.nearer_other(ray, embree.intersect(ray))
+    }
+
+    /// `hit` (Embree's, on a triangle), or the hit of `ray` on another
+    /// primitive nearer than it.
+    #[inline]
+    fn nearer_other(&self, ray: &Ray, hit: Option<Hit>) -> Option<Hit> {
         let shrunk = Ray {
             tmax: hit.map_or(ray.tmax, |h| h.t),
             ..*ray
@@ -328,6 +332,31 @@ impl Accel {
             Some(bvh) => self.intersect_bvh(bvh, &shrunk),
         };
         other.or(hit)
+    }
+
+    /// [`Accel::intersect`] of each ray of `rays` (coherent ones: the
+    /// camera rays of pixels), appended to `out`; with Embree, the
+    /// triangles traced as one stream (`stream` its working memory).
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when the stream's memory cannot be had.
+    pub fn intersect_many(
+        &self,
+        rays: &[Ray],
+        stream: &mut EmbreeStream,
+        out: &mut Vec<Option<Hit>>,
+    ) -> Result<()> {
+        let Some(embree) = self.embree.as_ref() else {
+            alloc::reserve(out, rays.len(), "the hits")?;
+            out.extend(rays.iter().map(|ray| self.intersect(ray)));
+            return Ok(());
+        };
+        let first = out.len();
+        embree.intersect_many(rays, stream, out)?;
+        for (ray, hit) in rays.iter().zip(&mut out[first..]) {
+            *hit = self.nearer_other(ray, *hit);
+        }
+        Ok(())
     }
 
     /// [`Accel::intersect`] in a scene without a BVH: every primitive.
@@ -524,6 +553,16 @@ mod tests {
             occluded += usize::from(obvhs.occluded(ray));
         }
         assert!(hits > 1000 && occluded == hits, "{hits} {occluded}");
+        // The stream finds what one ray at a time finds, bit for bit.
+        for accel in [&embree, &obvhs] {
+            let (mut stream, mut many) = (Default::default(), vec![None]);
+            accel.intersect_many(&rays, &mut stream, &mut many).unwrap();
+            let one: Vec<_> = rays.iter().map(|r| accel.intersect(r)).collect();
+            let bits =
+                |h: &Option<Hit>| h.map(|h| (h.primitive, h.t.to_bits(), h.bary.map(f32::to_bits)));
+            assert!(many[0].is_none() && many.len() == rays.len() + 1);
+            assert!(many[1..].iter().map(bits).eq(one.iter().map(bits)));
+        }
     }
 
     #[test]

@@ -20,7 +20,7 @@ use std::sync::OnceLock;
 
 use libloading::Library;
 
-use super::accel::Primitive;
+use super::accel::{Hit, Primitive};
 use super::shape::Ray;
 use crate::error::{Error, Result};
 
@@ -96,6 +96,7 @@ struct Api {
     commit_scene: unsafe extern "C" fn(Handle),
     release_scene: unsafe extern "C" fn(Handle),
     intersect1: unsafe extern "C" fn(Handle, *mut Context, *mut RayHit),
+    intersect1m: unsafe extern "C" fn(Handle, *mut Context, *mut RayHit, u32, usize),
     occluded1: unsafe extern "C" fn(Handle, *mut Context, *mut RtcRay),
     /// Kept loaded for the process's life: the pointers above point into it.
     _library: Library,
@@ -156,6 +157,7 @@ impl Api {
             commit_scene: entry!("rtcCommitScene"),
             release_scene: entry!("rtcReleaseScene"),
             intersect1: entry!("rtcIntersect1"),
+            intersect1m: entry!("rtcIntersect1M"),
             occluded1: entry!("rtcOccluded1"),
             _library: library,
         })
@@ -236,6 +238,11 @@ pub fn wanted() -> Result<Option<Library3>> {
             }),
     }
 }
+
+/// The working memory of [`Triangles::intersect_many`]: Embree's records
+/// of a stream of rays, kept from one batch to the next.
+#[derive(Default)]
+pub struct Stream(Vec<RayHit>);
 
 /// Triangles in an Embree scene (one triangle mesh of unshared vertices),
 /// with the index of each in the scene's list of primitives.
@@ -362,21 +369,19 @@ impl Triangles {
         }
     }
 
-    fn context() -> Context {
-        // rtcInitIntersectContext: incoherent rays, no filter.
+    /// `rtcInitIntersectContext`'s context (no filter), for rays that are
+    /// `coherent` or not.
+    fn context(coherent: bool) -> Context {
         Context {
-            flags: 0,
+            flags: u32::from(coherent),
             filter: std::ptr::null(),
             inst_id: [INVALID],
         }
     }
 
-    /// The nearest hit of `ray` in `[0, ray.tmax)`: the primitive's index,
-    /// the distance and the barycentrics `(b1, b2)` of `p0 + b1 e1 + b2 e2`.
-    #[inline]
-    #[allow(unsafe_code)]
-    pub fn intersect(&self, ray: &Ray) -> Option<(u32, f32, [f32; 2])> {
-        let mut rh = RayHit {
+    /// `ray` with no hit yet, for `rtcIntersect`.
+    fn ray_hit(ray: &Ray) -> RayHit {
+        RayHit {
             ray: Self::ray(ray),
             hit: RtcHit {
                 ng: [0.0; 3],
@@ -386,18 +391,66 @@ impl Triangles {
                 geom_id: INVALID,
                 inst_id: [INVALID],
             },
-        };
-        let mut context = Self::context();
+        }
+    }
+
+    /// The hit Embree left in `rh`, if any.
+    #[inline]
+    fn hit_of(&self, rh: &RayHit) -> Option<Hit> {
+        (rh.hit.geom_id != INVALID).then(|| Hit {
+            t: rh.ray.tfar,
+            primitive: self.primitive[rh.hit.prim_id as usize],
+            bary: [rh.hit.u, rh.hit.v],
+        })
+    }
+
+    /// The nearest hit of `ray` in `[0, ray.tmax)`: the primitive, the
+    /// distance and the barycentrics `(b1, b2)` of `p0 + b1 e1 + b2 e2`.
+    #[inline]
+    #[allow(unsafe_code)]
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let mut rh = Self::ray_hit(ray);
+        let mut context = Self::context(false);
         // SAFETY: a committed scene, a context and a ray-hit laid out as
         // Embree's header declares them.
         unsafe { (self.api.intersect1)(self.scene, &mut context, &mut rh) };
-        (rh.hit.geom_id != INVALID).then(|| {
-            (
-                self.primitive[rh.hit.prim_id as usize],
-                rh.ray.tfar,
-                [rh.hit.u, rh.hit.v],
-            )
-        })
+        self.hit_of(&rh)
+    }
+
+    /// [`Triangles::intersect`] of each ray of `rays`, appended to `out`:
+    /// traced as one coherent stream (`rtcIntersect1M`, which Embree
+    /// splits into packets), as the camera rays of a pixel are.
+    ///
+    /// # Errors
+    /// [`Error::Memory`] when the stream's records cannot be had.
+    #[allow(unsafe_code)]
+    pub fn intersect_many(
+        &self,
+        rays: &[Ray],
+        stream: &mut Stream,
+        out: &mut Vec<Option<Hit>>,
+    ) -> Result<()> {
+        const WHAT: &str = "a stream of rays";
+        stream.0.clear();
+        crate::alloc::reserve(&mut stream.0, rays.len(), WHAT)?;
+        crate::alloc::reserve(out, rays.len(), WHAT)?;
+        stream.0.extend(rays.iter().map(Self::ray_hit));
+        let mut context = Self::context(true);
+        for chunk in stream.0.chunks_mut(1 << 20) {
+            // SAFETY: as in `intersect`, for `chunk.len()` records one
+            // `size_of::<RayHit>()` apart (aligned to 16, as Embree needs).
+            unsafe {
+                (self.api.intersect1m)(
+                    self.scene,
+                    &mut context,
+                    chunk.as_mut_ptr(),
+                    chunk.len() as u32,
+                    size_of::<RayHit>(),
+                )
+            };
+        }
+        out.extend(stream.0.iter().map(|rh| self.hit_of(rh)));
+        Ok(())
     }
 
     /// Whether a triangle lies on `ray` in `[0, ray.tmax)`.
@@ -405,7 +458,7 @@ impl Triangles {
     #[allow(unsafe_code)]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let mut r = Self::ray(ray);
-        let mut context = Self::context();
+        let mut context = Self::context(false);
         // SAFETY: as in `intersect`.
         unsafe { (self.api.occluded1)(self.scene, &mut context, &mut r) };
         r.tfar == f32::NEG_INFINITY

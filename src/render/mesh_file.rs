@@ -288,8 +288,8 @@ mod tests {
     }
 
     /// A binary PLY (either byte order) with an element between the
-    /// vertices and the faces and `vertex_index` as the list's name; a
-    /// file without `z` is refused.
+    /// vertices and the faces and `vertex_index` as the list's name; a list
+    /// named `nx` leaves the normals out; a file without `z` is refused.
     #[test]
     fn binary_ply_in_either_byte_order_with_another_element() {
         let dir = tempfile::tempdir().unwrap();
@@ -331,6 +331,17 @@ mod tests {
             assert_eq!(m.faces, vec![[2, 1, 0]], "{order}");
             assert!(m.normals.is_none());
         }
+        // A list where a normal's coordinate should be: no normals.
+        let path = dir.path().join("list_nx.ply");
+        std::fs::write(
+            &path,
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+             property float z\nproperty list uchar float nx\nelement face 1\n\
+             property list uchar int vertex_indices\nend_header\n0 0 0 1 1\n1 0 0 1 1\n\
+             0 1 0 1 1\n3 0 1 2\n",
+        )
+        .unwrap();
+        assert!(read_mesh(&path).unwrap().normals.is_none());
         let path = dir.path().join("no_z.ply");
         std::fs::write(
             &path,

@@ -170,6 +170,8 @@ struct Batch {
     rays: Vec<Ray>,
     /// Where each camera ray first meets the scene.
     hits: Vec<Option<Hit>>,
+    /// Embree's records of the camera rays.
+    stream: embree::Stream,
     /// One pixel's sums per block at a time.
     block_sums: Vec<Sums>,
 }
@@ -253,15 +255,19 @@ impl Batch {
         self.hits.clear();
         let times = &self.times;
         let time = |i: usize| if moves { times[i] } else { 0.0 };
-        self.hits
-            .extend(self.rays.iter_mut().enumerate().map(|(i, ray)| {
-                let hit = scene.intersect(ray, time(i));
-                if settings.hide_emitters {
-                    integrator::skip_emitters(scene, ray, hit, time(i))
-                } else {
-                    hit
-                }
-            }));
+        // The still shapes' hits as one coherent stream (the camera rays of
+        // each pixel lie close together), then the moving shapes'.
+        scene
+            .accel()
+            .intersect_many(&self.rays, &mut self.stream, &mut self.hits)?;
+        for (i, (ray, hit)) in self.rays.iter_mut().zip(&mut self.hits).enumerate() {
+            if moves {
+                *hit = scene.intersect_movers(ray, time(i), *hit);
+            }
+            if settings.hide_emitters {
+                *hit = integrator::skip_emitters(scene, ray, *hit, time(i));
+            }
+        }
         let spp = spp.max(1) as usize;
         let per_pixel = self.rays.chunks(spp).zip(self.hits.chunks(spp));
         for (mut stream, (rays, hits)) in streams.into_iter().zip(per_pixel) {

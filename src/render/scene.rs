@@ -304,9 +304,9 @@ impl Scene {
     }
 
     /// [`Scene::intersect`] among the moving shapes, given the `best` hit
-    /// so far.
+    /// so far (`best` when nothing moves).
     #[inline(never)]
-    fn intersect_movers(&self, ray: &Ray, tau: f32, best: Option<Hit>) -> Option<Hit> {
+    pub fn intersect_movers(&self, ray: &Ray, tau: f32, best: Option<Hit>) -> Option<Hit> {
         self.movers
             .iter()
             .fold(best, |best, m| m.intersect(ray, tau, best))
