@@ -104,7 +104,9 @@ impl EnvMap {
     }
 
     /// `out[i] = pdf(d[i])` for a batch, in `F`, in blocks of
-    /// `BATCH_BLOCK`: for polar tables, every direction's cell by the
+    /// `BATCH_BLOCK`: for the luminance density, every direction's place
+    /// and Jacobian at full SIMD width, then the texels under it; for polar
+    /// tables, every direction's cell by the
     /// branch-free [`PolarTable::query`] at full SIMD width and its density
     /// prefetched, then the densities of the block before read (one block
     /// behind, so that the reads wait on no cache miss); for the others
@@ -118,7 +120,22 @@ impl EnvMap {
     ) -> bool {
         let mut ok = true;
         let blocks = out.chunks_mut(BATCH_BLOCK).zip(d.chunks(BATCH_BLOCK));
-        if let Some(table) = &self.polar {
+        if let Distribution::Luminance(density) = &self.distribution {
+            // Every direction's place and Jacobian by one loop (which
+            // vectorises), then the texels under it.
+            let mut queries = [[F::zero(); 3]; BATCH_BLOCK];
+            let query = {
+                #[inline(always)]
+                |x: [F; 3]| self.luminance_query(x)
+            };
+            for (o, x) in blocks {
+                let queries = &mut queries[..x.len()];
+                ok &= simd::map_rows(queries, x, &query, &valid, false);
+                for (o, &q) in o.iter_mut().zip(queries.iter()) {
+                    *o = self.luminance_pdf_of(density, q);
+                }
+            }
+        } else if let Some(table) = &self.polar {
             // Two blocks in flight: each block's cells are located and their
             // densities prefetched, then the densities of the block before
             // are read (by now in the caches), so that the table reads
@@ -246,6 +263,13 @@ impl EnvMap {
                 (points[k], corners[k]) = ([s, t, placed.pdf_q], placed.corners);
             };
             match &self.distribution {
+                Distribution::Luminance(density) => {
+                    let cells = &mut cells[..n];
+                    density.cells().sample_groups(us, cells);
+                    for (k, &(cell, r)) in cells.iter().enumerate() {
+                        place(k, self.place_luminance(density, cell, r));
+                    }
+                }
                 Distribution::Piecewise(table) => {
                     let cells = &mut cells[..n];
                     table.table().sample_groups(us, cells);

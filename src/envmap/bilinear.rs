@@ -103,12 +103,24 @@ impl BilinearGrid {
     #[inline(always)]
     fn place(&self, ((row, col), r): ((usize, usize), [f64; 2])) -> ([f64; 2], f64) {
         let c = self.corners(row, col);
-        let fy = sample_linear(r[1], c[0] + c[1], c[2] + c[3]);
-        let fx = sample_linear(r[0], lerp(fy, c[0], c[2]), lerp(fy, c[1], c[3]));
+        let [fx, fy] = warp_bilinear(c, r);
         let (px, py) = ((self.cols - 1) as f64, (self.rows - 1) as f64);
         let q = [(col as f64 + fx) / px, (row as f64 + fy) / py];
         (q, bilerp(c, fx, fy) * self.inv_mean)
     }
+}
+
+/// The point of the unit square with density `∝ bilerp(c, x, y)` (corners
+/// `[v00, v10, v01, v11]`, not all 0) at `r` in `[0, 1]²`: the marginal in
+/// y, then the conditional in x, each a linear density inverted in closed
+/// form.
+#[inline(always)]
+pub(super) fn warp_bilinear(c: [f64; 4], r: [f64; 2]) -> [f64; 2] {
+    let y = sample_linear(r[1], c[0] + c[1], c[2] + c[3]);
+    [
+        sample_linear(r[0], lerp(y, c[0], c[2]), lerp(y, c[1], c[3])),
+        y,
+    ]
 }
 
 #[inline(always)]
@@ -118,7 +130,7 @@ fn lerp(t: f64, a: f64, b: f64) -> f64 {
 
 /// `v00 (1−x)(1−y) + v10 x (1−y) + v01 (1−x) y + v11 x y`.
 #[inline(always)]
-fn bilerp(c: [f64; 4], x: f64, y: f64) -> f64 {
+pub(super) fn bilerp(c: [f64; 4], x: f64, y: f64) -> f64 {
     lerp(y, lerp(x, c[0], c[1]), lerp(x, c[2], c[3]))
 }
 

@@ -1,5 +1,5 @@
-//! [`CellSampler`]: draws from an environment map's piecewise density in
-//! O(1), for renderers that take one light sample at a time.
+//! [`CellSampler`]: draws from an environment map's luminance or piecewise
+//! density in O(1), for renderers that take one light sample at a time.
 
 use super::distribution::Distribution;
 use super::{EnvMap, EnvSample};
@@ -7,15 +7,17 @@ use crate::distr::AliasTable;
 use crate::error::Result;
 use crate::math::Real;
 
-/// The density of [`EnvMap::sample`] (piecewise sampling), drawn in O(1):
-/// the table cell `(row, col)` by an [`AliasTable`] over the cells'
-/// weights, the point within it uniformly by two numbers of its own.
+/// The density of [`EnvMap::sample`] (luminance or piecewise sampling),
+/// drawn in O(1): the table cell `(row, col)` by an [`AliasTable`] over the
+/// cells' weights, the point within it by two numbers of its own, as
+/// [`EnvMap::sample`] places it in the cell.
 ///
 /// # Density
 /// That of [`EnvMap::pdf`]: cell `c` is drawn with probability `w_c/Σw`
-/// (to the alias table's 32-bit thresholds) and its point uniformly, which
-/// is the piecewise-constant table density `p_c`, `p_c / (dω/dp)` per
-/// steradian. The map from numbers to directions differs from
+/// (to the alias table's 32-bit thresholds) and its point by the cell's
+/// own density (uniform in a piecewise table's cell, bilinear in a
+/// luminance density's), which is the table density `p_q`, `p_q / (dω/dp)`
+/// per steradian. The map from numbers to directions differs from
 /// [`EnvMap::sample`]'s inversion (no `sample_reuse`, no inverse): one
 /// draw costs a load of the cell and no search, which matters where draws
 /// come one at a time between other work (a renderer's next-event
@@ -27,19 +29,21 @@ pub struct CellSampler {
 }
 
 impl CellSampler {
-    /// The sampler of `env`'s table, or `None` when `env` is not sampled
-    /// piecewise (Mitsuba's bilinear density, or an all-black map).
+    /// The sampler of `env`'s cells, or `None` when `env` is sampled by
+    /// neither the luminance density nor a piecewise table (Mitsuba's
+    /// bilinear density, or an all-black map).
     ///
     /// # Errors
     /// Only when the thread pool cannot start.
     pub fn new(env: &EnvMap) -> Result<Option<Self>> {
-        let Distribution::Piecewise(table) = &env.distribution else {
-            return Ok(None);
+        let table = match &env.distribution {
+            Distribution::Luminance(density) => density.cells(),
+            Distribution::Piecewise(table) => table.table(),
+            Distribution::Bilinear(_) | Distribution::Black => return Ok(None),
         };
-        let weights = table.table().weights();
         Ok(Some(CellSampler {
-            cells: AliasTable::new(weights)?,
-            cols: table.table().shape().1,
+            cells: AliasTable::new(table.weights())?,
+            cols: table.shape().1,
         }))
     }
 
@@ -49,19 +53,19 @@ impl CellSampler {
     /// within it from the fractions `r` in `[0, 1)²` (along the table's x
     /// and y); from there it is the path of [`EnvMap::sample`]. Computed in
     /// `F`: in `f32` the point stays in its cell, and the direction and
-    /// density are good to a few `f32` ulps. (Given a map that is not
-    /// sampled piecewise, it draws by [`EnvMap::sample`] of `r`.)
+    /// density are good to a few `f32` ulps. (Given a map that has no
+    /// cells, it draws by [`EnvMap::sample`] of `r`.)
     #[inline]
     pub fn sample<F: Real>(&self, env: &EnvMap, bits: u64, r: [F; 2]) -> EnvSample<F> {
-        let Distribution::Piecewise(table) = &env.distribution else {
-            return env.sample(r.map(F::f64)).cast();
-        };
-        debug_assert_eq!(
-            table.table().shape().1,
-            self.cols,
-            "a sampler of another map"
-        );
         let c = self.cells.sample_bits(bits);
-        env.sample_at(&env.place_in_cell(table, (c / self.cols, c % self.cols), r))
+        let cell = (c / self.cols, c % self.cols);
+        let placed = match &env.distribution {
+            Distribution::Luminance(density) => env.place_luminance(density, cell, r),
+            Distribution::Piecewise(table) => env.place_in_cell(table, cell, r),
+            Distribution::Bilinear(_) | Distribution::Black => {
+                return env.sample(r.map(F::f64)).cast();
+            }
+        };
+        env.sample_at(&placed)
     }
 }

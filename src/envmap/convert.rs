@@ -11,7 +11,7 @@ impl EnvMap {
     /// (cube maps: `height = 6·width`): every new texel takes the bilinear
     /// value of this map in its direction. `to_world`, `scale` and
     /// `compensate` are kept; the sampling mode too where the new mapping
-    /// has it (else [`Sampling::Piecewise`]).
+    /// has it (else [`Sampling::default_for`] the new mapping).
     ///
     /// # Errors
     /// As [`EnvMap::new`] for the new shape.
@@ -31,10 +31,10 @@ impl EnvMap {
                 data.extend(rgb.map(|v| v as f32));
             }
         }
-        let sampling = if mapping == Mapping::LatLong {
+        let sampling = if self.options.sampling.supports(mapping) {
             self.options.sampling
         } else {
-            Sampling::Piecewise
+            Sampling::default_for(mapping)
         };
         EnvMap::new(
             width,

@@ -1,11 +1,13 @@
 //! The build of an [`EnvMap`]'s sampling distribution from its image: the
-//! piecewise-constant table of [`Sampling::Piecewise`] (with the polar
-//! lookup table of `pdf` where the mapping has one), or Mitsuba's bilinear
-//! vertex grid of [`Sampling::Mitsuba`].
+//! luminance density of [`Sampling::Luminance`], the piecewise-constant
+//! table of [`Sampling::Piecewise`] (with the polar lookup table of `pdf`
+//! where the mapping has one), or Mitsuba's bilinear vertex grid of
+//! [`Sampling::Mitsuba`].
 
 use super::bilinear::BilinearGrid;
 use super::convert::texel_centre;
 use super::image::Image;
+use super::luminance::LuminanceDensity;
 use super::mapping::Mapping;
 use super::polar::PolarTable;
 use super::sample::angular_uv;
@@ -24,9 +26,14 @@ use super::EnvMap;
 /// [`Sampling::Mitsuba`] mode so that its density is Mitsuba's.
 const MITSUBA_LUMINANCE: [f64; 3] = [0.212671, 0.715160, 0.072169];
 
+/// Rec. 709 luminance weights, as [`crate::math::luminance`].
+const REC709: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
 /// The density an [`EnvMap`] draws directions from.
 #[derive(Clone, Debug)]
 pub(super) enum Distribution {
+    /// The luminance of the bilinear radiance on the sphere, exactly.
+    Luminance(LuminanceDensity),
     /// Piecewise-constant over the cells of the bilinear radiance.
     Piecewise(PiecewiseConstant2D),
     /// Mitsuba's bilinear density on the lat-long vertex grid.
@@ -48,6 +55,7 @@ pub(super) fn build(
         return Ok((Distribution::Black, None));
     }
     match options.sampling {
+        Sampling::Luminance => Ok((luminance_density(image, options.compensate)?, None)),
         Sampling::Piecewise => {
             let (distribution, values) = piecewise_table(image, options)?;
             let polar = PolarTable::new(&distribution, values, image, options)?;
@@ -93,6 +101,13 @@ fn sampling_luminance(
     Ok(lum)
 }
 
+/// The density of [`Sampling::Luminance`] over a lat-long `image`.
+fn luminance_density(image: &Image, compensate: bool) -> Result<Distribution> {
+    let lum = sampling_luminance(image, Mapping::LatLong, REC709, compensate)?;
+    let density = LuminanceDensity::new(lum, image.width(), image.height())?;
+    Ok(density.map_or(Distribution::Black, Distribution::Luminance))
+}
+
 /// The piecewise-constant table of [`Sampling::Piecewise`] (or
 /// [`Distribution::Black`] when nothing is lit) and its cells' weights,
 /// row-major.
@@ -108,7 +123,7 @@ fn sampling_luminance(
 ///   times `J` at its centre / 16, so that lit sectors are never 0.
 fn piecewise_table(image: &Image, options: &Options) -> Result<(Distribution, Buffer<f64>)> {
     let mapping = options.mapping;
-    let lum = sampling_luminance(image, mapping, [0.2126, 0.7152, 0.0722], options.compensate)?;
+    let lum = sampling_luminance(image, mapping, REC709, options.compensate)?;
     let (w, h) = (image.width(), image.height());
     let (cols, rows, domain) = match mapping {
         Mapping::LatLong => (w, h - 1, [[0.0, 1.0], [0.0, 1.0]]),

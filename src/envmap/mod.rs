@@ -7,7 +7,16 @@
 //! Every method takes and returns world directions.
 //!
 //! # Sampling
-//! [`Sampling::Piecewise`] (the default) samples a [`PiecewiseConstant2D`]
+//! [`Sampling::Luminance`] (the default for lat-long maps) follows `Y`, the
+//! luminance of the bilinear radiance (in `luminance.rs`):
+//! the patches between texel centres are drawn in proportion to their
+//! `∫ Y dω` exactly, and points within them in proportion to `Y`, so the
+//! density per steradian is `Y(ω)/∫Y dω` times `s̄/sin θ` (`s̄` the patch's
+//! mean `sin θ`: a ratio within about `Δθ·cot θ/2` of 1). Wherever
+//! `eval(d) > 0`, `pdf(d) > 0`, also at the poles.
+//!
+//! [`Sampling::Piecewise`] (the default for angular and cube maps) samples
+//! a [`PiecewiseConstant2D`]
 //! over the cells of the map's domain in which the bilinear radiance is one
 //! polynomial (lat-long: the patches between texel centres, `W × (H − 1)`;
 //! angular and cube: half-texel cells), each weighted by the luminance of
@@ -39,8 +48,8 @@
 //! build of the sampling distribution in `distribution.rs`; the polar lookup
 //! table of `pdf` in `polar.rs`; resampling in `convert.rs`; [`CellSampler`]
 //! (one O(1) draw at a time) in `cell_sampler.rs`; the parameterisations,
-//! the texels and Mitsuba's bilinear density in `mapping.rs`, `image.rs`
-//! and `bilinear.rs`.
+//! the texels, the luminance density and Mitsuba's bilinear density in
+//! `mapping.rs`, `image.rs`, `luminance.rs` and `bilinear.rs`.
 
 mod batch;
 mod bilinear;
@@ -48,6 +57,7 @@ mod cell_sampler;
 mod convert;
 mod distribution;
 mod image;
+mod luminance;
 mod mapping;
 mod polar;
 mod sample;
@@ -81,16 +91,23 @@ const IDENTITY: Matrix3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// How an [`EnvMap`] samples directions (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Sampling {
-    /// Piecewise-constant over the cells of the bilinear radiance (default).
+    /// In proportion to the luminance of the bilinear radiance within
+    /// cells, and to its integral over the sphere across them (lat-long
+    /// only; their default).
+    Luminance,
+    /// Piecewise-constant over the cells of the bilinear radiance (the
+    /// default of angular and cube maps).
     Piecewise,
     /// Mitsuba 3's bilinear density on the vertex grid (lat-long only).
     Mitsuba,
 }
 
 impl Sampling {
-    /// The name used in the Python API: `"piecewise"` or `"mitsuba"`.
+    /// The name used in the Python API: `"luminance"`, `"piecewise"` or
+    /// `"mitsuba"`.
     pub fn name(self) -> &'static str {
         match self {
+            Sampling::Luminance => "luminance",
             Sampling::Piecewise => "piecewise",
             Sampling::Mitsuba => "mitsuba",
         }
@@ -99,14 +116,31 @@ impl Sampling {
     /// The mode called `name` (see [`Sampling::name`]).
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
+            "luminance" => Some(Sampling::Luminance),
             "piecewise" => Some(Sampling::Piecewise),
             "mitsuba" => Some(Sampling::Mitsuba),
             _ => None,
         }
     }
+
+    /// The default of maps of `mapping`: [`Sampling::Luminance`] for
+    /// lat-long maps, [`Sampling::Piecewise`] for the others.
+    pub fn default_for(mapping: Mapping) -> Self {
+        match mapping {
+            Mapping::LatLong => Sampling::Luminance,
+            Mapping::Angular | Mapping::Cube => Sampling::Piecewise,
+        }
+    }
+
+    /// Whether maps of `mapping` can be sampled this way (the lat-long
+    /// densities need a lat-long map).
+    pub fn supports(self, mapping: Mapping) -> bool {
+        self == Sampling::Piecewise || mapping == Mapping::LatLong
+    }
 }
 
-/// The options of an [`EnvMap`] beyond its image.
+/// The options of an [`EnvMap`] beyond its image. The default is a
+/// lat-long map's ([`Options::for_mapping`] gives another mapping's).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Options {
     /// How the image covers the sphere.
@@ -121,13 +155,25 @@ pub struct Options {
     pub compensate: bool,
 }
 
+impl Options {
+    /// The default options of a map of `mapping`, with its default sampling
+    /// ([`Sampling::default_for`]).
+    pub fn for_mapping(mapping: Mapping) -> Self {
+        Options {
+            mapping,
+            sampling: Sampling::default_for(mapping),
+            ..Options::default()
+        }
+    }
+}
+
 impl Default for Options {
     fn default() -> Self {
         Options {
             mapping: Mapping::LatLong,
             to_world: IDENTITY,
             scale: 1.0,
-            sampling: Sampling::Piecewise,
+            sampling: Sampling::Luminance,
             compensate: false,
         }
     }
@@ -151,7 +197,8 @@ impl EnvMap {
     /// As [`Image::new`]; [`Error::Parameter`] for a `scale` that is
     /// negative or not finite, or a `to_world` that is not a rotation (an
     /// orthonormal matrix, to 1e-4); [`Error::Choice`] for
-    /// [`Sampling::Mitsuba`] on a map that is not lat-long.
+    /// [`Sampling::Luminance`] or [`Sampling::Mitsuba`] on a map that is
+    /// not lat-long.
     pub fn new(width: usize, height: usize, data: &[f32], options: Options) -> Result<Self> {
         let image = Image::new(options.mapping, width, height, data)?;
         Self::from_image(image, options)
@@ -166,12 +213,13 @@ impl EnvMap {
             });
         }
         check_rotation(&options.to_world)?;
-        if options.sampling == Sampling::Mitsuba && options.mapping != Mapping::LatLong {
+        if !options.sampling.supports(options.mapping) {
             return Err(Error::Choice {
                 arg: "sampling",
-                value: "mitsuba".into(),
+                value: options.sampling.name().into(),
                 requirement: format!(
-                    "Mitsuba's envmap is lat-long only; mapping is {:?}",
+                    "{:?} sampling is for lat-long maps; mapping is {:?} (use \"piecewise\")",
+                    options.sampling.name(),
                     options.mapping.name()
                 ),
             });
@@ -253,9 +301,10 @@ impl EnvMap {
     /// steradian.
     #[inline]
     pub fn pdf(&self, d: V3<f64>) -> f64 {
-        match &self.polar {
-            Some(table) => table.pdf(table.query(d)),
-            None => self.pdf_at(self.pdf_query(d)),
+        match (&self.polar, &self.distribution) {
+            (Some(table), _) => table.pdf(table.query(d)),
+            (None, Distribution::Luminance(density)) => self.luminance_pdf(density, d),
+            (None, _) => self.pdf_at(self.pdf_query(d)),
         }
     }
 }

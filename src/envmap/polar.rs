@@ -16,7 +16,7 @@ use std::f64::consts::PI;
 
 /// Mitsuba's `Epsilon<float>` (2⁻²⁴): the floor of sin θ in the density of
 /// the polar tables, as in Mitsuba's envmap pdf.
-const SIN_FLOOR: f64 = 1.0 / 16_777_216.0;
+pub(super) const SIN_FLOOR: f64 = 1.0 / 16_777_216.0;
 
 /// `dω/dq` of a polar sampling table at a direction `θ` from its axis:
 /// `2π² max(|sin θ|, 2⁻²⁴)` (see [`SIN_FLOOR`]).

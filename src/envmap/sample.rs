@@ -10,15 +10,16 @@
 use super::EnvMap;
 use super::distribution::Distribution;
 use super::image::Corners;
+use super::luminance::LuminanceDensity;
 use super::mapping::{Mapping, normalized, polar_angle};
-use super::polar::polar_jacobian;
+use super::polar::{SIN_FLOOR, polar_jacobian};
 use crate::distr::PiecewiseConstant2D;
 use crate::math::{Real, atan2, sin_cos_turn};
 use crate::warp::{self, V3};
 use std::f64::consts::PI;
 
 #[cfg(doc)]
-use super::CellSampler;
+use super::{CellSampler, PolarTable};
 
 /// A direction drawn from an environment map: the record of every way of
 /// drawing one ([`EnvMap::sample`], [`EnvMap::sample_into`],
@@ -67,6 +68,10 @@ impl EnvMap {
     #[inline]
     pub fn sample(&self, u: [f64; 2]) -> EnvSample {
         let placed = match &self.distribution {
+            Distribution::Luminance(density) => {
+                let (cell, r) = density.cells().sample_reuse(u);
+                self.place_luminance(density, cell, r)
+            }
             Distribution::Piecewise(table) => {
                 let (cell, r) = table.table().sample_reuse(u);
                 self.place_in_cell(table, cell, r)
@@ -99,6 +104,27 @@ impl EnvMap {
                 corners: self.image.cell_corners(cell, r),
             },
             _ => self.place_at(q, pdf_q),
+        }
+    }
+
+    /// The point that the fractions `r` place in cell `cell` of the
+    /// luminance `density` (this map's), with its density per unit table
+    /// area. Placed in `f64` and rounded to `F`; the texels are the cell's
+    /// corners weighted by the point's fractions.
+    #[inline(always)]
+    pub(super) fn place_luminance<F: Real>(
+        &self,
+        density: &LuminanceDensity,
+        cell: (usize, usize),
+        r: [F; 2],
+    ) -> Placed<F> {
+        let ([x, y], pdf_q) = density.place(cell, r.map(F::f64));
+        let (w, h) = (self.image.width() as f64, (self.image.height() - 1) as f64);
+        let q = [(cell.1 as f64 + x) / w, (cell.0 as f64 + y) / h];
+        Placed {
+            point: self.table_to_uv(q.map(F::c)),
+            pdf_q: F::c(pdf_q),
+            corners: self.image.cell_corners(cell, [F::c(x), F::c(y)]),
         }
     }
 
@@ -225,11 +251,55 @@ impl EnvMap {
     #[inline]
     pub fn pdf_at(&self, query: PdfQuery) -> f64 {
         let pdf_q = match &self.distribution {
+            Distribution::Luminance(density) => self.luminance_table_pdf(density, query.q),
             Distribution::Piecewise(table) => table.pdf(query.q),
             Distribution::Bilinear(grid) => grid.pdf(query.q),
             Distribution::Black => return 0.0,
         };
         pdf_q / query.jacobian
+    }
+
+    /// The luminance `density`'s value (this map's) at table point `q`.
+    #[inline(always)]
+    fn luminance_table_pdf(&self, density: &LuminanceDensity, q: [f64; 2]) -> f64 {
+        let (w, h) = (self.image.width(), self.image.height() - 1);
+        let (x, y) = (q[0] * w as f64, q[1] * h as f64);
+        let (col, row) = (x.floor_index(w - 1), y.floor_index(h - 1));
+        let fractions = [x - col as f64, y - row as f64].map(|f| f.clamp(0.0, 1.0));
+        density.table_pdf((row, col), fractions)
+    }
+
+    /// The density of the luminance `density` (this map's) along the world
+    /// direction `d`, per steradian, computed in `F` from the texels
+    /// [`EnvMap::eval`] reads there and `1/(dω/dq)`, as
+    /// [`PolarTable::query`] finds it without normalising `d` (0 for
+    /// `d = 0`). Batches run the first half, [`EnvMap::luminance_query`],
+    /// over a block at SIMD width.
+    #[inline(always)]
+    pub(super) fn luminance_pdf<F: Real>(&self, density: &LuminanceDensity, d: V3<F>) -> F {
+        self.luminance_pdf_of(density, self.luminance_query(d))
+    }
+
+    /// `[s, t, 1/(dω/dq)]` of the world direction `d` on a lat-long map.
+    #[inline(always)]
+    pub(super) fn luminance_query<F: Real>(&self, d: V3<F>) -> [F; 3] {
+        let local = self.to_local(d);
+        let [s, t] = Mapping::LatLong.from_dir(local);
+        let r = (local[0] * local[0] + local[2] * local[2]).sqrt();
+        let length = (r * r + local[1] * local[1]).sqrt();
+        let scaled_sin = r.max(F::c(SIN_FLOOR) * length).max(F::min_positive_value());
+        [s, t, length / (F::c(2.0 * PI * PI) * scaled_sin)]
+    }
+
+    /// The second half of [`EnvMap::luminance_pdf`].
+    #[inline(always)]
+    pub(super) fn luminance_pdf_of<F: Real>(
+        &self,
+        density: &LuminanceDensity,
+        [s, t, inv_jacobian]: [F; 3],
+    ) -> F {
+        let corners = self.image.corners(Mapping::LatLong, [s, t]);
+        density.table_pdf_of_corners(&corners) * inv_jacobian
     }
 
     /// The point of the sampling table that looks along the local
@@ -258,9 +328,13 @@ impl EnvMap {
     /// `dω/dq` of the sampling table at the local direction `d`: for the
     /// polar tables (lat-long around Y, angular around Z)
     /// `2π² max(sin θ, 2⁻²⁴)` with sin θ from `d` (Mitsuba's floor, so a
-    /// pole has a finite density); for cube maps [`Mapping::jacobian`].
+    /// pole has a finite density); for cube maps [`Mapping::jacobian`];
+    /// `+∞` (density 0) for `d = 0`, which has no direction.
     #[inline(always)]
     fn table_jacobian(&self, d: V3<f64>) -> f64 {
+        if d == [0.0; 3] {
+            return f64::INFINITY;
+        }
         let d = normalized(d);
         let polar = |x: f64, y: f64| polar_jacobian((x * x + y * y).sqrt());
         match self.options.mapping {

@@ -22,7 +22,7 @@ _Floats = Union[NDArray[np.float64], NDArray[np.float32], np.float64, np.float32
 #: int64 indices, an array or one scalar.
 _Ints = Union[NDArray[np.int64], np.int64]
 _Mapping = Literal["latlong", "angular", "cube"]
-_Sampling = Literal["piecewise", "mitsuba"]
+_Sampling = Literal["luminance", "piecewise", "mitsuba"]
 
 @final
 class Rng:
@@ -192,12 +192,12 @@ class EnvMap:
     "cube")."""
 
     def __new__(cls, image: ArrayLike | None = None, *, mapping: _Mapping = "latlong",
-                to_world: Any = None, scale: float = 1.0, sampling: _Sampling = "piecewise",
+                to_world: Any = None, scale: float = 1.0, sampling: _Sampling | None = None,
                 compensate: bool = False) -> EnvMap: ...
     @classmethod
     def load(cls, path: str | os.PathLike[str], *, layer: str | None = None,
              mapping: _Mapping = "latlong", to_world: Any = None, scale: float = 1.0,
-             sampling: _Sampling = "piecewise", compensate: bool = False) -> EnvMap:
+             sampling: _Sampling | None = None, compensate: bool = False) -> EnvMap:
         """Reads an OpenEXR (of ``layer``), Radiance .hdr or PNG file."""
     def eval(self, d: ArrayLike, *, out: NDArray[Any] | None = None) -> _Floats:
         """Radiance from world directions d, (N, 3)."""

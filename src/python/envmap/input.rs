@@ -19,9 +19,14 @@ pub fn mapping_arg(name: &str) -> PyResult<Mapping> {
     choice("mapping", name, &options)
 }
 
-/// `sampling`, by the names of [`Sampling::name`].
-pub fn sampling_arg(name: &str) -> PyResult<Sampling> {
-    let options = [Sampling::Piecewise, Sampling::Mitsuba].map(|m| (m.name(), m));
+/// `sampling`, by the names of [`Sampling::name`]; `None` is
+/// [`Sampling::default_for`] `mapping`.
+pub fn sampling_arg(name: Option<&str>, mapping: Mapping) -> PyResult<Sampling> {
+    let Some(name) = name else {
+        return Ok(Sampling::default_for(mapping));
+    };
+    let options =
+        [Sampling::Luminance, Sampling::Piecewise, Sampling::Mitsuba].map(|m| (m.name(), m));
     choice("sampling", name, &options)
 }
 

@@ -61,10 +61,14 @@ record! {
 ///     Rotation from the map's frame to the world (translation ignored).
 /// scale : float
 ///     Radiance scale, finite and >= 0.
-/// sampling : "piecewise" (default) or "mitsuba"
-///     "piecewise": piecewise-constant over the cells of the bilinear
-///     radiance, so that pdf > 0 wherever eval > 0. "mitsuba" (lat-long
-///     only): Mitsuba's bilinear density, equal to its envmap emitter's
+/// sampling : None (default), "luminance", "piecewise" or "mitsuba"
+///     "luminance" (lat-long only; the default for lat-long maps): pdf(d)
+///     = Y(eval(d)) / integral of Y over the sphere exactly, Y the
+///     luminance, so that env-only sampling of a grey map has one weight
+///     for every direction. "piecewise" (the default for angular and cube
+///     maps): piecewise-constant over the cells of the bilinear radiance.
+///     Both have pdf > 0 wherever eval > 0. "mitsuba" (lat-long only):
+///     Mitsuba's bilinear density, equal to its envmap emitter's
 ///     ``pdf_direction``.
 /// compensate : bool
 ///     MIS compensation: the mean luminance is subtracted before the
@@ -201,21 +205,22 @@ impl PyEnvMap {
 #[pymethods]
 impl PyEnvMap {
     #[new]
-    #[pyo3(signature = (image = None, *, mapping = "latlong", to_world = None, scale = 1.0, sampling = "piecewise", compensate = false))]
+    #[pyo3(signature = (image = None, *, mapping = "latlong", to_world = None, scale = 1.0, sampling = None, compensate = false))]
     fn new(
         py: Python<'_>,
         image: Option<&Obj<'_>>,
         mapping: &str,
         to_world: Option<&Obj<'_>>,
         scale: f64,
-        sampling: &str,
+        sampling: Option<&str>,
         compensate: bool,
     ) -> PyResult<Self> {
+        let mapping = mapping_arg(mapping)?;
         let options = Options {
-            mapping: mapping_arg(mapping)?,
+            mapping,
             to_world: to_world_arg(to_world)?,
             scale,
-            sampling: sampling_arg(sampling)?,
+            sampling: sampling_arg(sampling, mapping)?,
             compensate,
         };
         let Some(image) = image.filter(|i| !i.is_none()) else {
@@ -261,7 +266,7 @@ impl PyEnvMap {
     #[classmethod]
     #[pyo3(
         signature = (path, **options),
-        text_signature = "(path, *, layer=None, mapping='latlong', to_world=None, scale=1.0, sampling='piecewise', compensate=False)"
+        text_signature = "(path, *, layer=None, mapping='latlong', to_world=None, scale=1.0, sampling=None, compensate=False)"
     )]
     fn load<'py>(
         cls: &Bound<'py, PyType>,
