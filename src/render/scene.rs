@@ -51,7 +51,7 @@ fn primitives_of(geometry: Geometry) -> Box<dyn ExactSizeIterator<Item = Primiti
     match geometry {
         Geometry::Mesh(tris) => Box::new(tris.into_iter().map(Primitive::Triangle)),
         Geometry::Sphere(s) => Box::new(std::iter::once(Primitive::Sphere(s))),
-        Geometry::Disk(d) => Box::new(std::iter::once(Primitive::Disk(d))),
+        Geometry::Disk(d) => Box::new(std::iter::once(Primitive::Disk(Box::new(d)))),
     }
 }
 
@@ -182,6 +182,7 @@ impl Scene {
         let count: usize = shapes.iter().map(|s| s.geometry.primitive_count()).sum();
         check_primitives("shapes", count)?;
         let mut primitives = alloc::with_capacity(count, "the scene's primitives")?;
+        let mut shape_of = alloc::with_capacity(count, "the scene's primitives")?;
         let mut materials = Vec::with_capacity(shapes.len());
         let mut emission = Vec::with_capacity(shapes.len());
         let mut light_of_shape = Vec::with_capacity(shapes.len());
@@ -200,22 +201,20 @@ impl Scene {
                         ),
                     });
                 }
-                movers.push(Mover::new(
-                    Accel::new(alloc::collect(
-                        primitives_of(shape.geometry).map(|p| (p, id)),
-                        "a moving shape's primitives",
-                    )?)?,
-                    motion,
-                ));
+                let own =
+                    alloc::collect(primitives_of(shape.geometry), "a moving shape's primitives")?;
+                let shapes = alloc::collect(own.iter().map(|_| id), "a moving shape's primitives")?;
+                movers.push(Mover::new(Accel::new(own, shapes)?, motion));
                 materials.push(shape.material);
                 emission.push(None);
                 light_of_shape.push(None);
                 continue;
             }
             let first = primitives.len() as u32;
-            primitives.extend(primitives_of(shape.geometry).map(|p| (p, id)));
+            primitives.extend(primitives_of(shape.geometry));
+            shape_of.resize(primitives.len(), id);
             let areas = alloc::collect(
-                primitives[first as usize..].iter().map(|(p, _)| p.area()),
+                primitives[first as usize..].iter().map(Primitive::area),
                 "the areas",
             )?;
             materials.push(shape.material);
@@ -242,7 +241,7 @@ impl Scene {
                 light_of_shape.push(None);
             }
         }
-        let accel = Accel::new(primitives)?;
+        let accel = Accel::new(primitives, shape_of)?;
         // At most MAX_PRIMITIVES in all (check_primitives above).
         let mut first = accel.primitives().len() as u32;
         for mover in &mut movers {
