@@ -9,7 +9,7 @@
 //! BVH, the leaves' primitives are read from a copy in the BVH's order
 //! (`Packed`: a triangle's vertex and edges in 40 bytes), so that a leaf
 //! is a run of memory rather than a scatter over the scene's list of
-//! primitives (112 bytes each).
+//! primitives (64 bytes each).
 
 use std::time::Duration;
 
@@ -30,8 +30,9 @@ use super::shape::{
 /// ([`Packed`]) was added.
 const BUILD_BYTES_PER_PRIMITIVE: usize = 300;
 
-/// A primitive of a scene. A disk, with its two affine maps, is kept out
-/// of line, so that the list holds 112 bytes a primitive (a triangle's).
+/// A primitive of a scene, in 64 bytes (a triangle's: its vertex, edges
+/// and the indices of its vertex normals). A disk, with its two affine
+/// maps, is kept out of line.
 #[derive(Clone, Debug)]
 pub enum Primitive {
     /// One triangle of a mesh.
@@ -71,11 +72,12 @@ impl Primitive {
         }
     }
 
-    /// A point drawn uniformly by area (density `1 / area`).
+    /// A point drawn uniformly by area (density `1 / area`); `normals` is
+    /// the table of a triangle's vertex normals ([`Accel::normals`]).
     #[inline]
-    pub fn sample(&self, u: [f32; 2]) -> SurfacePoint {
+    pub fn sample(&self, u: [f32; 2], normals: &[Vec3A]) -> SurfacePoint {
         match self {
-            Primitive::Triangle(t) => t.sample(u),
+            Primitive::Triangle(t) => t.sample(u, normals),
             Primitive::Sphere(s) => s.sample(u),
             Primitive::Disk(d) => d.sample(u),
         }
@@ -94,11 +96,12 @@ impl Primitive {
     }
 
     /// The surface point of a hit on this primitive at `p` (position along
-    /// the ray) with barycentrics `bary` (triangles).
+    /// the ray) with barycentrics `bary` (triangles; `normals` is the table
+    /// of their vertex normals, [`Accel::normals`]).
     #[inline]
-    pub fn point(&self, p: Vec3A, bary: [f32; 2]) -> SurfacePoint {
+    pub fn point(&self, p: Vec3A, bary: [f32; 2], normals: &[Vec3A]) -> SurfacePoint {
         match self {
-            Primitive::Triangle(t) => t.point(bary),
+            Primitive::Triangle(t) => t.point(bary, normals),
             Primitive::Sphere(s) => s.point(p),
             Primitive::Disk(d) => d.point(p),
         }
@@ -164,6 +167,8 @@ impl Packed {
 pub struct Accel {
     primitives: Vec<Primitive>,
     shape_of: Vec<u32>,
+    /// The triangles' vertex normals ([`Triangle::normals`] index it).
+    normals: Vec<Vec3A>,
     bounds: Option<Aabb>,
     embree: Option<Embree>,
     bvh: Option<CwBvh>,
@@ -210,15 +215,22 @@ impl Leaf {
 impl Accel {
     /// Builds the BVH over `primitives`, primitive `i` of shape
     /// `shape_of[i]` (the two as separate lists, so that the build holds
-    /// no second copy of the primitives).
+    /// no second copy of the primitives), whose triangles' vertex normals
+    /// index `normals`.
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the BVH's memory cannot be had.
     ///
     /// # Panics
     /// If the two lists differ in length.
-    pub fn new(primitives: Vec<Primitive>, shape_of: Vec<u32>) -> Result<Self> {
-        Self::build(primitives, shape_of, true)
+    pub fn new(
+        primitives: Vec<Primitive>,
+        shape_of: Vec<u32>,
+        normals: Vec<Vec3A>,
+    ) -> Result<Self> {
+        let mut accel = Self::build(primitives, shape_of, true)?;
+        accel.normals = normals;
+        Ok(accel)
     }
 
     /// [`Accel::new`], with Embree only if `embree` (and as
@@ -274,6 +286,7 @@ impl Accel {
         Ok(Accel {
             primitives,
             shape_of,
+            normals: Vec::new(),
             bounds,
             embree,
             bvh,
@@ -293,6 +306,12 @@ impl Accel {
     /// The primitives, in the order they were given.
     pub fn primitives(&self) -> &[Primitive] {
         &self.primitives
+    }
+
+    /// The table of the triangles' vertex normals.
+    #[inline]
+    pub fn normals(&self) -> &[Vec3A] {
+        &self.normals
     }
 
     /// The shape a primitive belongs to.
@@ -479,7 +498,7 @@ mod tests {
                     })
                 })
                 .collect();
-            let accel = Accel::new(prims, (0..count as u32).rev().collect()).unwrap();
+            let accel = Accel::new(prims, (0..count as u32).rev().collect(), Vec::new()).unwrap();
             assert_eq!(accel.bvh.is_some(), count > LEAF_MAX);
             let ray = Ray {
                 o: Vec3A::ZERO,
@@ -526,7 +545,7 @@ mod tests {
                 tmax: if i % 2 == 0 { f32::INFINITY } else { 3.0 },
             })
             .collect();
-        let embree = Accel::new(prims.clone(), shapes.clone()).unwrap();
+        let embree = Accel::new(prims.clone(), shapes.clone(), Vec::new()).unwrap();
         let obvhs = Accel::build(prims, shapes, false).unwrap();
         assert_eq!(obvhs.ray_tracer(), "obvhs");
         if std::env::var_os("CI").is_some() {
@@ -566,15 +585,16 @@ mod tests {
     }
 
     /// The scene's list of primitives is its largest part at 10^6
-    /// triangles: a disk's affine maps must stay out of line.
+    /// triangles: a disk's affine maps stay out of line, and a triangle's
+    /// normals in the scene's table.
     #[test]
-    fn a_primitive_is_112_bytes() {
-        assert_eq!(std::mem::size_of::<Primitive>(), 112);
+    fn a_primitive_is_64_bytes() {
+        assert_eq!(std::mem::size_of::<Primitive>(), 64);
     }
 
     #[test]
     fn empty_scene_hits_nothing() {
-        let accel = Accel::new(Vec::new(), Vec::new()).unwrap();
+        let accel = Accel::new(Vec::new(), Vec::new(), Vec::new()).unwrap();
         let ray = Ray {
             o: Vec3A::ZERO,
             d: Vec3A::X,

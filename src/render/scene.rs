@@ -46,15 +46,6 @@ pub struct Shape {
     pub motion: Option<Motion>,
 }
 
-/// The primitives of a shape's geometry.
-fn primitives_of(geometry: Geometry) -> Box<dyn ExactSizeIterator<Item = Primitive>> {
-    match geometry {
-        Geometry::Mesh(tris) => Box::new(tris.into_iter().map(Primitive::Triangle)),
-        Geometry::Sphere(s) => Box::new(std::iter::once(Primitive::Sphere(s))),
-        Geometry::Disk(d) => Box::new(std::iter::once(Primitive::Disk(Box::new(d)))),
-    }
-}
-
 /// Something emitter sampling can draw a direction toward.
 #[derive(Clone, Debug)]
 enum Light {
@@ -183,6 +174,7 @@ impl Scene {
         check_primitives("shapes", count)?;
         let mut primitives = alloc::with_capacity(count, "the scene's primitives")?;
         let mut shape_of = alloc::with_capacity(count, "the scene's primitives")?;
+        let mut normals = Vec::new();
         let mut materials = Vec::with_capacity(shapes.len());
         let mut emission = Vec::with_capacity(shapes.len());
         let mut light_of_shape = Vec::with_capacity(shapes.len());
@@ -201,17 +193,20 @@ impl Scene {
                         ),
                     });
                 }
-                let own =
-                    alloc::collect(primitives_of(shape.geometry), "a moving shape's primitives")?;
+                let mut own_normals = Vec::new();
+                let own = alloc::collect(
+                    shape.geometry.into_primitives(&mut own_normals)?,
+                    "a moving shape's primitives",
+                )?;
                 let shapes = alloc::collect(own.iter().map(|_| id), "a moving shape's primitives")?;
-                movers.push(Mover::new(Accel::new(own, shapes)?, motion));
+                movers.push(Mover::new(Accel::new(own, shapes, own_normals)?, motion));
                 materials.push(shape.material);
                 emission.push(None);
                 light_of_shape.push(None);
                 continue;
             }
             let first = primitives.len() as u32;
-            primitives.extend(primitives_of(shape.geometry));
+            primitives.extend(shape.geometry.into_primitives(&mut normals)?);
             shape_of.resize(primitives.len(), id);
             let areas = alloc::collect(
                 primitives[first as usize..].iter().map(Primitive::area),
@@ -241,7 +236,7 @@ impl Scene {
                 light_of_shape.push(None);
             }
         }
-        let accel = Accel::new(primitives, shape_of)?;
+        let accel = Accel::new(primitives, shape_of, normals)?;
         // At most MAX_PRIMITIVES in all (check_primitives above).
         let mut first = accel.primitives().len() as u32;
         for mover in &mut movers {
@@ -334,7 +329,7 @@ impl Scene {
         let primitive = &self.accel.primitives()[hit.primitive as usize];
         (
             self.accel.shape_of(hit.primitive),
-            primitive.point(ray.o + ray.d * hit.t, hit.bary),
+            primitive.point(ray.o + ray.d * hit.t, hit.bary, self.accel.normals()),
         )
     }
 
@@ -505,7 +500,7 @@ impl Scene {
                         .filter_map(|p| p.intersect(&ray).map(|c| (p, c)))
                         .min_by(|a, b| a.1.t.total_cmp(&b.1.t));
                     if let Some((p, c)) = nearest {
-                        let y = p.point(x + d * c.t, c.bary);
+                        let y = p.point(x + d * c.t, c.bary, self.accel.normals());
                         if self.emitted(*shape, y.ng, -d).is_some() {
                             pdf += self.light_pdf(*shape, x, y.ng, d, c.t);
                         }
@@ -567,7 +562,7 @@ impl Scene {
                 let (primitive, u2) = self.pick_primitive(area, [u[1], u[2]]);
                 Some(Emission::Surface {
                     shape: area.shape,
-                    point: primitive.sample(u2),
+                    point: primitive.sample(u2, self.accel.normals()),
                     pdf: pmf / area.total_area,
                     radiance: area.radiance,
                 })
@@ -613,7 +608,7 @@ impl Scene {
                         Some((y, pdf)) => (y, Some(pdf)),
                         None => (s.sample(u2), None),
                     },
-                    _ => (primitive.sample(u2), None),
+                    _ => (primitive.sample(u2, self.accel.normals()), None),
                 };
                 let to_light = y.p - x;
                 let dist = to_light.length();

@@ -23,7 +23,7 @@ fn triangle_hit_and_normals() {
         .intersect(&ray([0.25, 0.25, 2.0], [0.0, 0.0, -1.0]))
         .unwrap();
     assert!((hit.t - 2.0).abs() < 1e-6);
-    let sp = tri.point(hit.bary);
+    let sp = tri.point(hit.bary, &[]);
     assert!((sp.p - Vec3A::new(0.25, 0.25, 0.0)).length() < 1e-6);
     assert_eq!(sp.ng, Vec3A::Z);
     assert!(
@@ -31,18 +31,19 @@ fn triangle_hit_and_normals() {
             .is_none()
     );
     assert!((tri.area() - 0.5).abs() < 1e-7);
-    // With vertex normals, the shading normal is their barycentric blend,
-    // normalised: (1 − b1 − b2) n0 + b1 n1 + b2 n2.
+    // With vertex normals (indices into a table), the shading normal is
+    // their barycentric blend, normalised: (1 − b1 − b2) n0 + b1 n1 + b2 n2.
     let (n0, n1, n2) = (
         Vec3A::Z,
         Vec3A::new(1.0, 0.0, 1.0).normalize(),
         Vec3A::new(0.0, 1.0, 1.0).normalize(),
     );
+    let table = [Vec3A::X, n2, n0, n1];
     let smooth = Triangle {
-        normals: Some([n0, n1, n2]),
+        normals: Some([2, 3, 1]),
         ..tri
     };
-    let sp = smooth.point([0.2, 0.5]);
+    let sp = smooth.point([0.2, 0.5], &table);
     let expected = (0.3 * n0 + 0.2 * n1 + 0.5 * n2).normalize();
     assert!((sp.ns - expected).length() < 1e-6, "{}", sp.ns);
     assert_eq!(sp.ng, Vec3A::Z);
