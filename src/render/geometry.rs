@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 pub enum Geometry {
     /// A triangle mesh (world space), kept as indexed vertices (28 bytes
     /// a face with normals, where its [`Triangle`]s would take 64) until a
-    /// scene makes its primitives ([`Geometry::into_primitives`]).
+    /// scene makes its primitives.
     Mesh {
         /// The vertices.
         points: Vec<Vec3A>,
