@@ -98,6 +98,7 @@ struct Api {
     intersect1: unsafe extern "C" fn(Handle, *mut Context, *mut RayHit),
     intersect1m: unsafe extern "C" fn(Handle, *mut Context, *mut RayHit, u32, usize),
     occluded1: unsafe extern "C" fn(Handle, *mut Context, *mut RtcRay),
+    occluded1m: unsafe extern "C" fn(Handle, *mut Context, *mut RtcRay, u32, usize),
     /// Kept loaded for the process's life: the pointers above point into it.
     _library: Library,
 }
@@ -159,6 +160,7 @@ impl Api {
             intersect1: entry!("rtcIntersect1"),
             intersect1m: entry!("rtcIntersect1M"),
             occluded1: entry!("rtcOccluded1"),
+            occluded1m: entry!("rtcOccluded1M"),
             _library: library,
         })
     }
@@ -239,10 +241,17 @@ pub fn wanted() -> Result<Option<Library3>> {
     }
 }
 
-/// The working memory of [`Triangles::intersect_many`]: Embree's records
-/// of a stream of rays, kept from one batch to the next.
+/// The working memory of [`Triangles::intersect_many`] and
+/// [`Triangles::occluded_many`]: Embree's records of a stream of rays, kept
+/// from one batch to the next.
 #[derive(Default)]
-pub struct Stream(Vec<RayHit>);
+pub struct Stream {
+    hits: Vec<RayHit>,
+    rays: Vec<RtcRay>,
+}
+
+/// Rays per call of a stream function (its count is a `u32`).
+const STREAM_CHUNK: usize = 1 << 20;
 
 /// Triangles in an Embree scene (one triangle mesh of unshared vertices),
 /// with the index of each in the scene's list of primitives.
@@ -418,8 +427,9 @@ impl Triangles {
     }
 
     /// [`Triangles::intersect`] of each ray of `rays`, appended to `out`:
-    /// traced as one coherent stream (`rtcIntersect1M`, which Embree
-    /// splits into packets), as the camera rays of a pixel are.
+    /// traced as one stream (`rtcIntersect1M`), which Embree splits into
+    /// packets when the rays are `coherent` (as the camera rays of a pixel
+    /// are).
     ///
     /// # Errors
     /// [`Error::Memory`] when the stream's records cannot be had.
@@ -427,16 +437,17 @@ impl Triangles {
     pub fn intersect_many(
         &self,
         rays: &[Ray],
+        coherent: bool,
         stream: &mut Stream,
         out: &mut Vec<Option<Hit>>,
     ) -> Result<()> {
         const WHAT: &str = "a stream of rays";
-        stream.0.clear();
-        crate::alloc::reserve(&mut stream.0, rays.len(), WHAT)?;
+        stream.hits.clear();
+        crate::alloc::reserve(&mut stream.hits, rays.len(), WHAT)?;
         crate::alloc::reserve(out, rays.len(), WHAT)?;
-        stream.0.extend(rays.iter().map(Self::ray_hit));
-        let mut context = Self::context(true);
-        for chunk in stream.0.chunks_mut(1 << 20) {
+        stream.hits.extend(rays.iter().map(Self::ray_hit));
+        let mut context = Self::context(coherent);
+        for chunk in stream.hits.chunks_mut(STREAM_CHUNK) {
             // SAFETY: as in `intersect`, for `chunk.len()` records one
             // `size_of::<RayHit>()` apart (aligned to 16, as Embree needs).
             unsafe {
@@ -449,7 +460,43 @@ impl Triangles {
                 )
             };
         }
-        out.extend(stream.0.iter().map(|rh| self.hit_of(rh)));
+        out.extend(stream.hits.iter().map(|rh| self.hit_of(rh)));
+        Ok(())
+    }
+
+    /// [`Triangles::occluded`] of each ray of `rays` (incoherent ones: the
+    /// shadow rays of a batch of paths), appended to `out`, as one stream
+    /// (`rtcOccluded1M`).
+    ///
+    /// # Errors
+    /// [`Error::Memory`] when the stream's records cannot be had.
+    #[allow(unsafe_code)]
+    pub fn occluded_many(
+        &self,
+        rays: &[Ray],
+        stream: &mut Stream,
+        out: &mut Vec<bool>,
+    ) -> Result<()> {
+        const WHAT: &str = "a stream of shadow rays";
+        stream.rays.clear();
+        crate::alloc::reserve(&mut stream.rays, rays.len(), WHAT)?;
+        crate::alloc::reserve(out, rays.len(), WHAT)?;
+        stream.rays.extend(rays.iter().map(Self::ray));
+        let mut context = Self::context(false);
+        for chunk in stream.rays.chunks_mut(STREAM_CHUNK) {
+            // SAFETY: as in `occluded`, for `chunk.len()` records one
+            // `size_of::<RtcRay>()` apart (aligned to 16, as Embree needs).
+            unsafe {
+                (self.api.occluded1m)(
+                    self.scene,
+                    &mut context,
+                    chunk.as_mut_ptr(),
+                    chunk.len() as u32,
+                    size_of::<RtcRay>(),
+                )
+            };
+        }
+        out.extend(stream.rays.iter().map(|r| r.tfar == f32::NEG_INFINITY));
         Ok(())
     }
 

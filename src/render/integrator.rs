@@ -14,10 +14,11 @@
 //! emitter sampling. Emission seen straight from the camera counts unless
 //! `hide_emitters`.
 //! Path lengths follow Mitsuba's `max_depth`: 1 is emission only, 2 direct
-//! illumination, −1 unbounded.
+//! illumination, −1 unbounded. The loop runs over a batch of paths at once,
+//! one bounce at a time ([`super::wavefront`]).
 //!
 //! Every random decision of a sample has its own dimension of the pixel's
-//! [`Stream`] ([`dims`]): a stratified or low-discrepancy sampler then
+//! [`Stream`](crate::sampler::Stream) ([`dims`]): a stratified or low-discrepancy sampler then
 //! stratifies each decision across the pixel's samples.
 
 use glam::Vec3A;
@@ -28,7 +29,7 @@ use super::shape::Ray;
 use crate::alloc;
 use crate::frame::Frame;
 use crate::phong::PhongView;
-use crate::sampler::{Sampler, Stream};
+use crate::sampler::Sampler;
 
 /// The dimensions of a sample, in this order: the camera's, then
 /// [`dims::PER_BOUNCE`] for each shading point along the path
@@ -126,7 +127,7 @@ pub struct Settings {
 }
 
 impl Settings {
-    fn weight(&self, pdf_a: f32, pdf_b: f32) -> f32 {
+    pub(super) fn weight(&self, pdf_a: f32, pdf_b: f32) -> f32 {
         self.heuristic.weight(pdf_a, pdf_b)
     }
 
@@ -219,12 +220,12 @@ pub(super) fn unoccluded(scene: &Scene, o: Vec3A, end: Vec3A, tau: f32) -> bool 
 }
 
 #[inline]
-fn mul(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+pub(super) fn mul(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     [a[0] * b[0], a[1] * b[1], a[2] * b[2]]
 }
 
 #[inline]
-fn add_scaled(acc: &mut [f32; 3], a: [f32; 3], b: [f32; 3], s: f32) {
+pub(super) fn add_scaled(acc: &mut [f32; 3], a: [f32; 3], b: [f32; 3], s: f32) {
     for k in 0..3 {
         acc[k] += a[k] * b[k] * s;
     }
@@ -271,7 +272,7 @@ impl Escaped {
     /// Records a ray that left the scene with throughput `beta`; `bsdf_pdf`
     /// when its MIS weight against environment sampling remains to apply.
     #[inline]
-    fn push(&mut self, slot: u32, d: Vec3A, beta: [f32; 3], bsdf_pdf: Option<f32>) {
+    pub(super) fn push(&mut self, slot: u32, d: Vec3A, beta: [f32; 3], bsdf_pdf: Option<f32>) {
         self.slot.push(slot);
         self.dir.push(d.to_array());
         self.beta.push(beta);
@@ -319,142 +320,11 @@ pub fn skip_emitters(scene: &Scene, ray: &mut Ray, mut hit: Option<Hit>, time: f
     hit
 }
 
-/// The radiance arriving at the camera along `ray` at time `time` of the
-/// shutter (every ray of the path is traced at that time), whose first hit
-/// ([`Scene::intersect`]) is `hit`: one sample of the
-/// estimator above, drawing its random numbers from `stream` (at the
-/// current sample). Light from the
-/// environment is not included: rays that escape are added to `escaped`
-/// under `slot`, and [`add_escaped`] adds their light.
-#[inline]
-pub fn radiance(
-    scene: &Scene,
-    (ray, time): (Ray, f32),
-    hit: Option<Hit>,
-    stream: &mut Stream,
-    settings: &Settings,
-    escaped: &mut Escaped,
-    slot: u32,
-) -> [f32; 3] {
-    if settings.max_depth() == 0 {
-        return [0.0; 3];
-    }
-    match hit {
-        Some(hit) => path(scene, (ray, time), hit, stream, settings, escaped, slot),
-        None => {
-            if scene.environment().is_some() && !settings.hide_emitters {
-                escaped.push(slot, ray.d, [1.0; 3], None);
-            }
-            [0.0; 3]
-        }
-    }
-}
-
-/// The rest of [`radiance`] once `ray` (from the camera) has hit the
-/// scene at `hit`.
-#[inline(never)]
-fn path(
-    scene: &Scene,
-    (mut ray, time): (Ray, f32),
-    mut hit: Hit,
-    stream: &mut Stream,
-    settings: &Settings,
-    escaped: &mut Escaped,
-    slot: u32,
-) -> [f32; 3] {
-    let max_depth = settings.max_depth();
-    let mut l = [0.0f32; 3];
-    let mut beta = [1.0f32; 3];
-    let mut bsdf_pdf = 0.0f32;
-    // The shading point the ray left (emitter sampling's densities are
-    // seen from there).
-    let mut from = ray.o;
-    let mut depth = 0u32;
-    loop {
-        let (shape, sp) = scene.surface(&ray, &hit, time);
-        let wi = -ray.d;
-        if let Some(le) = scene.emitted(shape, sp.ng, wi) {
-            let w = emission_weight(settings, depth, bsdf_pdf, || {
-                scene.light_pdf(shape, from, sp.ng, ray.d, hit.t)
-            });
-            add_scaled(&mut l, beta, le, w);
-        }
-        if depth + 1 >= max_depth {
-            break;
-        }
-        let (frame, view) = shading(scene, shape, sp.ns, wi);
-
-        if settings.strategy != Strategy::Bsdf {
-            let choice = stream.get1(dims::bounce(depth, dims::LIGHT_CHOICE));
-            let [u1, u2] = stream.get2(dims::bounce(depth, dims::LIGHT_POSITION));
-            // The independent sampler picks environment cells from extra
-            // random bits (an alias table); the others by inversion, which
-            // keeps their stratification.
-            let bits = stream.independent().map(|rng| move || rng.next_u64());
-            if let Some(ls) = scene.sample_light(sp.p, [choice, u1, u2], bits) {
-                let wo = frame.to_local(ls.d.to_array());
-                let (f, pdf_wo) = view.eval_pdf_one(wo);
-                if f.iter().any(|&v| v > 0.0)
-                    && !scene.occluded(&shadow_ray(sp.p, sp.ng, &ls), time)
-                {
-                    let w = if settings.strategy == Strategy::Mis {
-                        settings.weight(ls.pdf, pdf_wo)
-                    } else {
-                        1.0
-                    };
-                    let s = w * wo[2].abs() / ls.pdf;
-                    add_scaled(&mut l, beta, mul(f, ls.radiance), s);
-                }
-            }
-            // Under emitter sampling, the next vertex's emission is not
-            // counted: when it would be the last, stop here.
-            if settings.strategy == Strategy::Emitter && depth + 2 >= max_depth {
-                break;
-            }
-        }
-
-        let component = stream.get1(dims::bounce(depth, dims::BSDF_COMPONENT));
-        let [u1, u2] = stream.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
-        let s = view.sample_one([component, u1, u2]);
-        if s.weight.iter().all(|&v| v <= 0.0) {
-            break;
-        }
-        beta = mul(beta, s.weight);
-        bsdf_pdf = s.pdf;
-        let d = Vec3A::from(frame.to_world(s.wo)).normalize();
-        from = sp.p;
-        ray = Ray {
-            o: offset(sp.p, sp.ng, d),
-            d,
-            tmax: f32::INFINITY,
-        };
-        depth += 1;
-        if settings.integrator == Integrator::Path && depth >= settings.rr_depth {
-            let q = beta.iter().copied().fold(0.0f32, f32::max).min(0.95);
-            if stream.get1::<f32>(dims::bounce(depth - 1, dims::ROULETTE)) >= q {
-                break;
-            }
-            beta = beta.map(|b| b / q);
-        }
-        hit = match scene.intersect(&ray, time) {
-            Some(hit) => hit,
-            None => {
-                if scene.environment().is_some() && settings.strategy != Strategy::Emitter {
-                    let mis = settings.strategy == Strategy::Mis;
-                    escaped.push(slot, ray.d, beta, mis.then_some(bsdf_pdf));
-                }
-                break;
-            }
-        };
-    }
-    l
-}
-
 /// The weight of emission found at path depth `depth` (0: seen from the
 /// camera) after a BSDF sample of density `bsdf_pdf`; `light_pdf` gives the
 /// density emitter sampling would have had for it.
 #[inline]
-fn emission_weight(
+pub(super) fn emission_weight(
     settings: &Settings,
     depth: u32,
     bsdf_pdf: f32,

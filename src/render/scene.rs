@@ -314,7 +314,7 @@ impl Scene {
 
     /// Whether a moving shape lies on `ray` at time `tau`.
     #[inline(never)]
-    fn movers_occlude(&self, ray: &Ray, tau: f32) -> bool {
+    pub fn movers_occlude(&self, ray: &Ray, tau: f32) -> bool {
         self.movers.iter().any(|m| m.occludes(ray, tau))
     }
 

@@ -7,16 +7,17 @@
 use glam::{Affine3A, DVec3, Quat, Vec3, Vec3A};
 
 use super::camera::{Camera, FovAxis};
-use super::integrator::{self, Escaped};
+use super::integrator;
 use super::scene::{Environment, Geometry, Material, Shape};
 use super::shape::Ray;
+use super::wavefront::{CameraSample, Wavefront};
 use super::{Heuristic, Integrator, Scene, Settings, Strategy};
 use crate::phong::{Phong, Selection};
 use crate::rng::Rng;
 use crate::sampler::zorder::ZOrder;
 use crate::sampler::{Sampler, Stream};
 
-fn diffuse(rho: f64) -> Material {
+pub(super) fn diffuse(rho: f64) -> Material {
     Material {
         bsdf: Phong::new([rho; 3], [0.0; 3], 0.0, Selection::Max).unwrap(),
         two_sided: false,
@@ -43,7 +44,7 @@ fn mesh(m: Affine3A, vertices: &[[f32; 3]], faces: &[[i64; 3]]) -> Geometry {
 }
 
 /// Mitsuba's rectangle `[−1, 1]², z = 0`, facing +z, placed by `m`.
-fn rectangle(m: Affine3A) -> Geometry {
+pub(super) fn rectangle(m: Affine3A) -> Geometry {
     let v = [
         [-1.0, -1.0, 0.0],
         [1.0, -1.0, 0.0],
@@ -54,7 +55,7 @@ fn rectangle(m: Affine3A) -> Geometry {
 }
 
 /// Mitsuba's cube `[−1, 1]³`, facing out, placed by `m`.
-fn cube(m: Affine3A) -> Geometry {
+pub(super) fn cube(m: Affine3A) -> Geometry {
     let mut v = Vec::new();
     let mut f = Vec::new();
     for axis in 0..3 {
@@ -75,7 +76,7 @@ fn cube(m: Affine3A) -> Geometry {
     mesh(m, &v, &f)
 }
 
-fn camera() -> Camera {
+pub(super) fn camera() -> Camera {
     Camera::new(
         Affine3A::IDENTITY,
         40.0,
@@ -103,7 +104,7 @@ fn floor_scene(rho: f64, lights: Vec<Shape>) -> Scene {
     Scene::new(shapes, None, camera(), 4, 4).unwrap()
 }
 
-fn light(geometry: Geometry, radiance: f64) -> Shape {
+pub(super) fn light(geometry: Geometry, radiance: f64) -> Shape {
     Shape {
         geometry,
         material: diffuse(0.0),
@@ -112,7 +113,7 @@ fn light(geometry: Geometry, radiance: f64) -> Shape {
     }
 }
 
-fn settings(integrator: Integrator, strategy: Strategy) -> Settings {
+pub(super) fn settings(integrator: Integrator, strategy: Strategy) -> Settings {
     Settings {
         integrator,
         strategy,
@@ -145,25 +146,29 @@ fn estimate(scene: &Scene, from: Vec3A, target: Vec3A, s: &Settings, n: usize) -
     let hit = scene.accel().intersect(&ray);
     let count = n as u64;
     let zorder = ZOrder::new((0, 0), (1, 1), count, 17);
-    let mut stream = Stream::new(s.sampler, 17, Rng::new(17, 5), count, zorder);
-    let mut escaped = Escaped::default();
+    let mut streams = [Stream::new(s.sampler, 17, Rng::new(17, 5), count, zorder)];
+    let independent = s.sampler == Sampler::Independent;
+    let mut paths = Wavefront::default();
     let (mut sum, mut sum_sq) = (0.0f64, 0.0f64);
     let mut l = vec![[0.0f32; 3]; 256];
     for block in 0..n / 256 {
-        escaped.clear();
-        for (slot, out) in l.iter_mut().enumerate() {
-            stream.start((block * 256 + slot) as u32);
-            *out = integrator::radiance(
-                scene,
-                (ray, 0.0),
+        paths.start(256).unwrap();
+        for slot in 0..256 {
+            let index = (block * 256 + slot) as u32;
+            let camera = CameraSample {
+                slot: slot as u32,
+                pixel: 0,
+                index,
+                ray,
                 hit,
-                &mut stream,
-                s,
-                &mut escaped,
-                slot as u32,
-            );
+                time: 0.0,
+                rng: independent.then(|| Rng::new(17, u64::from(index))),
+            };
+            paths.push(scene, s, camera);
         }
-        integrator::add_escaped(scene, s, &mut escaped, &mut l);
+        l.fill([0.0; 3]);
+        paths.trace(scene, s, &mut streams, &mut l).unwrap();
+        integrator::add_escaped(scene, s, &mut paths.escaped, &mut l);
         for v in &l {
             sum += f64::from(v[0]);
             sum_sq += f64::from(v[0]).powi(2);

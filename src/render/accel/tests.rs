@@ -1,0 +1,150 @@
+//! The BVH against the leaf test and Embree against obvhs: the same hits,
+//! one ray at a time and in streams.
+
+use super::*;
+use glam::DVec3;
+
+/// A row of spheres along −z, fewer than [`LEAF_MAX`] (tested directly)
+/// and many more (through the BVH).
+#[test]
+fn nearest_sphere_and_occlusion_with_and_without_a_bvh() {
+    for count in [3, LEAF_MAX, 100] {
+        // Listed far to near, so that the nearest is not the first tested.
+        let prims: Vec<Primitive> = (0..count as u32)
+            .rev()
+            .map(|i| {
+                Primitive::Sphere(Sphere {
+                    center: DVec3::new(0.0, 0.0, -3.0 * (f64::from(i) + 1.0)),
+                    radius: 1.0,
+                    flip: false,
+                })
+            })
+            .collect();
+        let accel = Accel::new(prims, (0..count as u32).rev().collect(), Vec::new()).unwrap();
+        assert_eq!(accel.bvh.is_some(), count > LEAF_MAX);
+        let ray = Ray {
+            o: Vec3A::ZERO,
+            d: Vec3A::NEG_Z,
+            tmax: f32::INFINITY,
+        };
+        let hit = accel.intersect(&ray).unwrap();
+        assert_eq!(accel.shape_of(hit.primitive), 0);
+        assert!((hit.t - 2.0).abs() < 1e-5);
+        assert!(accel.occluded(&ray));
+        assert!(!accel.occluded(&Ray { tmax: 1.5, ..ray }));
+        assert!(accel.intersect(&Ray { tmax: 1.5, ..ray }).is_none());
+        let up = Ray { d: Vec3A::Y, ..ray };
+        assert!(accel.intersect(&up).is_none());
+        let (lo, hi) = accel.bounds().unwrap();
+        assert!((lo.z + 3.0 * count as f32 + 1.0).abs() < 1e-4 && (hi.z + 2.0).abs() < 1e-4);
+    }
+}
+
+/// Embree and obvhs find the same hits on a cloud of 2,000 random
+/// triangles, 5,000 rays from random points, and the same occlusion.
+/// Where Embree cannot be loaded only obvhs runs, except under CI,
+/// which installs it.
+#[test]
+fn embree_and_obvhs_agree() {
+    let mut rng = crate::rng::Rng::new(7, 11);
+    let mut u = || rng.next_float::<f32>();
+    let mut point = |scale: f32| Vec3A::new(u() - 0.5, u() - 0.5, u() - 0.5) * scale;
+    let prims: Vec<Primitive> = (0..2000)
+        .map(|_| {
+            Primitive::Triangle(Triangle {
+                p0: point(4.0),
+                e1: point(0.6),
+                e2: point(0.6),
+                normals: None,
+            })
+        })
+        .collect();
+    let shapes: Vec<u32> = (0..2000).collect();
+    let rays: Vec<Ray> = (0..5000)
+        .map(|i| Ray {
+            o: point(6.0),
+            d: point(1.0),
+            tmax: if i % 2 == 0 { f32::INFINITY } else { 3.0 },
+        })
+        .collect();
+    let embree = Accel::new(prims.clone(), shapes.clone(), Vec::new()).unwrap();
+    let obvhs = Accel::build(prims, shapes, false).unwrap();
+    assert_eq!(obvhs.ray_tracer(), "obvhs");
+    if std::env::var_os("CI").is_some() {
+        assert!(embree.ray_tracer().starts_with("embree"));
+    }
+    let (mut hits, mut occluded) = (0, 0);
+    for ray in &rays {
+        let (a, b) = (embree.intersect(ray), obvhs.intersect(ray));
+        assert_eq!(a.is_some(), b.is_some(), "{ray:?}");
+        if let (Some(a), Some(b)) = (a, b) {
+            assert_eq!(a.primitive, b.primitive, "{ray:?}");
+            assert!((a.t - b.t).abs() <= 1e-5 * (1.0 + a.t), "{} {}", a.t, b.t);
+            for k in 0..2 {
+                assert!(
+                    (a.bary[k] - b.bary[k]).abs() < 1e-4,
+                    "{:?} {:?}",
+                    a.bary,
+                    b.bary
+                );
+            }
+            hits += 1;
+        }
+        assert_eq!(embree.occluded(ray), obvhs.occluded(ray));
+        occluded += usize::from(obvhs.occluded(ray));
+    }
+    assert!(hits > 1000 && occluded == hits, "{hits} {occluded}");
+    // The streams find what one ray at a time finds, bit for bit.
+    let bits = |h: &Option<Hit>| h.map(|h| (h.primitive, h.t.to_bits(), h.bary.map(f32::to_bits)));
+    for (accel, coherent) in [&embree, &obvhs].into_iter().zip([true, false]) {
+        let mut stream = Default::default();
+        let (mut many, mut blocked) = (vec![None], vec![true]);
+        accel
+            .intersect_many(&rays, coherent, &mut stream, &mut many)
+            .unwrap();
+        accel
+            .occluded_many(&rays, &mut stream, &mut blocked)
+            .unwrap();
+        let one: Vec<_> = rays.iter().map(|r| accel.intersect(r)).collect();
+        assert!(many[0].is_none() && many.len() == rays.len() + 1);
+        assert!(many[1..].iter().map(bits).eq(one.iter().map(bits)));
+        assert!(blocked[0] && blocked.len() == rays.len() + 1);
+        assert!(
+            blocked[1..]
+                .iter()
+                .copied()
+                .eq(rays.iter().map(|r| accel.occluded(r)))
+        );
+    }
+    // Embree's incoherent stream too.
+    let (mut stream, mut many) = (Default::default(), Vec::new());
+    embree
+        .intersect_many(&rays, false, &mut stream, &mut many)
+        .unwrap();
+    assert!(
+        many.iter()
+            .map(bits)
+            .eq(rays.iter().map(|r| embree.intersect(r)).map(|h| bits(&h)))
+    );
+}
+
+/// The scene's list of primitives is its largest part at 10^6
+/// triangles: a disk's affine maps stay out of line, and a triangle's
+/// normals in the scene's table.
+#[test]
+fn a_primitive_is_64_bytes() {
+    assert_eq!(std::mem::size_of::<Primitive>(), 64);
+}
+
+#[test]
+fn empty_scene_hits_nothing() {
+    let accel = Accel::new(Vec::new(), Vec::new(), Vec::new()).unwrap();
+    let ray = Ray {
+        o: Vec3A::ZERO,
+        d: Vec3A::X,
+        tmax: f32::INFINITY,
+    };
+    assert!(accel.intersect(&ray).is_none());
+    assert!(!accel.occluded(&ray));
+    assert!(accel.bounds().is_none());
+}

@@ -1,0 +1,445 @@
+//! The direct and path integrators ([`super::integrator`]) over a batch of
+//! camera samples at once, one bounce at a time (a wavefront):
+//!
+//! ```text
+//! loop while paths remain:
+//!   shade   each path at its hit: emission, a light sample (its shadow
+//!           ray kept for later), a BSDF sample (the next ray), roulette
+//!   occlude every shadow ray of the batch, one stream; add the light of
+//!           those that reach it
+//!   trace   every next ray, one stream; rays that leave the scene go to
+//!           the batch's escaped rays ([`Escaped`])
+//! ```
+//!
+//! Each ray tracer call then serves hundreds of rays: Embree's streams, and
+//! loops whose memory reads (the hit primitives', the light tables')
+//! overlap from one path to the next.
+//!
+//! The image is the one the same paths give traced one at a time: each
+//! path draws its numbers from its pixel's stream in its own order (the
+//! independent sampler's generator travels with the path), and adds its
+//! light to its sample in the same order (the emission found at a vertex,
+//! then that vertex's light sample, then the next vertex's).
+
+use glam::Vec3A;
+
+use super::accel::Hit;
+use super::embree;
+use super::integrator::{
+    Escaped, Integrator, Settings, Strategy, add_scaled, dims, emission_weight, mul, offset,
+    shading, shadow_ray,
+};
+use super::scene::Scene;
+use super::shape::{Ray, SurfacePoint};
+use crate::alloc;
+use crate::error::Result;
+use crate::rng::Rng;
+use crate::sampler::Stream;
+
+/// A path between two bounces.
+#[derive(Clone, Debug)]
+struct Path {
+    /// Its sample's index in the batch (where its light goes).
+    slot: u32,
+    /// Its pixel's stream, among the batch's.
+    pixel: u32,
+    /// Its sample's index in the pixel's sequence.
+    index: u32,
+    /// Shading points so far (0: the camera ray's).
+    depth: u32,
+    /// The ray toward the next shading point.
+    ray: Ray,
+    /// The shading point the ray left (emitter sampling's densities are
+    /// seen from there).
+    from: Vec3A,
+    /// The throughput `β`.
+    beta: [f32; 3],
+    /// The density of the BSDF sample that made `ray`.
+    bsdf_pdf: f32,
+    /// The time of the sample within the shutter.
+    time: f32,
+    /// The independent sampler's generator, where the path left it.
+    rng: Option<Rng>,
+}
+
+/// Light of a light sample, added to sample `slot` when its shadow ray is
+/// clear: `β · fc · s`.
+#[derive(Clone, Copy, Debug)]
+struct Unshadowed {
+    slot: u32,
+    time: f32,
+    beta: [f32; 3],
+    fc: [f32; 3],
+    s: f32,
+}
+
+/// A camera sample that starts a path.
+#[derive(Clone, Debug)]
+pub struct CameraSample {
+    /// Its index in the batch (where its light goes).
+    pub slot: u32,
+    /// Its pixel's stream, among the batch's.
+    pub pixel: u32,
+    /// Its index in the pixel's sequence.
+    pub index: u32,
+    /// The camera ray.
+    pub ray: Ray,
+    /// Where the camera ray first meets the scene.
+    pub hit: Option<Hit>,
+    /// The time of the sample within the shutter.
+    pub time: f32,
+    /// The independent sampler's generator after the camera's draws
+    /// (`None` for the other samplers).
+    pub rng: Option<Rng>,
+}
+
+/// One thread's paths in flight and their rays (reused from batch to
+/// batch).
+#[derive(Default)]
+pub struct Wavefront {
+    paths: Vec<Path>,
+    hits: Vec<Option<Hit>>,
+    /// The shape and surface point of each hit.
+    surfaces: Vec<Option<(Hit, (u32, SurfacePoint))>>,
+    next: Vec<Path>,
+    rays: Vec<Ray>,
+    shadows: Vec<Unshadowed>,
+    shadow_rays: Vec<Ray>,
+    blocked: Vec<bool>,
+    stream: embree::Stream,
+    /// The rays of the batch that left the scene.
+    pub escaped: Escaped,
+}
+
+impl Wavefront {
+    /// Room for the paths of `n` camera samples, every ray forgotten.
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when the memory cannot be had.
+    pub fn start(&mut self, n: usize) -> Result<()> {
+        const WHAT: &str = "a batch of paths";
+        self.paths.clear();
+        self.hits.clear();
+        self.escaped.clear();
+        alloc::reserve_each!(n, WHAT;
+            self.paths, self.hits, self.surfaces, self.next, self.rays, self.shadows, self.shadow_rays,
+            self.blocked)?;
+        self.escaped.reserve(n)
+    }
+
+    /// Starts the path of camera sample `c`.
+    pub fn push(&mut self, scene: &Scene, settings: &Settings, c: CameraSample) {
+        if settings.max_depth() == 0 {
+            return;
+        }
+        let Some(hit) = c.hit else {
+            if scene.environment().is_some() && !settings.hide_emitters {
+                self.escaped.push(c.slot, c.ray.d, [1.0; 3], None);
+            }
+            return;
+        };
+        self.paths.push(Path {
+            slot: c.slot,
+            pixel: c.pixel,
+            index: c.index,
+            depth: 0,
+            ray: c.ray,
+            from: c.ray.o,
+            beta: [1.0; 3],
+            bsdf_pdf: 0.0,
+            time: c.time,
+            rng: c.rng,
+        });
+        self.hits.push(Some(hit));
+    }
+
+    /// Traces every path pushed since [`Wavefront::start`] to its end,
+    /// adding its light to `l[slot]` (`streams[pixel]` giving its numbers),
+    /// except the environment's: that of the rays that left the scene is
+    /// added by [`super::integrator::add_escaped`] of
+    /// [`Wavefront::escaped`].
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when the ray streams' memory cannot be had.
+    pub fn trace(
+        &mut self,
+        scene: &Scene,
+        settings: &Settings,
+        streams: &mut [Stream],
+        l: &mut [[f32; 3]],
+    ) -> Result<()> {
+        while !self.paths.is_empty() {
+            self.next.clear();
+            self.rays.clear();
+            self.shadows.clear();
+            self.shadow_rays.clear();
+            // The surfaces first, in a loop of their own: the reads of
+            // the hit primitives overlap.
+            self.surfaces.clear();
+            self.surfaces
+                .extend(self.paths.iter().zip(&self.hits).map(|(path, hit)| {
+                    hit.map(|hit| (hit, scene.surface(&path.ray, &hit, path.time)))
+                }));
+            for (mut path, surface) in self.paths.drain(..).zip(&self.surfaces) {
+                let Some((hit, surface)) = surface else {
+                    continue;
+                };
+                let stream = &mut streams[path.pixel as usize];
+                stream.start(path.index);
+                swap_generators(stream, &mut path);
+                let bounce = Bounce {
+                    scene,
+                    settings,
+                    shadows: &mut self.shadows,
+                    shadow_rays: &mut self.shadow_rays,
+                };
+                let l = &mut l[path.slot as usize];
+                let goes_on = bounce.shade(&mut path, (hit.t, *surface), stream, l);
+                swap_generators(stream, &mut path);
+                if goes_on {
+                    self.rays.push(path.ray);
+                    self.next.push(path);
+                }
+            }
+            self.blocked.clear();
+            scene
+                .accel()
+                .occluded_many(&self.shadow_rays, &mut self.stream, &mut self.blocked)?;
+            for ((u, ray), &blocked) in self
+                .shadows
+                .iter()
+                .zip(&self.shadow_rays)
+                .zip(&self.blocked)
+            {
+                let blocked = blocked || scene.moves() && scene.movers_occlude(ray, u.time);
+                if !blocked {
+                    add_scaled(&mut l[u.slot as usize], u.beta, u.fc, u.s);
+                }
+            }
+            self.hits.clear();
+            scene
+                .accel()
+                .intersect_many(&self.rays, false, &mut self.stream, &mut self.hits)?;
+            for (path, hit) in self.next.drain(..).zip(&mut self.hits) {
+                if scene.moves() {
+                    *hit = scene.intersect_movers(&path.ray, path.time, *hit);
+                }
+                if hit.is_some() {
+                    self.paths.push(path);
+                } else if scene.environment().is_some() && settings.strategy != Strategy::Emitter {
+                    let mis = settings.strategy == Strategy::Mis;
+                    let pdf = mis.then_some(path.bsdf_pdf);
+                    self.escaped.push(path.slot, path.ray.d, path.beta, pdf);
+                }
+            }
+            self.hits.retain(Option::is_some);
+        }
+        Ok(())
+    }
+}
+
+/// Swaps the generator of `stream` (the independent sampler's) with the
+/// one `path` carries: before and after its draws.
+#[inline]
+fn swap_generators(stream: &mut Stream, path: &mut Path) {
+    if let (Some(rng), Some(own)) = (stream.independent(), path.rng.as_mut()) {
+        std::mem::swap(rng, own);
+    }
+}
+
+/// What shading a path's vertex needs besides the path.
+struct Bounce<'a> {
+    scene: &'a Scene,
+    settings: &'a Settings,
+    shadows: &'a mut Vec<Unshadowed>,
+    shadow_rays: &'a mut Vec<Ray>,
+}
+
+impl Bounce<'_> {
+    /// The vertex where `path.ray` meets the scene (at distance `t`, on
+    /// `shape` at `sp`): its emission
+    /// added to `l`, its light sample kept (with its shadow ray) when it
+    /// carries light, and `path` moved on to its next ray. Whether the
+    /// path goes on.
+    #[inline]
+    fn shade(
+        self,
+        path: &mut Path,
+        (t, (shape, sp)): (f32, (u32, SurfacePoint)),
+        stream: &mut Stream,
+        l: &mut [f32; 3],
+    ) -> bool {
+        let Bounce {
+            scene, settings, ..
+        } = self;
+        let (ray, depth) = (path.ray, path.depth);
+        let wi = -ray.d;
+        if let Some(le) = scene.emitted(shape, sp.ng, wi) {
+            let w = emission_weight(settings, depth, path.bsdf_pdf, || {
+                scene.light_pdf(shape, path.from, sp.ng, ray.d, t)
+            });
+            add_scaled(l, path.beta, le, w);
+        }
+        let max_depth = settings.max_depth();
+        if depth + 1 >= max_depth {
+            return false;
+        }
+        let (frame, view) = shading(scene, shape, sp.ns, wi);
+
+        if settings.strategy != Strategy::Bsdf {
+            let choice = stream.get1(dims::bounce(depth, dims::LIGHT_CHOICE));
+            let [u1, u2] = stream.get2(dims::bounce(depth, dims::LIGHT_POSITION));
+            // The independent sampler picks environment cells from extra
+            // random bits (an alias table); the others by inversion, which
+            // keeps their stratification.
+            let bits = stream.independent().map(|rng| move || rng.next_u64());
+            if let Some(ls) = scene.sample_light(sp.p, [choice, u1, u2], bits) {
+                let wo = frame.to_local(ls.d.to_array());
+                let (f, pdf_wo) = view.eval_pdf_one(wo);
+                if f.iter().any(|&v| v > 0.0) {
+                    let w = if settings.strategy == Strategy::Mis {
+                        settings.weight(ls.pdf, pdf_wo)
+                    } else {
+                        1.0
+                    };
+                    self.shadows.push(Unshadowed {
+                        slot: path.slot,
+                        time: path.time,
+                        beta: path.beta,
+                        fc: mul(f, ls.radiance),
+                        s: w * wo[2].abs() / ls.pdf,
+                    });
+                    self.shadow_rays.push(shadow_ray(sp.p, sp.ng, &ls));
+                }
+            }
+            // Under emitter sampling, the next vertex's emission is not
+            // counted: when it would be the last, stop here.
+            if settings.strategy == Strategy::Emitter && depth + 2 >= max_depth {
+                return false;
+            }
+        }
+
+        let component = stream.get1(dims::bounce(depth, dims::BSDF_COMPONENT));
+        let [u1, u2] = stream.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
+        let s = view.sample_one([component, u1, u2]);
+        if s.weight.iter().all(|&v| v <= 0.0) {
+            return false;
+        }
+        path.beta = mul(path.beta, s.weight);
+        path.bsdf_pdf = s.pdf;
+        let d = Vec3A::from(frame.to_world(s.wo)).normalize();
+        path.from = sp.p;
+        path.ray = Ray {
+            o: offset(sp.p, sp.ng, d),
+            d,
+            tmax: f32::INFINITY,
+        };
+        path.depth += 1;
+        if settings.integrator == Integrator::Path && path.depth >= settings.rr_depth {
+            let q = path.beta.iter().copied().fold(0.0f32, f32::max).min(0.95);
+            if stream.get1::<f32>(dims::bounce(depth, dims::ROULETTE)) >= q {
+                return false;
+            }
+            path.beta = path.beta.map(|b| b / q);
+        }
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Affine3A, Quat, Vec3};
+
+    use super::*;
+    use crate::render::geometry::Geometry;
+    use crate::render::integrator::add_escaped;
+    use crate::render::scene::{Environment, Shape};
+    use crate::render::tests::{camera, cube, diffuse, light, rectangle, settings};
+    use crate::sampler::Sampler;
+    use crate::sampler::zorder::ZOrder;
+
+    /// A floor, a box on it, a spherical light over it and a sky.
+    fn scene() -> Scene {
+        let still = |geometry, rho| Shape {
+            geometry,
+            material: diffuse(rho),
+            emission: None,
+            motion: None,
+        };
+        let turned = Affine3A::from_scale_rotation_translation(
+            Vec3::splat(0.5),
+            Quat::from_rotation_z(0.4),
+            Vec3::new(0.3, 0.0, 0.5),
+        );
+        let shapes = vec![
+            still(rectangle(Affine3A::from_scale(Vec3::splat(20.0))), 0.6),
+            still(cube(turned), 0.8),
+            light(Geometry::sphere([-0.5, 0.4, 1.6], 0.3, false).unwrap(), 6.0),
+        ];
+        let sky = Some(Environment::Constant([0.4, 0.5, 0.7]));
+        Scene::new(shapes, sky, camera(), 4, 4).unwrap()
+    }
+
+    /// The light of camera samples `slots` (rays from one point in
+    /// scattered directions, some to the sky), traced as one batch.
+    fn trace(scene: &Scene, s: &Settings, slots: std::ops::Range<u32>) -> Vec<[f32; 3]> {
+        let count = 1 << 10;
+        let zorder = ZOrder::new((0, 0), (1, 1), count, 3);
+        let mut streams = [Stream::new(s.sampler, 3, Rng::new(3, 1), count, zorder)];
+        let mut paths = Wavefront::default();
+        paths.start(slots.len()).unwrap();
+        for (slot, index) in slots.clone().enumerate() {
+            let mut rng = Rng::new(11, u64::from(index));
+            let [a, b] = [rng.next_float::<f32>(), rng.next_float::<f32>()];
+            let ray = Ray {
+                o: Vec3A::new(0.0, -2.5, 2.0),
+                d: Vec3A::new(2.0 * a - 1.0, 1.0, 0.2 - b).normalize(),
+                tmax: f32::INFINITY,
+            };
+            let camera = CameraSample {
+                slot: slot as u32,
+                pixel: 0,
+                index,
+                ray,
+                hit: scene.intersect(&ray, 0.0),
+                time: 0.0,
+                rng: (s.sampler == Sampler::Independent).then_some(rng),
+            };
+            paths.push(scene, s, camera);
+        }
+        let mut l = vec![[0.0; 3]; slots.len()];
+        paths.trace(scene, s, &mut streams, &mut l).unwrap();
+        add_escaped(scene, s, &mut paths.escaped, &mut l);
+        l
+    }
+
+    /// A path traced in a batch of others gives, bit for bit, what it
+    /// gives traced alone: its numbers, its light samples and its rays stay
+    /// its own, for every integrator, strategy and sampler.
+    #[test]
+    fn a_path_in_a_batch_is_the_path_alone() {
+        let scene = scene();
+        let mut lit = 0;
+        for (integrator, strategy, sampler) in [
+            (Integrator::Path, Strategy::Mis, Sampler::Independent),
+            (Integrator::Path, Strategy::Emitter, Sampler::Sobol),
+            (Integrator::Path, Strategy::Bsdf, Sampler::Independent),
+            (Integrator::Direct, Strategy::Mis, Sampler::Stratified),
+        ] {
+            let s = Settings {
+                rr_depth: 2,
+                sampler,
+                ..settings(integrator, strategy)
+            };
+            let batch = trace(&scene, &s, 0..200);
+            for (i, l) in batch.iter().enumerate() {
+                let i = i as u32;
+                let alone = trace(&scene, &s, i..i + 1);
+                assert_eq!(l.map(f32::to_bits), alone[0].map(f32::to_bits), "{s:?} {i}");
+            }
+            lit += batch.iter().filter(|l| l[0] > 0.0).count();
+        }
+        // Most samples see light (the sky, the light, lit surfaces).
+        assert!(lit > 600, "{lit}");
+    }
+}
