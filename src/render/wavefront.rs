@@ -29,10 +29,12 @@ use super::integrator::{
     Escaped, Integrator, Settings, Strategy, add_scaled, dims, emission_weight, mul, offset,
     shading, shadow_ray,
 };
-use super::scene::Scene;
+use super::scene::{LightSample, Scene};
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
 use crate::error::Result;
+use crate::frame::Frame;
+use crate::phong::PhongView;
 use crate::rng::Rng;
 use crate::sampler::Stream;
 
@@ -73,6 +75,29 @@ struct Unshadowed {
     s: f32,
 }
 
+/// A shading point as a light sample sees it.
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    slot: u32,
+    time: f32,
+    beta: [f32; 3],
+    p: Vec3A,
+    ng: Vec3A,
+    frame: Frame<f32>,
+    view: PhongView<f32>,
+}
+
+/// An environment-map light sample drawn by its cell sampler, left for
+/// the batch's others ([`Wavefront::trace`]).
+#[derive(Clone, Copy, Debug)]
+struct Deferred {
+    vertex: Vertex,
+    /// The probability of having chosen the environment.
+    pmf: f32,
+    u: [f32; 2],
+    bits: u64,
+}
+
 /// A camera sample that starts a path.
 #[derive(Clone, Debug)]
 pub struct CameraSample {
@@ -106,6 +131,8 @@ pub struct Wavefront {
     shadows: Vec<Unshadowed>,
     shadow_rays: Vec<Ray>,
     blocked: Vec<bool>,
+    deferred: Vec<Deferred>,
+    env_samples: Vec<Option<LightSample>>,
     stream: embree::Stream,
     /// The rays of the batch that left the scene.
     pub escaped: Escaped,
@@ -123,7 +150,7 @@ impl Wavefront {
         self.escaped.clear();
         alloc::reserve_each!(n, WHAT;
             self.paths, self.hits, self.surfaces, self.next, self.rays, self.shadows, self.shadow_rays,
-            self.blocked)?;
+            self.blocked, self.deferred, self.env_samples)?;
         self.escaped.reserve(n)
     }
 
@@ -173,6 +200,7 @@ impl Wavefront {
             self.rays.clear();
             self.shadows.clear();
             self.shadow_rays.clear();
+            self.deferred.clear();
             // The surfaces first, in a loop of their own: the reads of
             // the hit primitives overlap.
             self.surfaces.clear();
@@ -192,6 +220,7 @@ impl Wavefront {
                     settings,
                     shadows: &mut self.shadows,
                     shadow_rays: &mut self.shadow_rays,
+                    deferred: &mut self.deferred,
                 };
                 let l = &mut l[path.slot as usize];
                 let goes_on = bounce.shade(&mut path, (hit.t, *surface), stream, l);
@@ -199,6 +228,22 @@ impl Wavefront {
                 if goes_on {
                     self.rays.push(path.ray);
                     self.next.push(path);
+                }
+            }
+            // The deferred environment samples, together: their table reads
+            // and arithmetic overlap from one to the next.
+            if let Some(cells) = scene.environment_cells() {
+                self.env_samples.clear();
+                self.env_samples.extend(
+                    self.deferred
+                        .iter()
+                        .map(|d| scene.sample_environment(d.pmf, d.u, Some((cells, d.bits)))),
+                );
+                for (d, ls) in self.deferred.iter().zip(&self.env_samples) {
+                    if let Some(ls) = ls {
+                        d.vertex
+                            .connect(ls, settings, &mut self.shadows, &mut self.shadow_rays);
+                    }
                 }
             }
             self.blocked.clear();
@@ -253,6 +298,38 @@ struct Bounce<'a> {
     settings: &'a Settings,
     shadows: &'a mut Vec<Unshadowed>,
     shadow_rays: &'a mut Vec<Ray>,
+    deferred: &'a mut Vec<Deferred>,
+}
+
+impl Vertex {
+    /// The light sample `ls` seen from this vertex: its light (BSDF,
+    /// cosine, MIS weight), kept with its shadow ray when it carries any.
+    #[inline]
+    fn connect(
+        &self,
+        ls: &LightSample,
+        settings: &Settings,
+        shadows: &mut Vec<Unshadowed>,
+        shadow_rays: &mut Vec<Ray>,
+    ) {
+        let wo = self.frame.to_local(ls.d.to_array());
+        let (f, pdf_wo) = self.view.eval_pdf_one(wo);
+        if f.iter().any(|&v| v > 0.0) {
+            let w = if settings.strategy == Strategy::Mis {
+                settings.weight(ls.pdf, pdf_wo)
+            } else {
+                1.0
+            };
+            shadows.push(Unshadowed {
+                slot: self.slot,
+                time: self.time,
+                beta: self.beta,
+                fc: mul(f, ls.radiance),
+                s: w * wo[2].abs() / ls.pdf,
+            });
+            shadow_rays.push(shadow_ray(self.p, self.ng, ls));
+        }
+    }
 }
 
 impl Bounce<'_> {
@@ -292,24 +369,33 @@ impl Bounce<'_> {
             // The independent sampler picks environment cells from extra
             // random bits (an alias table); the others by inversion, which
             // keeps their stratification.
-            let bits = stream.independent().map(|rng| move || rng.next_u64());
-            if let Some(ls) = scene.sample_light(sp.p, [choice, u1, u2], bits) {
-                let wo = frame.to_local(ls.d.to_array());
-                let (f, pdf_wo) = view.eval_pdf_one(wo);
-                if f.iter().any(|&v| v > 0.0) {
-                    let w = if settings.strategy == Strategy::Mis {
-                        settings.weight(ls.pdf, pdf_wo)
-                    } else {
-                        1.0
-                    };
-                    self.shadows.push(Unshadowed {
-                        slot: path.slot,
-                        time: path.time,
-                        beta: path.beta,
-                        fc: mul(f, ls.radiance),
-                        s: w * wo[2].abs() / ls.pdf,
-                    });
-                    self.shadow_rays.push(shadow_ray(sp.p, sp.ng, &ls));
+            if let Some(light) = scene.choose_light(choice) {
+                let bits = light
+                    .cells()
+                    .and(stream.independent())
+                    .map(|r| r.next_u64());
+                let vertex = Vertex {
+                    slot: path.slot,
+                    time: path.time,
+                    beta: path.beta,
+                    p: sp.p,
+                    ng: sp.ng,
+                    frame,
+                    view,
+                };
+                match bits {
+                    // A map's cell: drawn with the batch's others.
+                    Some(bits) => self.deferred.push(Deferred {
+                        vertex,
+                        pmf: light.pmf(),
+                        u: [u1, u2],
+                        bits,
+                    }),
+                    None => {
+                        if let Some(ls) = scene.sample_chosen(light, sp.p, [u1, u2], None) {
+                            vertex.connect(&ls, settings, self.shadows, self.shadow_rays);
+                        }
+                    }
                 }
             }
             // Under emitter sampling, the next vertex's emission is not
@@ -351,6 +437,9 @@ mod tests {
     use glam::{Affine3A, Quat, Vec3};
 
     use super::*;
+    use std::sync::Arc;
+
+    use crate::envmap::{EnvMap, Options};
     use crate::render::geometry::Geometry;
     use crate::render::integrator::add_escaped;
     use crate::render::scene::{Environment, Shape};
@@ -358,8 +447,9 @@ mod tests {
     use crate::sampler::Sampler;
     use crate::sampler::zorder::ZOrder;
 
-    /// A floor, a box on it, a spherical light over it and a sky.
-    fn scene() -> Scene {
+    /// A floor, a box on it, a spherical light over it and a sky: a
+    /// constant one, or a map (whose cells are drawn by the batch).
+    fn scene(map: bool) -> Scene {
         let still = |geometry, rho| Shape {
             geometry,
             material: diffuse(rho),
@@ -376,7 +466,17 @@ mod tests {
             still(cube(turned), 0.8),
             light(Geometry::sphere([-0.5, 0.4, 1.6], 0.3, false).unwrap(), 6.0),
         ];
-        let sky = Some(Environment::Constant([0.4, 0.5, 0.7]));
+        let sky = if map {
+            let (w, h) = (16, 8);
+            let texels: Vec<f32> = (0..w * h * 3)
+                .map(|i| 0.2 + ((i * 7919) % 13) as f32 / 13.0)
+                .collect();
+            let env = EnvMap::new(w, h, &texels, Options::default()).unwrap();
+            Environment::Map(Arc::new(env))
+        } else {
+            Environment::Constant([0.4, 0.5, 0.7])
+        };
+        let sky = Some(sky);
         Scene::new(shapes, sky, camera(), 4, 4).unwrap()
     }
 
@@ -418,14 +518,32 @@ mod tests {
     /// its own, for every integrator, strategy and sampler.
     #[test]
     fn a_path_in_a_batch_is_the_path_alone() {
-        let scene = scene();
         let mut lit = 0;
-        for (integrator, strategy, sampler) in [
-            (Integrator::Path, Strategy::Mis, Sampler::Independent),
-            (Integrator::Path, Strategy::Emitter, Sampler::Sobol),
-            (Integrator::Path, Strategy::Bsdf, Sampler::Independent),
-            (Integrator::Direct, Strategy::Mis, Sampler::Stratified),
+        for (map, integrator, strategy, sampler) in [
+            (false, Integrator::Path, Strategy::Mis, Sampler::Independent),
+            (false, Integrator::Path, Strategy::Emitter, Sampler::Sobol),
+            (
+                false,
+                Integrator::Path,
+                Strategy::Bsdf,
+                Sampler::Independent,
+            ),
+            (
+                false,
+                Integrator::Direct,
+                Strategy::Mis,
+                Sampler::Stratified,
+            ),
+            (true, Integrator::Path, Strategy::Mis, Sampler::Independent),
+            (
+                true,
+                Integrator::Path,
+                Strategy::Emitter,
+                Sampler::Independent,
+            ),
+            (true, Integrator::Direct, Strategy::Emitter, Sampler::Sobol),
         ] {
+            let scene = scene(map);
             let s = Settings {
                 rr_depth: 2,
                 sampler,
@@ -440,6 +558,6 @@ mod tests {
             lit += batch.iter().filter(|l| l[0] > 0.0).count();
         }
         // Most samples see light (the sky, the light, lit surfaces).
-        assert!(lit > 600, "{lit}");
+        assert!(lit > 1000, "{lit}");
     }
 }

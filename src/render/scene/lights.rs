@@ -1,0 +1,364 @@
+//! Emitter sampling: the lights of a scene, how one is chosen and
+//! sampled, and the densities of those draws.
+
+use glam::Vec3A;
+
+use super::{Environment, Scene};
+use crate::distr::Discrete1D;
+use crate::envmap::CellSampler;
+use crate::render::accel::Primitive;
+use crate::render::shape::{Ray, SurfacePoint};
+
+/// Something emitter sampling can draw a direction toward.
+#[derive(Clone, Debug)]
+pub(super) enum Light {
+    /// An area light.
+    Area(AreaLight),
+    /// The environment, drawn by its map's [`CellSampler`] where it has
+    /// one.
+    Environment { cells: Option<CellSampler> },
+}
+
+/// A light chosen for emitter sampling ([`Scene::choose_light`]) and the
+/// probability of that choice.
+#[derive(Clone, Copy, Debug)]
+pub struct ChosenLight<'a> {
+    light: &'a Light,
+    pmf: f32,
+}
+
+impl ChosenLight<'_> {
+    /// The probability of the choice.
+    #[inline]
+    pub fn pmf(&self) -> f32 {
+        self.pmf
+    }
+
+    /// The environment map's cell sampler, when the light is a map that
+    /// has one: its draws take 64 random bits.
+    #[inline]
+    pub fn cells(&self) -> Option<&CellSampler> {
+        match self.light {
+            Light::Environment { cells } => cells.as_ref(),
+            Light::Area(_) => None,
+        }
+    }
+}
+
+/// The emitting shape `shape`, whose primitives are
+/// `primitives[first..first + count]`, one chosen by area (`areas`, when
+/// there are several).
+#[derive(Clone, Debug)]
+pub(super) struct AreaLight {
+    pub(super) shape: u32,
+    pub(super) first: u32,
+    pub(super) count: u32,
+    pub(super) areas: Option<Discrete1D>,
+    pub(super) total_area: f32,
+    pub(super) radiance: [f32; 3],
+}
+
+/// A direction toward a light, from emitter sampling.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the shading point toward the light.
+    pub d: Vec3A,
+    /// Distance to the light point (infinite for the environment).
+    pub dist: f32,
+    /// Density per steradian, including the choice of the light.
+    pub pdf: f32,
+    /// Radiance arriving along `d` (before the visibility test).
+    pub radiance: [f32; 3],
+    /// The point on an area light (where the shadow ray ends) and its
+    /// shape, `None` for the environment.
+    pub point: Option<(SurfacePoint, u32)>,
+}
+
+/// Where light starts ([`Scene::sample_emission`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Emission {
+    /// A point on an area light.
+    Surface {
+        /// The shape it lies on.
+        shape: u32,
+        /// The point (light leaves its front side, along `ng`).
+        point: SurfacePoint,
+        /// Density per unit area, including the choice of the light.
+        pdf: f32,
+        /// Emitted radiance.
+        radiance: [f32; 3],
+    },
+    /// Light from the environment.
+    Environment {
+        /// Unit direction toward the environment (light travels along `−d`).
+        d: Vec3A,
+        /// Density per steradian, including the choice of the light.
+        pdf: f32,
+        /// Radiance arriving along `−d`.
+        radiance: [f32; 3],
+        /// The probability of having chosen the environment.
+        choice: f32,
+    },
+}
+
+impl Scene {
+    fn choice_pmf(&self, light: Option<u32>) -> f32 {
+        match (light, &self.light_choice) {
+            (Some(l), Some(choice)) => choice.pmf(l as usize) as f32,
+            _ => 0.0,
+        }
+    }
+
+    /// Density per steradian with which emitter sampling from the shading
+    /// point `x` draws the direction `d` that reaches shape `shape` at
+    /// distance `dist`, where its geometric normal is `ng`: the choice of
+    /// the light times [`Sphere::cone_pdf`](crate::render::shape::Sphere::cone_pdf) for a sphere seen from outside,
+    /// else `dist² / (|cos θ_light| A)` (uniform by area `A`, turned into
+    /// solid angle).
+    #[inline]
+    pub fn light_pdf(&self, shape: u32, x: Vec3A, ng: Vec3A, d: Vec3A, dist: f32) -> f32 {
+        let light = self.light_of_shape[shape as usize];
+        let Some(Light::Area(area)) = light.map(|l| &self.lights[l as usize]) else {
+            return 0.0;
+        };
+        let pmf = self.choice_pmf(light);
+        if let Primitive::Sphere(s) = &self.accel.primitives()[area.first as usize]
+            && let Some(pdf) = s.cone_pdf(x)
+        {
+            return pmf * pdf;
+        }
+        let cos = ng.dot(d).abs();
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        pmf * dist * dist / (cos * area.total_area)
+    }
+
+    /// The density per unit area with which [`Scene::sample_emission`]
+    /// draws a point of shape `shape` (0 unless it is an area light): the
+    /// choice of its light over its area.
+    pub fn emission_pdf(&self, shape: u32) -> f32 {
+        let light = self.light_of_shape[shape as usize];
+        match light.map(|l| &self.lights[l as usize]) {
+            Some(Light::Area(area)) => self.choice_pmf(light) / area.total_area,
+            _ => 0.0,
+        }
+    }
+
+    /// The density per steradian with which [`Scene::sample_light`] and
+    /// [`Scene::sample_emission`] draw the environment direction `d` (the
+    /// choice of the environment included).
+    pub fn environment_pdf(&self, d: Vec3A) -> f32 {
+        self.environment
+            .as_ref()
+            .map_or(0.0, |env| self.choice_pmf(self.env_light) * env.pdf(d))
+    }
+
+    /// `out[i]`: the density per steradian with which emitter sampling
+    /// draws the environment direction `d[i]` (the choice of the
+    /// environment among the lights included).
+    pub fn environment_pdf_into(&self, d: &[[f32; 3]], out: &mut [f32]) {
+        let pmf = self.choice_pmf(self.env_light);
+        match &self.environment {
+            Some(Environment::Map(env)) => {
+                env.pdf_into(d, out, |_| true);
+                out.iter_mut().for_each(|p| *p *= pmf);
+            }
+            Some(env) => out.fill(pmf * env.pdf(Vec3A::Z)),
+            None => out.fill(0.0),
+        }
+    }
+
+    /// The density per steradian with which [`Scene::sample_light`] from
+    /// `x` draws the unit direction `d`: over the lights, the probability of
+    /// choosing each times its density toward `d`. An area light counts
+    /// where `d` first meets it (among its own primitives: other shapes are
+    /// ignored, as the sampler ignores them) on its front side.
+    pub fn emitter_pdf(&self, x: Vec3A, d: Vec3A) -> f32 {
+        let ray = Ray {
+            o: x,
+            d,
+            tmax: f32::INFINITY,
+        };
+        let mut pdf = 0.0;
+        for (index, light) in self.lights.iter().enumerate() {
+            match light {
+                Light::Area(AreaLight {
+                    shape,
+                    first,
+                    count,
+                    ..
+                }) => {
+                    let own = &self.accel.primitives()[*first as usize..(first + count) as usize];
+                    let nearest = own
+                        .iter()
+                        .filter_map(|p| p.intersect(&ray).map(|c| (p, c)))
+                        .min_by(|a, b| a.1.t.total_cmp(&b.1.t));
+                    if let Some((p, c)) = nearest {
+                        let y = p.point(x + d * c.t, c.bary, self.accel.normals());
+                        if self.emitted(*shape, y.ng, -d).is_some() {
+                            pdf += self.light_pdf(*shape, x, y.ng, d, c.t);
+                        }
+                    }
+                }
+                Light::Environment { .. } => {
+                    if let Some(env) = &self.environment {
+                        pdf += self.choice_pmf(Some(index as u32)) * env.pdf(d);
+                    }
+                }
+            }
+        }
+        pdf
+    }
+
+    /// A primitive of `area` chosen by area with `u[0]`, and `u` made
+    /// uniform again.
+    #[inline]
+    fn pick_primitive(&self, area: &AreaLight, u: [f32; 2]) -> (&Primitive, [f32; 2]) {
+        let (k, u0) = match &area.areas {
+            Some(a) => a.sample_reuse(u[0]),
+            None => (0, u[0]),
+        };
+        (
+            &self.accel.primitives()[area.first as usize + k],
+            [u0, u[1]],
+        )
+    }
+
+    /// Where light starts, for light tracing: a light chosen by power
+    /// (`u[0]`, as [`Scene::sample_light`]), then a point on an area light
+    /// uniformly by area, or a direction toward the environment by its own
+    /// sampling ([`Environment::sample`] by inversion) (`u[1..3]`). `None`
+    /// when the scene has no light or the sample carries no radiance.
+    pub fn sample_emission(&self, u: [f32; 3]) -> Option<Emission> {
+        let choice = self.light_choice.as_ref()?;
+        let index = choice.sample(u[0]);
+        let pmf = choice.pmf(index) as f32;
+        match &self.lights[index] {
+            Light::Environment { .. } => {
+                let (d, pdf, radiance) = self.environment.as_ref()?.sample([u[1], u[2]], None);
+                (pdf > 0.0).then_some(Emission::Environment {
+                    d,
+                    pdf: pdf * pmf,
+                    radiance,
+                    choice: pmf,
+                })
+            }
+            Light::Area(area) => {
+                let (primitive, u2) = self.pick_primitive(area, [u[1], u[2]]);
+                Some(Emission::Surface {
+                    shape: area.shape,
+                    point: primitive.sample(u2, self.accel.normals()),
+                    pdf: pmf / area.total_area,
+                    radiance: area.radiance,
+                })
+            }
+        }
+    }
+
+    /// Emitter sampling from the shading point `x`: a light chosen by power
+    /// (`u[0]`, [`Scene::choose_light`]), then a point on it (uniformly by
+    /// area, or for a sphere seen from outside by the cone it subtends) or
+    /// an environment direction by the environment's own sampling
+    /// (`u[1..3]`; a map's cell by its [`CellSampler`] from 64 bits of
+    /// `bits` when given, else by
+    /// [`EnvMap::sample`](crate::envmap::EnvMap::sample) of `u[1..3]`, with
+    /// the same density). `None` when the scene has no light or the sample
+    /// carries no radiance.
+    #[inline]
+    pub fn sample_light(
+        &self,
+        x: Vec3A,
+        u: [f32; 3],
+        bits: Option<impl FnOnce() -> u64>,
+    ) -> Option<LightSample> {
+        let light = self.choose_light(u[0])?;
+        let bits = light.cells().and(bits).map(|bits| bits());
+        self.sample_chosen(light, x, [u[1], u[2]], bits)
+    }
+
+    /// [`Scene::sample_chosen`] of the environment, chosen with probability
+    /// `pmf`: by its map's cell sampler and 64 random bits when `cells`
+    /// gives them, else by inversion of `u`.
+    #[inline]
+    pub fn sample_environment(
+        &self,
+        pmf: f32,
+        u: [f32; 2],
+        cells: Option<(&CellSampler, u64)>,
+    ) -> Option<LightSample> {
+        let (d, pdf, radiance) = self.environment.as_ref()?.sample(u, cells);
+        (pdf > 0.0).then_some(LightSample {
+            d,
+            dist: f32::INFINITY,
+            pdf: pdf * pmf,
+            radiance,
+            point: None,
+        })
+    }
+
+    /// The environment map's cell sampler, when the scene's environment
+    /// is a map that has one.
+    pub fn environment_cells(&self) -> Option<&CellSampler> {
+        match self.lights.get(self.env_light? as usize)? {
+            Light::Environment { cells } => cells.as_ref(),
+            Light::Area(_) => None,
+        }
+    }
+
+    /// The light emitter sampling draws by `u` (by power), or `None` when
+    /// the scene has none.
+    #[inline]
+    pub fn choose_light(&self, u: f32) -> Option<ChosenLight<'_>> {
+        let choice = self.light_choice.as_ref()?;
+        let index = choice.sample(u);
+        Some(ChosenLight {
+            light: &self.lights[index],
+            pmf: choice.pmf(index) as f32,
+        })
+    }
+
+    /// [`Scene::sample_light`] of the chosen `light`, with `u` the
+    /// position's numbers and `bits` the [`CellSampler`]'s (used only when
+    /// [`ChosenLight::cells`] has one).
+    #[inline]
+    pub fn sample_chosen(
+        &self,
+        ChosenLight { light, pmf }: ChosenLight<'_>,
+        x: Vec3A,
+        u: [f32; 2],
+        bits: Option<u64>,
+    ) -> Option<LightSample> {
+        match light {
+            Light::Environment { cells } => {
+                self.sample_environment(pmf, u, cells.as_ref().zip(bits))
+            }
+            Light::Area(area) => {
+                let (primitive, u2) = self.pick_primitive(area, u);
+                // A sphere seen from outside: by the cone it subtends.
+                let (y, cone_pdf) = match primitive {
+                    Primitive::Sphere(s) => match s.sample_cone(x, u2) {
+                        Some((y, pdf)) => (y, Some(pdf)),
+                        None => (s.sample(u2), None),
+                    },
+                    _ => (primitive.sample(u2, self.accel.normals()), None),
+                };
+                let to_light = y.p - x;
+                let dist = to_light.length();
+                if dist <= 0.0 {
+                    return None;
+                }
+                let d = to_light / dist;
+                let cos = -y.ng.dot(d);
+                let pdf = cone_pdf.unwrap_or(dist * dist / (cos * area.total_area));
+                (cos > 0.0 && pdf.is_finite()).then_some(LightSample {
+                    d,
+                    dist,
+                    pdf: pmf * pdf,
+                    radiance: area.radiance,
+                    point: Some((y, area.shape)),
+                })
+            }
+        }
+    }
+}
