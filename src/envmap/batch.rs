@@ -4,7 +4,9 @@
 //! cache misses overlap. Each computes what its one-at-a-time method does,
 //! with the same functions.
 
+use super::cell_sampler::CellSampler;
 use super::distribution::Distribution;
+use super::image::Corners;
 use super::mapping::Mapping;
 use super::polar::TableFloat;
 use super::sample::{PdfQuery, Placed};
@@ -246,7 +248,6 @@ impl EnvMap {
         let mut corners = [([0; 4], [zero; 4]); GROUP];
         let mut bilinear = [([0.0; 2], 0.0); GROUP];
         let mut group = [[zero; 2]; GROUP];
-        let mapping = self.options.mapping;
         for (g, rows) in rows.chunks(GROUP).enumerate() {
             let n = rows.len();
             let first = g * GROUP;
@@ -294,17 +295,91 @@ impl EnvMap {
                     continue;
                 }
             }
-            let (points, frames) = (&points[..n], &mut frames[..n]);
-            per_mapping!(mapping, |M| {
-                let frame = {
-                    #[inline(always)]
-                    |[s, t, pdf_q]: [F; 3]| self.frame_at(M, [s, t], pdf_q)
-                };
-                simd::map_rows(frames, points, &frame, |_| true, false)
+            self.finish_group(&points[..n], &corners, &mut frames, |k, s| {
+                out.set(first + k, s);
             });
-            for ((k, f), c) in (first..).zip(frames.iter()).zip(&corners) {
-                out.set(k, self.sample_from(f, c));
+        }
+    }
+
+    /// The second half of a group's draws: the directions and densities of
+    /// `points` (domain point and table density) at SIMD width, then each
+    /// sample's radiance from its `corners`, handed to `emit` with its index
+    /// in the group.
+    #[inline(always)]
+    fn finish_group<F: Real>(
+        &self,
+        points: &[[F; 3]],
+        corners: &[Corners<F>],
+        frames: &mut [[F; 5]; GROUP],
+        mut emit: impl FnMut(usize, EnvSample<F>),
+    ) {
+        let frames = &mut frames[..points.len()];
+        per_mapping!(self.options.mapping, |M| {
+            let frame = {
+                #[inline(always)]
+                |[s, t, pdf_q]: [F; 3]| self.frame_at(M, [s, t], pdf_q)
+            };
+            simd::map_rows(frames, points, &frame, |_| true, false)
+        });
+        for (k, (f, c)) in frames.iter().zip(corners).enumerate() {
+            emit(k, self.sample_from(f, c));
+        }
+    }
+
+    /// [`CellSampler::sample`] by `sampler` (built for this map) of each
+    /// `(bits, r)` of `draws`, appended to `out`, group by group as
+    /// [`EnvMap::sample_rows`] draws: the cells (their alias-table reads
+    /// overlap), the points placed in them and their texels prefetched,
+    /// then [`EnvMap::finish_group`].
+    #[inline(always)]
+    pub(super) fn sample_cells<F: Real>(
+        &self,
+        sampler: &CellSampler,
+        draws: &[(u64, [F; 2])],
+        out: &mut Vec<EnvSample<F>>,
+    ) {
+        match &self.distribution {
+            Distribution::Luminance(density) => {
+                self.sample_cells_by(sampler, draws, out, |c, r| {
+                    self.place_luminance(density, c, r)
+                })
             }
+            Distribution::Piecewise(table) => {
+                self.sample_cells_by(sampler, draws, out, |c, r| self.place_in_cell(table, c, r))
+            }
+            // (Maps without cells have no cell sampler.)
+            Distribution::Bilinear(_) | Distribution::Black => {
+                out.extend(draws.iter().map(|&(bits, r)| sampler.sample(self, bits, r)));
+            }
+        }
+    }
+
+    /// [`EnvMap::sample_cells`] with the cell's point placed by `place`.
+    #[inline(always)]
+    fn sample_cells_by<F: Real>(
+        &self,
+        sampler: &CellSampler,
+        draws: &[(u64, [F; 2])],
+        out: &mut Vec<EnvSample<F>>,
+        place: impl Fn((usize, usize), [F; 2]) -> Placed<F>,
+    ) {
+        let zero = F::zero();
+        let mut cells = [(0, 0); GROUP];
+        let mut points = [[zero; 3]; GROUP];
+        let mut frames = [[zero; 5]; GROUP];
+        let mut corners = [([0; 4], [zero; 4]); GROUP];
+        for draws in draws.chunks(GROUP) {
+            for (cell, &(bits, _)) in cells.iter_mut().zip(draws) {
+                *cell = sampler.cell(bits);
+            }
+            for (k, (&cell, &(_, r))) in cells.iter().zip(draws).enumerate() {
+                let placed = place(cell, r);
+                self.image.prefetch(&placed.corners);
+                let [s, t] = placed.point;
+                (points[k], corners[k]) = ([s, t, placed.pdf_q], placed.corners);
+            }
+            let points = &points[..draws.len()];
+            self.finish_group(points, &corners, &mut frames, |_, s| out.push(s));
         }
     }
 }

@@ -6,6 +6,7 @@ use super::{EnvMap, EnvSample};
 use crate::distr::AliasTable;
 use crate::error::Result;
 use crate::math::Real;
+use crate::simd;
 
 /// The density of [`EnvMap::sample`] (luminance or piecewise sampling),
 /// drawn in O(1): the table cell `(row, col)` by an [`AliasTable`] over the
@@ -57,8 +58,7 @@ impl CellSampler {
     /// cells, it draws by [`EnvMap::sample`] of `r`.)
     #[inline]
     pub fn sample<F: Real>(&self, env: &EnvMap, bits: u64, r: [F; 2]) -> EnvSample<F> {
-        let c = self.cells.sample_bits(bits);
-        let cell = (c / self.cols, c % self.cols);
+        let cell = self.cell(bits);
         let placed = match &env.distribution {
             Distribution::Luminance(density) => env.place_luminance(density, cell, r),
             Distribution::Piecewise(table) => env.place_in_cell(table, cell, r),
@@ -67,5 +67,28 @@ impl CellSampler {
             }
         };
         env.sample_at(&placed)
+    }
+
+    /// The table cell `(row, col)` drawn from the 64 bits `bits`.
+    #[inline(always)]
+    pub(super) fn cell(&self, bits: u64) -> (usize, usize) {
+        let c = self.cells.sample_bits(bits);
+        (c / self.cols, c % self.cols)
+    }
+
+    /// [`CellSampler::sample`] of each `(bits, r)` of `draws`, appended to
+    /// `out` in order, the same samples: drawn together, in groups whose
+    /// table reads overlap and whose directions and densities are computed
+    /// at SIMD width (as [`EnvMap::sample_into`] draws).
+    pub fn sample_many<F: Real>(
+        &self,
+        env: &EnvMap,
+        draws: &[(u64, [F; 2])],
+        out: &mut Vec<EnvSample<F>>,
+    ) {
+        simd::dispatch(
+            #[inline(always)]
+            |_| env.sample_cells(self, draws, out),
+        );
     }
 }

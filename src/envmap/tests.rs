@@ -472,3 +472,43 @@ fn cell_sampler_draws_the_table_density() {
         assert!(tested > 50, "{:?}: {tested} cells tested", m.options());
     }
 }
+
+/// The cell sampler's batch draws are its single draws, bit for bit, in
+/// `f32` and `f64`, for every map that has one (and more draws than a
+/// group).
+#[test]
+fn cell_sampler_batches_are_its_single_draws() {
+    fn check<F: Real>(m: &EnvMap, cells: &CellSampler, draws: &[(u64, [F; 2])]) {
+        let mut many = Vec::new();
+        cells.sample_many(m, draws, &mut many);
+        assert_eq!(many.len(), draws.len());
+        for (s, &(bits, r)) in many.iter().zip(draws) {
+            let one = cells.sample(m, bits, r);
+            let key = |s: &EnvSample<F>| {
+                let parts = [s.direction, s.weight, s.radiance];
+                (
+                    s.pdf.f64().to_bits(),
+                    parts.map(|v| v.map(|x| x.f64().to_bits())),
+                )
+            };
+            assert_eq!(key(s), key(&one), "{:?}", m.options());
+        }
+    }
+    let mut rng = crate::rng::Rng::new(5, 9);
+    let draws: Vec<(u64, [f64; 2])> = (0..3 * crate::distr::GROUP + 7)
+        .map(|_| (rng.next_u64(), [rng.next_float(), rng.next_float()]))
+        .collect();
+    let mut checked = 0;
+    for m in all_maps() {
+        if let Some(cells) = CellSampler::new(&m).unwrap() {
+            check(&m, &cells, &draws);
+            let draws32: Vec<_> = draws
+                .iter()
+                .map(|&(b, r)| (b, r.map(|x| x as f32)))
+                .collect();
+            check(&m, &cells, &draws32);
+            checked += 1;
+        }
+    }
+    assert!(checked >= 5, "{checked}");
+}

@@ -32,6 +32,7 @@ use super::integrator::{
 use super::scene::{LightSample, Scene};
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
+use crate::envmap::EnvSample;
 use crate::error::Result;
 use crate::frame::Frame;
 use crate::phong::PhongView;
@@ -87,17 +88,6 @@ struct Vertex {
     view: PhongView<f32>,
 }
 
-/// An environment-map light sample drawn by its cell sampler, left for
-/// the batch's others ([`Wavefront::trace`]).
-#[derive(Clone, Copy, Debug)]
-struct Deferred {
-    vertex: Vertex,
-    /// The probability of having chosen the environment.
-    pmf: f32,
-    u: [f32; 2],
-    bits: u64,
-}
-
 /// A camera sample that starts a path.
 #[derive(Clone, Debug)]
 pub struct CameraSample {
@@ -131,8 +121,13 @@ pub struct Wavefront {
     shadows: Vec<Unshadowed>,
     shadow_rays: Vec<Ray>,
     blocked: Vec<bool>,
-    deferred: Vec<Deferred>,
-    env_samples: Vec<Option<LightSample>>,
+    /// The vertices whose environment-map light samples are left for the
+    /// batch's others, and the numbers of those draws (the cell sampler's
+    /// bits and the point's numbers).
+    deferred: Vec<Vertex>,
+    draws: Vec<(u64, [f32; 2])>,
+    env_samples: Vec<EnvSample<f32>>,
+    light_samples: Vec<Option<LightSample>>,
     stream: embree::Stream,
     /// The rays of the batch that left the scene.
     pub escaped: Escaped,
@@ -150,7 +145,7 @@ impl Wavefront {
         self.escaped.clear();
         alloc::reserve_each!(n, WHAT;
             self.paths, self.hits, self.surfaces, self.next, self.rays, self.shadows, self.shadow_rays,
-            self.blocked, self.deferred, self.env_samples)?;
+            self.blocked, self.deferred, self.draws, self.env_samples, self.light_samples)?;
         self.escaped.reserve(n)
     }
 
@@ -201,6 +196,7 @@ impl Wavefront {
             self.shadows.clear();
             self.shadow_rays.clear();
             self.deferred.clear();
+            self.draws.clear();
             // The surfaces first, in a loop of their own: the reads of
             // the hit primitives overlap.
             self.surfaces.clear();
@@ -220,7 +216,7 @@ impl Wavefront {
                     settings,
                     shadows: &mut self.shadows,
                     shadow_rays: &mut self.shadow_rays,
-                    deferred: &mut self.deferred,
+                    deferred: (&mut self.deferred, &mut self.draws),
                 };
                 let l = &mut l[path.slot as usize];
                 let goes_on = bounce.shade(&mut path, (hit.t, *surface), stream, l);
@@ -231,19 +227,16 @@ impl Wavefront {
                 }
             }
             // The deferred environment samples, together: their table reads
-            // and arithmetic overlap from one to the next.
-            if let Some(cells) = scene.environment_cells() {
-                self.env_samples.clear();
-                self.env_samples.extend(
-                    self.deferred
-                        .iter()
-                        .map(|d| scene.sample_environment(d.pmf, d.u, Some((cells, d.bits)))),
-                );
-                for (d, ls) in self.deferred.iter().zip(&self.env_samples) {
-                    if let Some(ls) = ls {
-                        d.vertex
-                            .connect(ls, settings, &mut self.shadows, &mut self.shadow_rays);
-                    }
+            // overlap, and their directions are computed at SIMD width.
+            self.light_samples.clear();
+            scene.sample_environment_cells(
+                &self.draws,
+                &mut self.env_samples,
+                &mut self.light_samples,
+            );
+            for (vertex, ls) in self.deferred.iter().zip(&self.light_samples) {
+                if let Some(ls) = ls {
+                    vertex.connect(ls, settings, &mut self.shadows, &mut self.shadow_rays);
                 }
             }
             self.blocked.clear();
@@ -298,7 +291,7 @@ struct Bounce<'a> {
     settings: &'a Settings,
     shadows: &'a mut Vec<Unshadowed>,
     shadow_rays: &'a mut Vec<Ray>,
-    deferred: &'a mut Vec<Deferred>,
+    deferred: (&'a mut Vec<Vertex>, &'a mut Vec<(u64, [f32; 2])>),
 }
 
 impl Vertex {
@@ -385,12 +378,10 @@ impl Bounce<'_> {
                 };
                 match bits {
                     // A map's cell: drawn with the batch's others.
-                    Some(bits) => self.deferred.push(Deferred {
-                        vertex,
-                        pmf: light.pmf(),
-                        u: [u1, u2],
-                        bits,
-                    }),
+                    Some(bits) => {
+                        self.deferred.0.push(vertex);
+                        self.deferred.1.push((bits, [u1, u2]));
+                    }
                     None => {
                         if let Some(ls) = scene.sample_chosen(light, sp.p, [u1, u2], None) {
                             vertex.connect(&ls, settings, self.shadows, self.shadow_rays);

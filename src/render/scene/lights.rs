@@ -5,7 +5,7 @@ use glam::Vec3A;
 
 use super::{Environment, Scene};
 use crate::distr::Discrete1D;
-use crate::envmap::CellSampler;
+use crate::envmap::{CellSampler, EnvSample};
 use crate::render::accel::Primitive;
 use crate::render::shape::{Ray, SurfacePoint};
 
@@ -28,12 +28,6 @@ pub struct ChosenLight<'a> {
 }
 
 impl ChosenLight<'_> {
-    /// The probability of the choice.
-    #[inline]
-    pub fn pmf(&self) -> f32 {
-        self.pmf
-    }
-
     /// The environment map's cell sampler, when the light is a map that
     /// has one: its draws take 64 random bits.
     #[inline]
@@ -288,13 +282,33 @@ impl Scene {
         cells: Option<(&CellSampler, u64)>,
     ) -> Option<LightSample> {
         let (d, pdf, radiance) = self.environment.as_ref()?.sample(u, cells);
-        (pdf > 0.0).then_some(LightSample {
-            d,
-            dist: f32::INFINITY,
-            pdf: pdf * pmf,
-            radiance,
-            point: None,
-        })
+        environment_sample(d, pdf, pmf, radiance)
+    }
+
+    /// [`Scene::sample_environment`] by the map's cell sampler
+    /// ([`Scene::environment_cells`]) of each `(bits, u)` of `draws`, the
+    /// same samples, drawn together ([`CellSampler::sample_many`]) and
+    /// appended to `out` (`scratch`: the map's samples); nothing without a
+    /// cell sampler.
+    pub fn sample_environment_cells(
+        &self,
+        draws: &[(u64, [f32; 2])],
+        scratch: &mut Vec<EnvSample<f32>>,
+        out: &mut Vec<Option<LightSample>>,
+    ) {
+        let (Some(Environment::Map(env)), Some(cells)) =
+            (&self.environment, self.environment_cells())
+        else {
+            return;
+        };
+        let pmf = self.choice_pmf(self.env_light);
+        scratch.clear();
+        cells.sample_many(env, draws, scratch);
+        out.extend(
+            scratch
+                .iter()
+                .map(|s| environment_sample(Vec3A::from(s.direction), s.pdf, pmf, s.radiance)),
+        );
     }
 
     /// The environment map's cell sampler, when the scene's environment
@@ -361,4 +375,18 @@ impl Scene {
             }
         }
     }
+}
+
+/// The light sample toward the environment along `d`, drawn with density
+/// `pdf` by the environment, chosen with probability `pmf`; `None` where
+/// `pdf` is 0.
+#[inline(always)]
+fn environment_sample(d: Vec3A, pdf: f32, pmf: f32, radiance: [f32; 3]) -> Option<LightSample> {
+    (pdf > 0.0).then_some(LightSample {
+        d,
+        dist: f32::INFINITY,
+        pdf: pdf * pmf,
+        radiance,
+        point: None,
+    })
 }
