@@ -148,11 +148,11 @@ pub struct Progress {
     pub cancel: AtomicBool,
 }
 
-/// Camera samples per batch: their paths are traced together
-/// ([`wavefront`]) and their escaped rays' environment light is looked up
-/// together ([`integrator::add_escaped`]). (From 128 to 1024 the 2·10^5-
-/// triangle mesh renders within 3 % of its best time; at 16384, 13 %
-/// slower.)
+/// Camera samples per batch (at least one pixel's), and paths traced
+/// together ([`wavefront`], in groups of at most this many, whose escaped
+/// rays' environment light is looked up together:
+/// [`integrator::add_escaped`]). (From 128 to 1024 the 2·10^5-triangle
+/// mesh renders within 3 % of its best time; at 16384, 13 % slower.)
 const BATCH: usize = 256;
 
 /// One thread's buffers for a batch of camera samples (reused from batch
@@ -213,7 +213,6 @@ impl Batch {
         const WHAT: &str = "a batch of samples";
         alloc::reserve_each!(n, WHAT;
             self.camera_u, self.weights, self.times, self.resume, self.rays, self.hits, self.radiance)?;
-        self.paths.start(n)?;
         let mut streams = alloc::with_capacity(pixels.len(), WHAT)?;
         for x in pixels {
             let pixel = (y * width + x) as u64;
@@ -275,28 +274,33 @@ impl Batch {
         }
         let spp = spp.max(1) as usize;
         self.radiance.resize(self.rays.len(), [0.0; 3]);
-        for (slot, (ray, hit)) in self.rays.iter().zip(&self.hits).enumerate() {
-            let pixel = slot / spp;
-            let index = samples.first + (slot % spp) as u64;
-            self.paths.push(
-                scene,
-                settings,
-                CameraSample {
-                    slot: slot as u32,
-                    pixel: pixel as u32,
-                    index: index as u32,
-                    ray: *ray,
-                    hit: *hit,
-                    time: time(slot),
-                    // The path goes on from where the sample's camera
-                    // draws left its numbers.
-                    rng: self.resume.get(slot).cloned(),
-                },
-            );
+        // The paths in groups of at most BATCH (a pixel's samples may be
+        // many more): the memory of the paths in flight stays bounded.
+        for first in (0..self.rays.len()).step_by(BATCH) {
+            let slots = first..(first + BATCH).min(self.rays.len());
+            self.paths.start(slots.len())?;
+            for slot in slots {
+                let index = samples.first + (slot % spp) as u64;
+                self.paths.push(
+                    scene,
+                    settings,
+                    CameraSample {
+                        slot: slot as u32,
+                        pixel: (slot / spp) as u32,
+                        index: index as u32,
+                        ray: self.rays[slot],
+                        hit: self.hits[slot],
+                        time: time(slot),
+                        // The path goes on from where the sample's camera
+                        // draws left its numbers.
+                        rng: self.resume.get(slot).cloned(),
+                    },
+                );
+            }
+            self.paths
+                .trace(scene, settings, &mut streams, &mut self.radiance)?;
+            integrator::add_escaped(scene, settings, &mut self.paths.escaped, &mut self.radiance);
         }
-        self.paths
-            .trace(scene, settings, &mut streams, &mut self.radiance)?;
-        integrator::add_escaped(scene, settings, &mut self.paths.escaped, &mut self.radiance);
         for (l, w) in self.radiance.iter_mut().zip(&self.weights) {
             *l = l.map(|v| v * w);
         }
