@@ -1,5 +1,6 @@
 //! [`CellSampler`]: draws from an environment map's luminance or piecewise
-//! density in O(1), for renderers that take one light sample at a time.
+//! density in O(1), for renderers' light samples (one at a time, or a
+//! bounce's together: [`CellSampler::sample_many`]).
 
 use super::distribution::Distribution;
 use super::{EnvMap, EnvSample};
@@ -21,8 +22,9 @@ use crate::simd;
 /// per steradian. The map from numbers to directions differs from
 /// [`EnvMap::sample`]'s inversion (no `sample_reuse`, no inverse): one
 /// draw costs a load of the cell and no search, which matters where draws
-/// come one at a time between other work (a renderer's next-event
-/// estimation), so that the searches' cache misses cannot overlap.
+/// come between other work (a renderer's next-event estimation), and the
+/// cache misses of a search's loads, each waiting on the last, could not
+/// overlap.
 #[derive(Clone, Debug)]
 pub struct CellSampler {
     cells: AliasTable,

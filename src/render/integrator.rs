@@ -267,6 +267,8 @@ impl Escaped {
         self.dir.clear();
         self.beta.clear();
         self.bsdf_pdf.clear();
+        self.radiance.clear();
+        self.light_pdf.clear();
     }
 
     /// Records a ray that left the scene with throughput `beta`; `bsdf_pdf`

@@ -22,17 +22,17 @@
 //! Samples are rendered in batches of about `BATCH` (whole pixels of one
 //! row): each pixel's film and lens positions are drawn first, the camera
 //! rays of the batch are made at SIMD width, the paths are traced together
-//! one bounce at a time ([`wavefront`]: every shadow ray and every next ray
-//! of the batch in one stream), and the light of every ray that left the
-//! scene is looked up for the whole batch at the end (vectorised, with the
-//! texel reads overlapping). The draws of a
-//! pixel thus come in a fixed order, whatever the batch size or thread.
+//! one bounce at a time, in groups of at most `BATCH` ([`wavefront`]: every
+//! shadow ray and every next ray of a group in one stream), and the light
+//! of every ray of a group that left the scene is looked up at its end
+//! (vectorised, with the texel reads overlapping). The draws of a pixel
+//! thus come in a fixed order, whatever the batch size or thread.
 //!
 //! Emitter sampling draws an environment map with the density of its own
 //! [`crate::envmap::EnvMap::pdf`], but by its
 //! [`crate::envmap::CellSampler`] (an alias table over the sampling table's
-//! cells, in `f32`): one draw at a time between other work, a search of the
-//! table's running sums would wait on each of its loads in turn.
+//! cells, in `f32`), all of a bounce's draws together: a cell costs one
+//! load and no search of the table's running sums.
 
 pub mod accel;
 pub mod bdpt;
@@ -186,8 +186,9 @@ impl Batch {
     /// The `spp` samples of each pixel `(x, y)`, `x` in `pixels`, into
     /// [`Batch::radiance`]: film and lens positions first (from the pixel's
     /// own stream, which then drives its paths), the camera rays of the
-    /// whole batch at SIMD width, the paths bounce by bounce, and last the
-    /// light of every ray that left the scene, looked up together.
+    /// whole batch at SIMD width, then the paths bounce by bounce in groups
+    /// of at most `BATCH`, each group's escaped rays' light looked up
+    /// together at its end.
     fn run(
         &mut self,
         scene: &Scene,

@@ -4,7 +4,10 @@
 //! ```text
 //! loop while paths remain:
 //!   shade   each path at its hit: emission, a light sample (its shadow
-//!           ray kept for later), a BSDF sample (the next ray), roulette
+//!           ray kept for later; an environment map's draw left for the
+//!           next step), a BSDF sample (the next ray), roulette
+//!   light   the environment-map light samples of the bounce, drawn
+//!           together (`CellSampler::sample_many`)
 //!   occlude every shadow ray of the batch, one stream; add the light of
 //!           those that reach it
 //!   trace   every next ray, one stream; rays that leave the scene go to
@@ -113,9 +116,12 @@ pub struct CameraSample {
 #[derive(Default)]
 pub struct Wavefront {
     paths: Vec<Path>,
-    hits: Vec<Option<Hit>>,
-    /// The shape and surface point of each hit.
-    surfaces: Vec<Option<(Hit, (u32, SurfacePoint))>>,
+    /// Where each path's ray meets the scene, and the shape and surface
+    /// point there.
+    hits: Vec<Hit>,
+    surfaces: Vec<(u32, SurfacePoint)>,
+    /// What the stream of next rays found.
+    found: Vec<Option<Hit>>,
     next: Vec<Path>,
     rays: Vec<Ray>,
     shadows: Vec<Unshadowed>,
@@ -134,18 +140,35 @@ pub struct Wavefront {
 }
 
 impl Wavefront {
-    /// Room for the paths of `n` camera samples, every ray forgotten.
+    /// Room for the paths of `n` camera samples, every path and ray of the
+    /// last batch forgotten.
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the memory cannot be had.
     pub fn start(&mut self, n: usize) -> Result<()> {
         const WHAT: &str = "a batch of paths";
-        self.paths.clear();
-        self.hits.clear();
+        macro_rules! clear_and_reserve {
+            ($($v:expr),*) => {{
+                $($v.clear();)*
+                alloc::reserve_each!(n, WHAT; $($v),*)
+            }};
+        }
+        clear_and_reserve!(
+            self.paths,
+            self.hits,
+            self.surfaces,
+            self.found,
+            self.next,
+            self.rays,
+            self.shadows,
+            self.shadow_rays,
+            self.blocked,
+            self.deferred,
+            self.draws,
+            self.env_samples,
+            self.light_samples
+        )?;
         self.escaped.clear();
-        alloc::reserve_each!(n, WHAT;
-            self.paths, self.hits, self.surfaces, self.next, self.rays, self.shadows, self.shadow_rays,
-            self.blocked, self.deferred, self.draws, self.env_samples, self.light_samples)?;
         self.escaped.reserve(n)
     }
 
@@ -172,7 +195,7 @@ impl Wavefront {
             time: c.time,
             rng: c.rng,
         });
-        self.hits.push(Some(hit));
+        self.hits.push(hit);
     }
 
     /// Traces every path pushed since [`Wavefront::start`] to its end,
@@ -200,14 +223,14 @@ impl Wavefront {
             // The surfaces first, in a loop of their own: the reads of
             // the hit primitives overlap.
             self.surfaces.clear();
-            self.surfaces
-                .extend(self.paths.iter().zip(&self.hits).map(|(path, hit)| {
-                    hit.map(|hit| (hit, scene.surface(&path.ray, &hit, path.time)))
-                }));
-            for (mut path, surface) in self.paths.drain(..).zip(&self.surfaces) {
-                let Some((hit, surface)) = surface else {
-                    continue;
-                };
+            self.surfaces.extend(
+                self.paths
+                    .iter()
+                    .zip(&self.hits)
+                    .map(|(path, hit)| scene.surface(&path.ray, hit, path.time)),
+            );
+            let shading_points = self.hits.iter().zip(&self.surfaces);
+            for (mut path, (hit, surface)) in self.paths.drain(..).zip(shading_points) {
                 let stream = &mut streams[path.pixel as usize];
                 stream.start(path.index);
                 swap_generators(stream, &mut path);
@@ -234,6 +257,7 @@ impl Wavefront {
                 &mut self.env_samples,
                 &mut self.light_samples,
             );
+            debug_assert_eq!(self.light_samples.len(), self.deferred.len());
             for (vertex, ls) in self.deferred.iter().zip(&self.light_samples) {
                 if let Some(ls) = ls {
                     vertex.connect(ls, settings, &mut self.shadows, &mut self.shadow_rays);
@@ -254,23 +278,26 @@ impl Wavefront {
                     add_scaled(&mut l[u.slot as usize], u.beta, u.fc, u.s);
                 }
             }
-            self.hits.clear();
+            self.found.clear();
             scene
                 .accel()
-                .intersect_many(&self.rays, false, &mut self.stream, &mut self.hits)?;
-            for (path, hit) in self.next.drain(..).zip(&mut self.hits) {
-                if scene.moves() {
-                    *hit = scene.intersect_movers(&path.ray, path.time, *hit);
-                }
-                if hit.is_some() {
+                .intersect_many(&self.rays, false, &mut self.stream, &mut self.found)?;
+            self.hits.clear();
+            for (path, &found) in self.next.drain(..).zip(&self.found) {
+                let hit = if scene.moves() {
+                    scene.intersect_movers(&path.ray, path.time, found)
+                } else {
+                    found
+                };
+                if let Some(hit) = hit {
                     self.paths.push(path);
+                    self.hits.push(hit);
                 } else if scene.environment().is_some() && settings.strategy != Strategy::Emitter {
                     let mis = settings.strategy == Strategy::Mis;
                     let pdf = mis.then_some(path.bsdf_pdf);
                     self.escaped.push(path.slot, path.ray.d, path.beta, pdf);
                 }
             }
-            self.hits.retain(Option::is_some);
         }
         Ok(())
     }
