@@ -58,26 +58,29 @@ impl Environment {
         cells: Option<(&CellSampler, u64)>,
     ) -> (Vec3A, f32, [f32; 3]) {
         match self {
-            Environment::Map(env) => {
-                let s = match cells {
-                    Some((cells, bits)) => cells.sample(env, bits, u),
-                    None => {
-                        let s = env.sample(u.map(f64::from)).cast::<f32>();
-                        // Radiance as weight · pdf in f32 rather than rounded
-                        // from f64, so that these renders keep their bits.
-                        EnvSample {
-                            radiance: s.weight.map(|w| w * s.pdf),
-                            ..s
-                        }
-                    }
-                };
-                (Vec3A::from(s.direction), s.pdf, s.radiance)
-            }
+            Environment::Map(env) => match cells {
+                Some((cells, bits)) => {
+                    let s = cells.sample(env, bits, u);
+                    (Vec3A::from(s.direction), s.pdf, s.radiance)
+                }
+                None => Self::of_inversion(env.sample(u.map(f64::from))),
+            },
             Environment::Constant(l) => {
                 let d = warp::square_to_uniform_sphere(u);
                 (Vec3A::from(d), self.pdf(Vec3A::Z), l.map(|v| v as f32))
             }
         }
+    }
+
+    /// [`Environment::sample`] of a map's sample `s` by inversion (in
+    /// `f64`): rounded to `f32`, its radiance as weight · pdf in `f32`
+    /// rather than rounded from `f64`, so that these renders keep their
+    /// bits.
+    #[inline]
+    pub(super) fn of_inversion(s: EnvSample) -> (Vec3A, f32, [f32; 3]) {
+        let s = s.cast::<f32>();
+        let radiance = s.weight.map(|w| w * s.pdf);
+        (Vec3A::from(s.direction), s.pdf, radiance)
     }
 
     /// `∫ Y(L(ω)) dω` over the sphere, by the midpoint rule on a 256 × 128

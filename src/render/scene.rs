@@ -22,7 +22,7 @@ use crate::phong::Phong;
 
 mod lights;
 use lights::{AreaLight, Light};
-pub use lights::{ChosenLight, Emission, LightSample};
+pub use lights::{ChosenLight, Emission, InvertedSamples, LightSample};
 
 /// A surface's BSDF: the Phong BRDF (a diffuse material is Phong with
 /// `ρs = 0`), reflecting on the front side only unless `two_sided`, as in

@@ -7,7 +7,8 @@
 //!           ray kept for later; an environment map's draw left for the
 //!           next step), a BSDF sample (the next ray), roulette
 //!   light   the environment-map light samples of the bounce, drawn
-//!           together (`CellSampler::sample_many`)
+//!           together (`CellSampler::sample_many`, or by inversion
+//!           `EnvMap::sample_into` for the other samplers)
 //!   occlude every shadow ray of the batch, one stream; add the light of
 //!           those that reach it
 //!   trace   every next ray, one stream; rays that leave the scene go to
@@ -32,7 +33,7 @@ use super::integrator::{
     Escaped, Integrator, Settings, Strategy, add_scaled, dims, emission_weight, mul, offset,
     shading, shadow_ray,
 };
-use super::scene::{LightSample, Scene};
+use super::scene::{InvertedSamples, LightSample, Scene};
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
 use crate::envmap::EnvSample;
@@ -128,11 +129,12 @@ pub struct Wavefront {
     shadow_rays: Vec<Ray>,
     blocked: Vec<bool>,
     /// The vertices whose environment-map light samples are left for the
-    /// batch's others, and the numbers of those draws (the cell sampler's
-    /// bits and the point's numbers).
-    deferred: Vec<Vertex>,
-    draws: Vec<(u64, [f32; 2])>,
+    /// batch's others, by the map's cell sampler (its bits and the point's
+    /// numbers) or by inversion (the numbers).
+    by_cells: Waiting<(u64, [f32; 2])>,
+    by_inversion: Waiting<[f64; 2]>,
     env_samples: Vec<EnvSample<f32>>,
+    inverted: InvertedSamples,
     light_samples: Vec<Option<LightSample>>,
     stream: embree::Stream,
     /// The rays of the batch that left the scene.
@@ -163,8 +165,10 @@ impl Wavefront {
             self.shadows,
             self.shadow_rays,
             self.blocked,
-            self.deferred,
-            self.draws,
+            self.by_cells.vertices,
+            self.by_cells.draws,
+            self.by_inversion.vertices,
+            self.by_inversion.draws,
             self.env_samples,
             self.light_samples
         )?;
@@ -218,8 +222,8 @@ impl Wavefront {
             self.rays.clear();
             self.shadows.clear();
             self.shadow_rays.clear();
-            self.deferred.clear();
-            self.draws.clear();
+            self.by_cells.clear();
+            self.by_inversion.clear();
             // The surfaces first, in a loop of their own: the reads of
             // the hit primitives overlap.
             self.surfaces.clear();
@@ -239,7 +243,8 @@ impl Wavefront {
                     settings,
                     shadows: &mut self.shadows,
                     shadow_rays: &mut self.shadow_rays,
-                    deferred: (&mut self.deferred, &mut self.draws),
+                    by_cells: &mut self.by_cells,
+                    by_inversion: &mut self.by_inversion,
                 };
                 let l = &mut l[path.slot as usize];
                 let goes_on = bounce.shade(&mut path, (hit.t, *surface), stream, l);
@@ -253,12 +258,18 @@ impl Wavefront {
             // overlap, and their directions are computed at SIMD width.
             self.light_samples.clear();
             scene.sample_environment_cells(
-                &self.draws,
+                &self.by_cells.draws,
                 &mut self.env_samples,
                 &mut self.light_samples,
             );
-            debug_assert_eq!(self.light_samples.len(), self.deferred.len());
-            for (vertex, ls) in self.deferred.iter().zip(&self.light_samples) {
+            scene.sample_environment_inverted(
+                &self.by_inversion.draws,
+                &mut self.inverted,
+                &mut self.light_samples,
+            );
+            let waiting = (self.by_cells.vertices.iter()).chain(&self.by_inversion.vertices);
+            debug_assert_eq!(self.light_samples.len(), waiting.clone().count());
+            for (vertex, ls) in waiting.zip(&self.light_samples) {
                 if let Some(ls) = ls {
                     vertex.connect(ls, settings, &mut self.shadows, &mut self.shadow_rays);
                 }
@@ -318,7 +329,37 @@ struct Bounce<'a> {
     settings: &'a Settings,
     shadows: &'a mut Vec<Unshadowed>,
     shadow_rays: &'a mut Vec<Ray>,
-    deferred: (&'a mut Vec<Vertex>, &'a mut Vec<(u64, [f32; 2])>),
+    by_cells: &'a mut Waiting<(u64, [f32; 2])>,
+    by_inversion: &'a mut Waiting<[f64; 2]>,
+}
+
+/// Vertices whose environment-map light samples wait for the bounce's
+/// others, with the numbers of each draw.
+#[derive(Debug)]
+struct Waiting<D> {
+    vertices: Vec<Vertex>,
+    draws: Vec<D>,
+}
+
+impl<D> Default for Waiting<D> {
+    fn default() -> Self {
+        Waiting {
+            vertices: Vec::new(),
+            draws: Vec::new(),
+        }
+    }
+}
+
+impl<D> Waiting<D> {
+    fn clear(&mut self) {
+        self.vertices.clear();
+        self.draws.clear();
+    }
+
+    fn push(&mut self, vertex: Vertex, draw: D) {
+        self.vertices.push(vertex);
+        self.draws.push(draw);
+    }
 }
 
 impl Vertex {
@@ -405,9 +446,11 @@ impl Bounce<'_> {
                 };
                 match bits {
                     // A map's cell: drawn with the batch's others.
-                    Some(bits) => {
-                        self.deferred.0.push(vertex);
-                        self.deferred.1.push((bits, [u1, u2]));
+                    Some(bits) => self.by_cells.push(vertex, (bits, [u1, u2])),
+                    // A map by inversion (the other samplers, or a map
+                    // without cells): likewise.
+                    None if light.is_environment() && scene.environment_map().is_some() => {
+                        self.by_inversion.push(vertex, [u1, u2].map(f64::from));
                     }
                     None => {
                         if let Some(ls) = scene.sample_chosen(light, sp.p, [u1, u2], None) {

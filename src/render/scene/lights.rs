@@ -5,7 +5,7 @@ use glam::Vec3A;
 
 use super::{Environment, Scene};
 use crate::distr::Discrete1D;
-use crate::envmap::{CellSampler, EnvSample};
+use crate::envmap::{CellSampler, EnvMap, EnvSample, EnvSamples};
 use crate::render::accel::Primitive;
 use crate::render::shape::{Ray, SurfacePoint};
 
@@ -28,6 +28,12 @@ pub struct ChosenLight<'a> {
 }
 
 impl ChosenLight<'_> {
+    /// Whether the light is the environment.
+    #[inline]
+    pub fn is_environment(&self) -> bool {
+        matches!(self.light, Light::Environment { .. })
+    }
+
     /// The environment map's cell sampler, when the light is a map that
     /// has one: its draws take 64 random bits.
     #[inline]
@@ -311,6 +317,57 @@ impl Scene {
         );
     }
 
+    /// [`Scene::sample_environment`] by inversion (no cells) of each `u` of
+    /// `us`, the same samples, drawn together ([`EnvMap::sample_into`], in
+    /// `f64` as one draw is) and appended to `out` (`scratch`: the map's
+    /// samples); nothing when the environment is not a map.
+    pub fn sample_environment_inverted(
+        &self,
+        us: &[[f64; 2]],
+        scratch: &mut InvertedSamples,
+        out: &mut Vec<Option<LightSample>>,
+    ) {
+        let Some(env) = self.environment_map() else {
+            return;
+        };
+        let pmf = self.choice_pmf(self.env_light);
+        let InvertedSamples {
+            direction,
+            pdf,
+            weight,
+        } = scratch;
+        for v in [&mut *direction, &mut *weight] {
+            v.clear();
+            v.resize(us.len(), [0.0; 3]);
+        }
+        pdf.clear();
+        pdf.resize(us.len(), 0.0);
+        let samples = EnvSamples {
+            direction,
+            pdf,
+            weight,
+        };
+        env.sample_into(us, samples);
+        out.extend((0..us.len()).map(|i| {
+            let s = EnvSample {
+                direction: direction[i],
+                pdf: pdf[i],
+                weight: weight[i],
+                radiance: [0.0; 3],
+            };
+            let (d, pdf, radiance) = Environment::of_inversion(s);
+            environment_sample(d, pdf, pmf, radiance)
+        }));
+    }
+
+    /// The environment map, when the scene's environment is one.
+    pub fn environment_map(&self) -> Option<&EnvMap> {
+        match &self.environment {
+            Some(Environment::Map(env)) => Some(env),
+            _ => None,
+        }
+    }
+
     /// The environment map's cell sampler, when the scene's environment
     /// is a map that has one.
     pub fn environment_cells(&self) -> Option<&CellSampler> {
@@ -389,4 +446,12 @@ fn environment_sample(d: Vec3A, pdf: f32, pmf: f32, radiance: [f32; 3]) -> Optio
         radiance,
         point: None,
     })
+}
+
+/// Scratch for [`Scene::sample_environment_inverted`]: the map's samples.
+#[derive(Debug, Default)]
+pub struct InvertedSamples {
+    direction: Vec<[f64; 3]>,
+    pdf: Vec<f64>,
+    weight: Vec<[f64; 3]>,
 }
