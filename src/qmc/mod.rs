@@ -19,7 +19,7 @@ pub use halton::{
 pub use patterns::{
     MAX_DIMENSIONS as PATTERN_MAX_DIMENSIONS, MAX_POINTS as PATTERN_MAX_POINTS, Pattern, Patterns,
 };
-pub use sobol::{Scramble, Sobol, owen, owen_reversed};
+pub use sobol::{Scramble, Sobol, owen, owen_reversed, owen_reversed_pair};
 
 use crate::error::{Error, Result};
 use crate::parallel::Outputs;

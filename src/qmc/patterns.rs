@@ -164,7 +164,14 @@ pub(crate) fn multi_jitter(s: u32, n: u32, p: u32) -> (f64, f64) {
 /// invertible on those low bits (xor, multiplication by odd constants,
 /// xor-shifts), applied again while the result is `≥ len` (cycle
 /// walking), then rotated by `seed`. `i < len`.
-pub(crate) fn permute(mut i: u32, len: u32, seed: u32) -> u32 {
+pub(crate) fn permute(i: u32, len: u32, seed: u32) -> u32 {
+    permute_rotated(i, len, seed, (u64::from(seed) % u64::from(len)) as u32)
+}
+
+/// [`permute`] given its rotation `seed mod len` (a caller that permutes
+/// many indices by one seed divides once).
+#[inline]
+pub(crate) fn permute_rotated(mut i: u32, len: u32, seed: u32, rotation: u32) -> u32 {
     let w = u32::MAX >> (len.max(2) - 1).leading_zeros();
     loop {
         i ^= seed;
@@ -186,7 +193,9 @@ pub(crate) fn permute(mut i: u32, len: u32, seed: u32) -> u32 {
         i &= w;
         i ^= i >> 5;
         if i < len {
-            return ((u64::from(i) + u64::from(seed)) % u64::from(len)) as u32;
+            // (i + seed) mod len, with i and the rotation below len.
+            let sum = u64::from(i) + u64::from(rotation);
+            return sum.checked_sub(u64::from(len)).unwrap_or(sum) as u32;
         }
     }
 }

@@ -36,8 +36,8 @@ pub mod zorder;
 
 use crate::error::{Error, Result};
 use crate::math::Real;
-use crate::qmc::patterns::{jitter, mix64, multi_jitter, permute, stratified};
-use crate::qmc::sobol::owen_reversed;
+use crate::qmc::patterns::{jitter, mix64, multi_jitter, permute, permute_rotated, stratified};
+use crate::qmc::sobol::{owen_reversed, owen_reversed_pair};
 use crate::rng::Rng;
 use zorder::ZOrder;
 
@@ -115,6 +115,9 @@ struct DimKey {
     /// ([`ZOrder::block`]); [`Sampler::Sobol`]: the seed of the index
     /// permutation.
     block: u64,
+    /// [`Sampler::Sobol`]: the rotation that ends the index permutation,
+    /// its seed modulo the stream's count.
+    rotation: u32,
 }
 
 /// The samples `0 .. count` of one pixel or one estimate.
@@ -205,12 +208,15 @@ impl Stream {
             DimKey {
                 seed,
                 block: self.zorder.block(seed),
+                rotation: 0,
             }
         } else {
             let seed = mix64(self.key ^ dim);
+            let block = mix64(seed);
             DimKey {
                 seed,
-                block: mix64(seed),
+                block,
+                rotation: (u64::from(block as u32) % u64::from(self.count)) as u32,
             }
         }
     }
@@ -271,10 +277,8 @@ impl Stream {
             Sampler::Sobol | Sampler::ZSobol => {
                 let (i, k) = self.sobol_index(dim);
                 let (x, y) = zorder::sobol01_reversed(i);
-                [
-                    F::from_random_bits(owen_reversed(x, k.seed as u32)),
-                    F::from_random_bits(owen_reversed(y, (k.seed >> 32) as u32)),
-                ]
+                let seeds = [k.seed as u32, (k.seed >> 32) as u32];
+                owen_reversed_pair([x, y], seeds).map(F::from_random_bits)
             }
         }
     }
@@ -288,7 +292,12 @@ impl Stream {
         let i = if self.sampler == Sampler::ZSobol {
             k.block | self.zorder.within(self.index, k.seed)
         } else {
-            u64::from(permute(self.index, self.count, k.block as u32))
+            u64::from(permute_rotated(
+                self.index,
+                self.count,
+                k.block as u32,
+                k.rotation,
+            ))
         };
         (i, k)
     }

@@ -37,27 +37,6 @@ const fn permutations() -> [[u8; 4]; 24] {
     out
 }
 
-/// Column `b` of the second Sobol' dimension's generator matrix (Pascal's
-/// triangle mod 2, `binom(b, r)` odd iff `r & !b = 0` by Lucas), for indices
-/// of up to 64 bits, bit-reversed: bit `r` of column `b` is row `r`.
-const PASCAL_REVERSED: [u32; 64] = pascal_reversed();
-
-const fn pascal_reversed() -> [u32; 64] {
-    let mut out = [0u32; 64];
-    let mut b = 0;
-    while b < 64 {
-        let mut r = 0;
-        while r < 32 {
-            if r & !b == 0 {
-                out[b] |= 1 << r;
-            }
-            r += 1;
-        }
-        b += 1;
-    }
-    out
-}
-
 /// The first Sobol' dimension (van der Corput's) of index `i`, as 32
 /// bits reversed (which are the index's low 32 bits).
 #[inline(always)]
@@ -67,15 +46,27 @@ pub fn sobol0_reversed(i: u64) -> u32 {
 
 /// The first two Sobol' dimensions of index `i` (natural order), as 32
 /// bits each, reversed.
+///
+/// The second dimension's generator matrix is Pascal's triangle mod 2:
+/// digit `r` of the value is the parity of the index bits `b` with
+/// `binom(b, r)` odd, which by Lucas is `r & !b = 0` (the positions `b`
+/// whose bits include those of `r`). That sum over supersets is six
+/// shift-and-xor steps, one per bit of a position, on the index itself.
 #[inline]
 pub fn sobol01_reversed(i: u64) -> (u32, u32) {
-    let mut y = 0;
-    let mut bits = i;
-    while bits != 0 {
-        y ^= PASCAL_REVERSED[bits.trailing_zeros() as usize];
-        bits &= bits - 1;
+    const LOW_HALVES: [u64; 6] = [
+        0x5555_5555_5555_5555,
+        0x3333_3333_3333_3333,
+        0x0f0f_0f0f_0f0f_0f0f,
+        0x00ff_00ff_00ff_00ff,
+        0x0000_ffff_0000_ffff,
+        0x0000_0000_ffff_ffff,
+    ];
+    let mut y = i;
+    for (k, mask) in LOW_HALVES.iter().enumerate() {
+        y ^= (y >> (1 << k)) & mask;
     }
-    (sobol0_reversed(i), y)
+    (sobol0_reversed(i), y as u32)
 }
 
 /// The z-order of one pixel's samples (the default: a single pixel).
@@ -198,9 +189,16 @@ mod tests {
     use crate::qmc::directions::columns;
 
     #[test]
-    fn pascal_is_the_second_sobol_dimension() {
+    fn the_second_dimension_is_pascals_triangle() {
+        // The map is linear over GF(2), so the unit indices settle it: the
+        // Joe–Kuo columns below bit 32, Lucas's rule above.
         let v = columns(2)[1].map(u32::reverse_bits);
-        assert_eq!(&PASCAL_REVERSED[..32], &v[..]);
+        for b in 0..64 {
+            let column = sobol01_reversed(1 << b).1;
+            let lucas = (0..32).filter(|r| r & !b == 0).fold(0, |c, r| c | 1 << r);
+            assert_eq!(column, v.get(b).copied().unwrap_or(lucas), "bit {b}");
+            assert_eq!(column, lucas, "bit {b}");
+        }
     }
 
     #[test]
