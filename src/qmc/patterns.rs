@@ -160,10 +160,9 @@ pub(crate) fn multi_jitter(s: u32, n: u32, p: u32) -> (f64, f64) {
 }
 
 /// Kensler's hashed permutation of `0 .. len` (2013): a bijection on the
-/// smallest power-of-two range holding `len`, built of steps each
-/// invertible on those low bits (xor, multiplication by odd constants,
-/// xor-shifts), applied again while the result is `≥ len` (cycle
-/// walking), then rotated by `seed`. `i < len`.
+/// smallest power-of-two range holding `len` ([`kensler_step`]), applied
+/// again while the result is `≥ len` (cycle walking), then rotated by
+/// `seed`. `i < len`.
 pub(crate) fn permute(i: u32, len: u32, seed: u32) -> u32 {
     permute_rotated(i, len, seed, (u64::from(seed) % u64::from(len)) as u32)
 }
@@ -171,33 +170,52 @@ pub(crate) fn permute(i: u32, len: u32, seed: u32) -> u32 {
 /// [`permute`] given its rotation `seed mod len` (a caller that permutes
 /// many indices by one seed divides once).
 #[inline]
-pub(crate) fn permute_rotated(mut i: u32, len: u32, seed: u32, rotation: u32) -> u32 {
-    let w = u32::MAX >> (len.max(2) - 1).leading_zeros();
-    loop {
-        i ^= seed;
-        i = i.wrapping_mul(0xe170_893d);
-        i ^= seed >> 16;
-        i ^= (i & w) >> 4;
-        i ^= seed >> 8;
-        i = i.wrapping_mul(0x0929_eb3f);
-        i ^= seed >> 23;
-        i ^= (i & w) >> 1;
-        i = i.wrapping_mul(1 | seed >> 27);
-        i = i.wrapping_mul(0x6935_fa69);
-        i ^= (i & w) >> 11;
-        i = i.wrapping_mul(0x74dc_b303);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0x9e50_1cc3);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0xc860_a3df);
-        i &= w;
-        i ^= i >> 5;
-        if i < len {
-            // (i + seed) mod len, with i and the rotation below len.
-            let sum = u64::from(i) + u64::from(rotation);
-            return sum.checked_sub(u64::from(len)).unwrap_or(sum) as u32;
-        }
+pub(crate) fn permute_rotated(i: u32, len: u32, seed: u32, rotation: u32) -> u32 {
+    rotate(walk(kensler_step(i, len, seed), len, seed), len, rotation)
+}
+
+/// The cycle walk of [`permute`]: [`kensler_step`] again while `i ≥ len`
+/// (never, when `len` is a power of two).
+#[inline(always)]
+pub(crate) fn walk(mut i: u32, len: u32, seed: u32) -> u32 {
+    while i >= len {
+        i = kensler_step(i, len, seed);
     }
+    i
+}
+
+/// `(i + rotation) mod len` for `i` and `rotation` below `len`.
+#[inline(always)]
+pub(crate) fn rotate(i: u32, len: u32, rotation: u32) -> u32 {
+    let sum = u64::from(i) + u64::from(rotation);
+    sum.checked_sub(u64::from(len)).unwrap_or(sum) as u32
+}
+
+/// One step of Kensler's permutation: a bijection of the bits of `i`
+/// below the smallest power of two holding `len`, built of steps each
+/// invertible on those bits (xor, multiplication by odd constants,
+/// xor-shifts). Branch-free, so that loops over it vectorise.
+#[inline(always)]
+pub(crate) fn kensler_step(mut i: u32, len: u32, seed: u32) -> u32 {
+    let w = u32::MAX >> (len.max(2) - 1).leading_zeros();
+    i ^= seed;
+    i = i.wrapping_mul(0xe170_893d);
+    i ^= seed >> 16;
+    i ^= (i & w) >> 4;
+    i ^= seed >> 8;
+    i = i.wrapping_mul(0x0929_eb3f);
+    i ^= seed >> 23;
+    i ^= (i & w) >> 1;
+    i = i.wrapping_mul(1 | seed >> 27);
+    i = i.wrapping_mul(0x6935_fa69);
+    i ^= (i & w) >> 11;
+    i = i.wrapping_mul(0x74dc_b303);
+    i ^= (i & w) >> 2;
+    i = i.wrapping_mul(0x9e50_1cc3);
+    i ^= (i & w) >> 2;
+    i = i.wrapping_mul(0xc860_a3df);
+    i &= w;
+    i ^ (i >> 5)
 }
 
 /// A uniform jitter in `[0, 1)` for index `i` and seed `p`: 32 bits of

@@ -26,7 +26,12 @@
 //! shadow ray and every next ray of a group in one stream), and the light
 //! of every ray of a group that left the scene is looked up at its end
 //! (vectorised, with the texel reads overlapping). The draws of a pixel
-//! thus come in a fixed order, whatever the batch size or thread.
+//! thus come in a fixed order, whatever the batch size or thread. The
+//! samplers other than the independent one give a value that depends only
+//! on the sample and the dimension, so the numbers the camera samples of a
+//! batch, and then each bounce of its paths, will ask for are drawn
+//! together beforehand at SIMD width ([`crate::sampler::batch`], the same
+//! bits as one at a time).
 //!
 //! Emitter sampling draws an environment map with the density of its own
 //! [`crate::envmap::EnvMap::pdf`], but by its
@@ -45,6 +50,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod mesh_file;
 pub mod motion;
+mod numbers;
 pub mod ptracer;
 pub mod scene;
 pub mod shape;
@@ -65,10 +71,12 @@ use crate::alloc;
 use crate::error::Result;
 use crate::parallel;
 use crate::rng::Rng;
+use crate::sampler::batch::{Drawn, Request};
 use crate::sampler::zorder::ZOrder;
 use crate::sampler::{Sampler, Stream};
 use accel::Hit;
 use film::{Block, Sums};
+use numbers::{Numbers, camera_requests};
 use shape::Ray;
 use wavefront::{CameraSample, Wavefront};
 
@@ -178,6 +186,11 @@ struct Batch {
     hits: Vec<Option<Hit>>,
     /// Embree's records of the camera rays.
     stream: embree::Stream,
+    /// The camera's numbers drawn beforehand (the samplers other than the
+    /// independent one): sample `j`'s requests and values are those from
+    /// `j · (1 + lens + time)` on.
+    requests: Vec<Request>,
+    drawn: Drawn,
     /// One pixel's sums per block at a time.
     block_sums: Vec<Sums>,
 }
@@ -214,25 +227,49 @@ impl Batch {
         const WHAT: &str = "a batch of samples";
         alloc::reserve_each!(n, WHAT;
             self.camera_u, self.weights, self.times, self.resume, self.rays, self.hits, self.radiance)?;
-        let mut streams = alloc::with_capacity(pixels.len(), WHAT)?;
-        for x in pixels {
+        let mut streams: Vec<Stream> = alloc::with_capacity(pixels.len(), WHAT)?;
+        for x in pixels.clone() {
             let pixel = (y * width + x) as u64;
             let key = mix(seed, pixel);
-            let mut stream = Stream::new(
+            streams.push(Stream::new(
                 settings.sampler,
                 key,
                 Rng::new(key, pixel),
                 samples.total,
                 ZOrder::new((x, y), (width, height), samples.total, seed),
-            );
-            // A pinhole ignores the lens: only the independent sampler,
-            // whose draws come in order, must draw it.
-            let lens_drawn = scene.camera().has_lens() || stream.independent().is_some();
+            ));
+        }
+        // A pinhole ignores the lens: only the independent sampler,
+        // whose draws come in order, must draw it. A still scene draws no
+        // time (likewise).
+        let independent = settings.sampler == Sampler::Independent;
+        let lens_drawn = scene.camera().has_lens() || independent;
+        // The other samplers' camera numbers, drawn together.
+        self.requests.clear();
+        let per_sample = 1 + usize::from(lens_drawn) + usize::from(moves);
+        if !independent {
+            alloc::reserve(&mut self.requests, n * per_sample, WHAT)?;
+            for (p, i) in (0..streams.len() as u32).flat_map(|p| (0..spp).map(move |i| (p, i))) {
+                let index = (samples.first + u64::from(i)) as u32;
+                camera_requests(p, index, (lens_drawn, moves), &mut self.requests);
+            }
+            self.drawn.draw(&mut streams, &self.requests)?;
+        }
+        for (p, (x, stream)) in pixels.zip(&mut streams).enumerate() {
+            let pixel = (y * width + x) as u64;
+            let key = mix(seed, pixel);
             for i in 0..u64::from(spp) {
-                start_sample(&mut stream, key, pixel, samples.first + i);
-                let film = stream.get2::<f32>(dims::FILM);
+                start_sample(stream, key, pixel, samples.first + i);
+                let first = (p * spp as usize + i as usize) * per_sample;
+                let drawn =
+                    first.min(self.requests.len())..(first + per_sample).min(self.requests.len());
+                let mut numbers = Numbers {
+                    stream,
+                    drawn: (&self.requests[drawn.clone()], &self.drawn.values[drawn]),
+                };
+                let film = numbers.get2(dims::FILM);
                 let lens = if lens_drawn {
-                    stream.get2(dims::LENS)
+                    numbers.get2(dims::LENS)
                 } else {
                     [0.5; 2]
                 };
@@ -242,16 +279,13 @@ impl Batch {
                 if filter.weighted() {
                     self.weights.push(weight);
                 }
-                // A still scene draws no time (the independent sampler
-                // keeps its order of draws).
                 if moves {
-                    self.times.push(stream.get1(dims::TIME));
+                    self.times.push(numbers.get1(dims::TIME));
                 }
-                if let Some(rng) = stream.independent() {
+                if let Some(rng) = numbers.independent() {
                     self.resume.push(rng.clone());
                 }
             }
-            streams.push(stream);
         }
         self.rays.resize(self.camera_u.len(), Ray::default());
         scene

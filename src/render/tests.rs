@@ -621,3 +621,67 @@ fn render_all(scene: &Scene, spp: u32, seed: u64, s: &Settings) -> super::Image 
     )
     .unwrap()
 }
+
+/// Each camera sample gets its own stream's film, lens and time numbers
+/// (drawn for the whole batch beforehand by the samplers other than the
+/// independent one), with a lens and a moving shape so that all three are
+/// drawn.
+#[test]
+fn camera_samples_draw_their_own_numbers() {
+    use super::{Batch, Samples, mix};
+    use crate::render::integrator::dims;
+    use crate::render::motion::Motion;
+    use glam::DAffine3;
+    let cam = Camera::new(
+        Affine3A::IDENTITY,
+        40.0,
+        FovAxis::X,
+        4,
+        4,
+        0.01,
+        100.0,
+        0.1,
+        3.0,
+    )
+    .unwrap();
+    let moved = DAffine3::from_translation(DVec3::new(0.0, 0.0, -1.0));
+    let moving = Shape {
+        geometry: cube(Affine3A::from_translation(Vec3::new(0.0, 0.0, -5.0))),
+        material: diffuse(0.5),
+        emission: None,
+        motion: Some(Motion::new("to_world", DAffine3::IDENTITY, moved).unwrap()),
+    };
+    let scene = Scene::new(vec![moving], None, cam, 4, 4).unwrap();
+    for &(_, sampler) in &Sampler::NAMES[1..] {
+        let settings = Settings {
+            sampler,
+            ..settings(Integrator::Direct, Strategy::Mis)
+        };
+        let samples = Samples {
+            first: 3,
+            count: 5,
+            total: 11,
+            keep_sums: false,
+        };
+        let (seed, y) = (7, 2);
+        let mut batch = Batch::default();
+        batch
+            .run(&scene, &settings, seed, samples, y, 1..4)
+            .unwrap();
+        for (j, (u, &time)) in batch.camera_u.iter().zip(&batch.times).enumerate() {
+            let x = 1 + j / 5;
+            let pixel = (y * 4 + x) as u64;
+            let key = mix(seed, pixel);
+            let zorder = ZOrder::new((x, y), (4, 4), 11, seed);
+            let mut s = Stream::new(sampler, key, Rng::new(key, pixel), 11, zorder);
+            s.start(3 + (j % 5) as u32);
+            let film = s.get2::<f32>(dims::FILM);
+            assert_eq!(u[2..], s.get2::<f32>(dims::LENS), "{sampler:?} {j}");
+            assert_eq!(time, s.get1::<f32>(dims::TIME), "{sampler:?} {j}");
+            let on_film = [u[0] * 4.0 - x as f32, u[1] * 4.0 - y as f32];
+            assert!((on_film[0] - film[0]).abs() < 1e-5, "{sampler:?} {j}");
+            assert!((on_film[1] - film[1]).abs() < 1e-5, "{sampler:?} {j}");
+        }
+        assert_eq!(batch.times.len(), 15);
+    }
+}

@@ -3,6 +3,8 @@
 //!
 //! ```text
 //! loop while paths remain:
+//!   numbers the numbers the shading below will ask for, drawn together
+//!           (samplers other than the independent one: `sampler::batch`)
 //!   shade   each path at its hit: emission, a light sample (its shadow
 //!           ray kept for later; an environment map's draw left for the
 //!           next step), a BSDF sample (the next ray), roulette
@@ -33,6 +35,7 @@ use super::integrator::{
     Escaped, Integrator, Settings, Strategy, add_scaled, dims, emission_weight, mul, offset,
     shading, shadow_ray,
 };
+use super::numbers::{Numbers, bounce_requests};
 use super::scene::{InvertedSamples, LightSample, Scene};
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
@@ -41,7 +44,8 @@ use crate::error::Result;
 use crate::frame::Frame;
 use crate::phong::PhongView;
 use crate::rng::Rng;
-use crate::sampler::Stream;
+use crate::sampler::batch::{Drawn, Request};
+use crate::sampler::{Sampler, Stream};
 
 /// A path between two bounces.
 #[derive(Clone, Debug)]
@@ -136,6 +140,12 @@ pub struct Wavefront {
     env_samples: Vec<EnvSample<f32>>,
     inverted: InvertedSamples,
     light_samples: Vec<Option<LightSample>>,
+    /// The numbers of the bounce drawn beforehand (the samplers other than
+    /// the independent one): the requests of path `k` are
+    /// `requests[first[k] .. first[k + 1]]`.
+    requests: Vec<Request>,
+    first: Vec<u32>,
+    drawn: Drawn,
     stream: embree::Stream,
     /// The rays of the batch that left the scene.
     pub escaped: Escaped,
@@ -172,6 +182,12 @@ impl Wavefront {
             self.env_samples,
             self.light_samples
         )?;
+        // The numbers of a bounce: at most the 5 requests of a vertex
+        // (`numbers::bounce_requests`) per path.
+        self.requests.clear();
+        alloc::reserve(&mut self.requests, 5 * n, WHAT)?;
+        self.first.clear();
+        alloc::reserve(&mut self.first, n + 1, WHAT)?;
         self.escaped.clear();
         self.escaped.reserve(n)
     }
@@ -233,11 +249,39 @@ impl Wavefront {
                     .zip(&self.hits)
                     .map(|(path, hit)| scene.surface(&path.ray, hit, path.time)),
             );
+            // The numbers the shading will ask for, drawn together.
+            self.requests.clear();
+            self.first.clear();
+            if streams
+                .first()
+                .is_some_and(|s| s.sampler() != Sampler::Independent)
+            {
+                for path in &self.paths {
+                    self.first.push(self.requests.len() as u32);
+                    bounce_requests(
+                        settings,
+                        (path.pixel, path.index, path.depth),
+                        &mut self.requests,
+                    );
+                }
+                self.first.push(self.requests.len() as u32);
+                self.drawn.draw(streams, &self.requests)?;
+            }
             let shading_points = self.hits.iter().zip(&self.surfaces);
-            for (mut path, (hit, surface)) in self.paths.drain(..).zip(shading_points) {
+            for (k, (mut path, (hit, surface))) in
+                self.paths.drain(..).zip(shading_points).enumerate()
+            {
                 let stream = &mut streams[path.pixel as usize];
                 stream.start(path.index);
                 swap_generators(stream, &mut path);
+                let drawn = match (self.first.get(k), self.first.get(k + 1)) {
+                    (Some(&a), Some(&b)) => a as usize..b as usize,
+                    _ => 0..0,
+                };
+                let mut numbers = Numbers {
+                    stream,
+                    drawn: (&self.requests[drawn.clone()], &self.drawn.values[drawn]),
+                };
                 let bounce = Bounce {
                     scene,
                     settings,
@@ -247,8 +291,8 @@ impl Wavefront {
                     by_inversion: &mut self.by_inversion,
                 };
                 let l = &mut l[path.slot as usize];
-                let goes_on = bounce.shade(&mut path, (hit.t, *surface), stream, l);
-                swap_generators(stream, &mut path);
+                let goes_on = bounce.shade(&mut path, (hit.t, *surface), &mut numbers, l);
+                swap_generators(numbers.stream, &mut path);
                 if goes_on {
                     self.rays.push(path.ray);
                     self.next.push(path);
@@ -404,7 +448,7 @@ impl Bounce<'_> {
         self,
         path: &mut Path,
         (t, (shape, sp)): (f32, (u32, SurfacePoint)),
-        stream: &mut Stream,
+        numbers: &mut Numbers,
         l: &mut [f32; 3],
     ) -> bool {
         let Bounce {
@@ -425,15 +469,15 @@ impl Bounce<'_> {
         let (frame, view) = shading(scene, shape, sp.ns, wi);
 
         if settings.strategy != Strategy::Bsdf {
-            let choice = stream.get1(dims::bounce(depth, dims::LIGHT_CHOICE));
-            let [u1, u2] = stream.get2(dims::bounce(depth, dims::LIGHT_POSITION));
+            let choice = numbers.get1(dims::bounce(depth, dims::LIGHT_CHOICE));
+            let [u1, u2] = numbers.get2(dims::bounce(depth, dims::LIGHT_POSITION));
             // The independent sampler picks environment cells from extra
             // random bits (an alias table); the others by inversion, which
             // keeps their stratification.
             if let Some(light) = scene.choose_light(choice) {
                 let bits = light
                     .cells()
-                    .and(stream.independent())
+                    .and(numbers.independent())
                     .map(|r| r.next_u64());
                 let vertex = Vertex {
                     slot: path.slot,
@@ -466,8 +510,8 @@ impl Bounce<'_> {
             }
         }
 
-        let component = stream.get1(dims::bounce(depth, dims::BSDF_COMPONENT));
-        let [u1, u2] = stream.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
+        let component = numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT));
+        let [u1, u2] = numbers.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
         let s = view.sample_one([component, u1, u2]);
         if s.weight.iter().all(|&v| v <= 0.0) {
             return false;
@@ -484,7 +528,7 @@ impl Bounce<'_> {
         path.depth += 1;
         if settings.integrator == Integrator::Path && path.depth >= settings.rr_depth {
             let q = path.beta.iter().copied().fold(0.0f32, f32::max).min(0.95);
-            if stream.get1::<f32>(dims::bounce(depth, dims::ROULETTE)) >= q {
+            if numbers.get1(dims::bounce(depth, dims::ROULETTE)) >= q {
                 return false;
             }
             path.beta = path.beta.map(|b| b / q);
@@ -494,131 +538,4 @@ impl Bounce<'_> {
 }
 
 #[cfg(test)]
-mod tests {
-    use glam::{Affine3A, Quat, Vec3};
-
-    use super::*;
-    use std::sync::Arc;
-
-    use crate::envmap::{EnvMap, Options};
-    use crate::render::geometry::Geometry;
-    use crate::render::integrator::add_escaped;
-    use crate::render::scene::{Environment, Shape};
-    use crate::render::tests::{camera, cube, diffuse, light, rectangle, settings};
-    use crate::sampler::Sampler;
-    use crate::sampler::zorder::ZOrder;
-
-    /// A floor, a box on it, a spherical light over it and a sky: a
-    /// constant one, or a map (whose cells are drawn by the batch).
-    fn scene(map: bool) -> Scene {
-        let still = |geometry, rho| Shape {
-            geometry,
-            material: diffuse(rho),
-            emission: None,
-            motion: None,
-        };
-        let turned = Affine3A::from_scale_rotation_translation(
-            Vec3::splat(0.5),
-            Quat::from_rotation_z(0.4),
-            Vec3::new(0.3, 0.0, 0.5),
-        );
-        let shapes = vec![
-            still(rectangle(Affine3A::from_scale(Vec3::splat(20.0))), 0.6),
-            still(cube(turned), 0.8),
-            light(Geometry::sphere([-0.5, 0.4, 1.6], 0.3, false).unwrap(), 6.0),
-        ];
-        let sky = if map {
-            let (w, h) = (16, 8);
-            let texels: Vec<f32> = (0..w * h * 3)
-                .map(|i| 0.2 + ((i * 7919) % 13) as f32 / 13.0)
-                .collect();
-            let env = EnvMap::new(w, h, &texels, Options::default()).unwrap();
-            Environment::Map(Arc::new(env))
-        } else {
-            Environment::Constant([0.4, 0.5, 0.7])
-        };
-        let sky = Some(sky);
-        Scene::new(shapes, sky, camera(), 4, 4).unwrap()
-    }
-
-    /// The light of camera samples `slots` (rays from one point in
-    /// scattered directions, some to the sky), traced as one batch.
-    fn trace(scene: &Scene, s: &Settings, slots: std::ops::Range<u32>) -> Vec<[f32; 3]> {
-        let count = 1 << 10;
-        let zorder = ZOrder::new((0, 0), (1, 1), count, 3);
-        let mut streams = [Stream::new(s.sampler, 3, Rng::new(3, 1), count, zorder)];
-        let mut paths = Wavefront::default();
-        paths.start(slots.len()).unwrap();
-        for (slot, index) in slots.clone().enumerate() {
-            let mut rng = Rng::new(11, u64::from(index));
-            let [a, b] = [rng.next_float::<f32>(), rng.next_float::<f32>()];
-            let ray = Ray {
-                o: Vec3A::new(0.0, -2.5, 2.0),
-                d: Vec3A::new(2.0 * a - 1.0, 1.0, 0.2 - b).normalize(),
-                tmax: f32::INFINITY,
-            };
-            let camera = CameraSample {
-                slot: slot as u32,
-                pixel: 0,
-                index,
-                ray,
-                hit: scene.intersect(&ray, 0.0),
-                time: 0.0,
-                rng: (s.sampler == Sampler::Independent).then_some(rng),
-            };
-            paths.push(scene, s, camera);
-        }
-        let mut l = vec![[0.0; 3]; slots.len()];
-        paths.trace(scene, s, &mut streams, &mut l).unwrap();
-        add_escaped(scene, s, &mut paths.escaped, &mut l);
-        l
-    }
-
-    /// A path traced in a batch of others gives, bit for bit, what it
-    /// gives traced alone: its numbers, its light samples and its rays stay
-    /// its own, for every integrator, strategy and sampler.
-    #[test]
-    fn a_path_in_a_batch_is_the_path_alone() {
-        let mut lit = 0;
-        for (map, integrator, strategy, sampler) in [
-            (false, Integrator::Path, Strategy::Mis, Sampler::Independent),
-            (false, Integrator::Path, Strategy::Emitter, Sampler::Sobol),
-            (
-                false,
-                Integrator::Path,
-                Strategy::Bsdf,
-                Sampler::Independent,
-            ),
-            (
-                false,
-                Integrator::Direct,
-                Strategy::Mis,
-                Sampler::Stratified,
-            ),
-            (true, Integrator::Path, Strategy::Mis, Sampler::Independent),
-            (
-                true,
-                Integrator::Path,
-                Strategy::Emitter,
-                Sampler::Independent,
-            ),
-            (true, Integrator::Direct, Strategy::Emitter, Sampler::Sobol),
-        ] {
-            let scene = scene(map);
-            let s = Settings {
-                rr_depth: 2,
-                sampler,
-                ..settings(integrator, strategy)
-            };
-            let batch = trace(&scene, &s, 0..200);
-            for (i, l) in batch.iter().enumerate() {
-                let i = i as u32;
-                let alone = trace(&scene, &s, i..i + 1);
-                assert_eq!(l.map(f32::to_bits), alone[0].map(f32::to_bits), "{s:?} {i}");
-            }
-            lit += batch.iter().filter(|l| l[0] > 0.0).count();
-        }
-        // Most samples see light (the sky, the light, lit surfaces).
-        assert!(lit > 1000, "{lit}");
-    }
-}
+mod tests;

@@ -32,6 +32,7 @@
 //! uniform point by point), so every estimator stays unbiased whatever the
 //! sampler.
 
+pub mod batch;
 pub mod zorder;
 
 use crate::error::{Error, Result};

@@ -195,3 +195,50 @@ fn dimensions_are_uncorrelated_within_a_pixel() {
         }
     }
 }
+
+#[test]
+fn a_batch_of_requests_is_the_requests_one_by_one() {
+    // Streams of different keys and pixels, counts a power of two or not
+    // (the permutation walks), dimensions cached and not, 1D and 2D.
+    for sampler in &ALL[1..] {
+        for count in [1u64, 7, 64, 100] {
+            let fresh = || -> Vec<Stream> {
+                (0..3)
+                    .map(|k| {
+                        let zorder = ZOrder::new((k, 5 - k), (8, 8), count, 11);
+                        Stream::new(*sampler, 40 + k as u64, Rng::new(1, 1), count, zorder)
+                    })
+                    .collect()
+            };
+            let requests: Vec<batch::Request> = (0..90u32)
+                .map(|k| batch::Request {
+                    stream: k % 3,
+                    index: (k * 7 + k / 3) % count as u32,
+                    dim: [0, 1, 5, 12, 31, 40][(k % 6) as usize],
+                    two: k % 4 != 1,
+                })
+                .collect();
+            let mut drawn = batch::Drawn::default();
+            let mut streams = fresh();
+            // Twice: the second time with every key cached.
+            for _ in 0..2 {
+                drawn.draw(&mut streams, &requests).unwrap();
+                let mut alone = fresh();
+                for (r, v) in requests.iter().zip(&drawn.values) {
+                    let s = &mut alone[r.stream as usize];
+                    s.start(r.index);
+                    let want = if r.two {
+                        s.get2(r.dim)
+                    } else {
+                        [s.get1(r.dim), v[1]]
+                    };
+                    assert_eq!(
+                        v.map(f32::to_bits),
+                        want.map(f32::to_bits),
+                        "{sampler:?} {count} {r:?}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,110 @@
+//! Where a sample's numbers come from. The independent sampler's are
+//! drawn as the camera and the shading ask for them (their order is their
+//! meaning). The other samplers' depend only on the sample and the
+//! dimension, so the requests a batch's camera samples, or a bounce of its
+//! paths, will make are drawn for the whole batch beforehand, at SIMD width
+//! ([`crate::sampler::batch`]), and then read.
+
+use super::integrator::{Integrator, Settings, Strategy, dims};
+use crate::rng::Rng;
+use crate::sampler::Stream;
+use crate::sampler::batch::Request;
+
+/// The numbers of one camera sample, or of one path's bounce.
+pub struct Numbers<'a> {
+    /// The pixel's stream, at the sample.
+    pub stream: &'a mut Stream,
+    /// The requests drawn for the sample beforehand, and their values.
+    pub drawn: (&'a [Request], &'a [[f32; 2]]),
+}
+
+impl Numbers<'_> {
+    /// Coordinate `dim` of the sample ([`Stream::get1`]).
+    #[inline]
+    pub fn get1(&mut self, dim: u32) -> f32 {
+        self.find(dim)
+            .map_or_else(|| self.stream.get1(dim), |v| v[0])
+    }
+
+    /// Coordinates `dim` and `dim + 1` ([`Stream::get2`]).
+    #[inline]
+    pub fn get2(&mut self, dim: u32) -> [f32; 2] {
+        self.find(dim).unwrap_or_else(|| self.stream.get2(dim))
+    }
+
+    /// [`Stream::independent`].
+    #[inline]
+    pub fn independent(&mut self) -> Option<&mut Rng> {
+        self.stream.independent()
+    }
+
+    /// The value drawn beforehand for `dim`, if it was (a request the
+    /// shading makes that [`bounce_requests`] did not foresee is asked of
+    /// the stream: slower, the same bits).
+    #[inline]
+    fn find(&self, dim: u32) -> Option<[f32; 2]> {
+        let (requests, values) = self.drawn;
+        let k = requests.iter().position(|r| r.dim == dim)?;
+        values.get(k).copied()
+    }
+}
+
+/// Pushes the requests the camera makes for sample `index` of the
+/// batch's pixel `pixel` (`Batch::run`, in its order) for a sampler other
+/// than the independent one: the film position, the lens position when
+/// the camera has a lens, the time when something moves.
+pub fn camera_requests(pixel: u32, index: u32, (lens, time): (bool, bool), out: &mut Vec<Request>) {
+    let mut push = |dim: u32, two: bool| {
+        out.push(Request {
+            stream: pixel,
+            index,
+            dim,
+            two,
+        });
+    };
+    push(dims::FILM, true);
+    if lens {
+        push(dims::LENS, true);
+    }
+    if time {
+        push(dims::TIME, false);
+    }
+}
+
+/// Pushes the requests the shading of the vertex at `depth` of a path of
+/// sample `index` of the batch's pixel `pixel` makes (`Bounce::shade` of
+/// [`super::wavefront`], in its order) for a sampler other than the
+/// independent one: none at the last vertex; the light's choice and
+/// position unless only the BSDF is sampled; the BSDF's component and
+/// direction unless emitter sampling stops there; Russian roulette from
+/// `rr_depth` on.
+pub fn bounce_requests(
+    settings: &Settings,
+    (pixel, index, depth): (u32, u32, u32),
+    out: &mut Vec<Request>,
+) {
+    let max_depth = settings.max_depth();
+    if depth + 1 >= max_depth {
+        return;
+    }
+    let mut push = |offset: u32, two: bool| {
+        out.push(Request {
+            stream: pixel,
+            index,
+            dim: dims::bounce(depth, offset),
+            two,
+        });
+    };
+    if settings.strategy != Strategy::Bsdf {
+        push(dims::LIGHT_CHOICE, false);
+        push(dims::LIGHT_POSITION, true);
+        if settings.strategy == Strategy::Emitter && depth + 2 >= max_depth {
+            return;
+        }
+    }
+    push(dims::BSDF_COMPONENT, false);
+    push(dims::BSDF_DIRECTION, true);
+    if settings.integrator == Integrator::Path && depth + 1 >= settings.rr_depth {
+        push(dims::ROULETTE, false);
+    }
+}

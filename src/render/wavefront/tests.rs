@@ -1,0 +1,126 @@
+use glam::{Affine3A, Quat, Vec3};
+
+use super::*;
+use std::sync::Arc;
+
+use crate::envmap::{EnvMap, Options};
+use crate::render::geometry::Geometry;
+use crate::render::integrator::add_escaped;
+use crate::render::scene::{Environment, Shape};
+use crate::render::tests::{camera, cube, diffuse, light, rectangle, settings};
+use crate::sampler::Sampler;
+use crate::sampler::zorder::ZOrder;
+
+/// A floor, a box on it, a spherical light over it and a sky: a
+/// constant one, or a map (whose cells are drawn by the batch).
+fn scene(map: bool) -> Scene {
+    let still = |geometry, rho| Shape {
+        geometry,
+        material: diffuse(rho),
+        emission: None,
+        motion: None,
+    };
+    let turned = Affine3A::from_scale_rotation_translation(
+        Vec3::splat(0.5),
+        Quat::from_rotation_z(0.4),
+        Vec3::new(0.3, 0.0, 0.5),
+    );
+    let shapes = vec![
+        still(rectangle(Affine3A::from_scale(Vec3::splat(20.0))), 0.6),
+        still(cube(turned), 0.8),
+        light(Geometry::sphere([-0.5, 0.4, 1.6], 0.3, false).unwrap(), 6.0),
+    ];
+    let sky = if map {
+        let (w, h) = (16, 8);
+        let texels: Vec<f32> = (0..w * h * 3)
+            .map(|i| 0.2 + ((i * 7919) % 13) as f32 / 13.0)
+            .collect();
+        let env = EnvMap::new(w, h, &texels, Options::default()).unwrap();
+        Environment::Map(Arc::new(env))
+    } else {
+        Environment::Constant([0.4, 0.5, 0.7])
+    };
+    let sky = Some(sky);
+    Scene::new(shapes, sky, camera(), 4, 4).unwrap()
+}
+
+/// The light of camera samples `slots` (rays from one point in
+/// scattered directions, some to the sky), traced as one batch.
+fn trace(scene: &Scene, s: &Settings, slots: std::ops::Range<u32>) -> Vec<[f32; 3]> {
+    let count = 1 << 10;
+    let zorder = ZOrder::new((0, 0), (1, 1), count, 3);
+    let mut streams = [Stream::new(s.sampler, 3, Rng::new(3, 1), count, zorder)];
+    let mut paths = Wavefront::default();
+    paths.start(slots.len()).unwrap();
+    for (slot, index) in slots.clone().enumerate() {
+        let mut rng = Rng::new(11, u64::from(index));
+        let [a, b] = [rng.next_float::<f32>(), rng.next_float::<f32>()];
+        let ray = Ray {
+            o: Vec3A::new(0.0, -2.5, 2.0),
+            d: Vec3A::new(2.0 * a - 1.0, 1.0, 0.2 - b).normalize(),
+            tmax: f32::INFINITY,
+        };
+        let camera = CameraSample {
+            slot: slot as u32,
+            pixel: 0,
+            index,
+            ray,
+            hit: scene.intersect(&ray, 0.0),
+            time: 0.0,
+            rng: (s.sampler == Sampler::Independent).then_some(rng),
+        };
+        paths.push(scene, s, camera);
+    }
+    let mut l = vec![[0.0; 3]; slots.len()];
+    paths.trace(scene, s, &mut streams, &mut l).unwrap();
+    add_escaped(scene, s, &mut paths.escaped, &mut l);
+    l
+}
+
+/// A path traced in a batch of others gives, bit for bit, what it
+/// gives traced alone: its numbers, its light samples and its rays stay
+/// its own, for every integrator, strategy and sampler.
+#[test]
+fn a_path_in_a_batch_is_the_path_alone() {
+    let mut lit = 0;
+    for (map, integrator, strategy, sampler) in [
+        (false, Integrator::Path, Strategy::Mis, Sampler::Independent),
+        (false, Integrator::Path, Strategy::Emitter, Sampler::Sobol),
+        (
+            false,
+            Integrator::Path,
+            Strategy::Bsdf,
+            Sampler::Independent,
+        ),
+        (
+            false,
+            Integrator::Direct,
+            Strategy::Mis,
+            Sampler::Stratified,
+        ),
+        (true, Integrator::Path, Strategy::Mis, Sampler::Independent),
+        (
+            true,
+            Integrator::Path,
+            Strategy::Emitter,
+            Sampler::Independent,
+        ),
+        (true, Integrator::Direct, Strategy::Emitter, Sampler::Sobol),
+    ] {
+        let scene = scene(map);
+        let s = Settings {
+            rr_depth: 2,
+            sampler,
+            ..settings(integrator, strategy)
+        };
+        let batch = trace(&scene, &s, 0..200);
+        for (i, l) in batch.iter().enumerate() {
+            let i = i as u32;
+            let alone = trace(&scene, &s, i..i + 1);
+            assert_eq!(l.map(f32::to_bits), alone[0].map(f32::to_bits), "{s:?} {i}");
+        }
+        lit += batch.iter().filter(|l| l[0] > 0.0).count();
+    }
+    // Most samples see light (the sky, the light, lit surfaces).
+    assert!(lit > 1000, "{lit}");
+}

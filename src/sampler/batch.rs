@@ -1,0 +1,148 @@
+//! Many requests of a batch of samples drawn together: what each would
+//! get from [`Stream::get1`] or [`Stream::get2`], bit for bit, at SIMD width
+//! for the Sobol' family.
+//!
+//! A request of [`Sampler::Sobol`] or [`Sampler::ZSobol`] is a chain of
+//! integer hashes (the index permutation or z-order shuffle, the second
+//! dimension's matrix, two Owen scrambles, a bit reversal) whose latency a
+//! scalar caller waits on between its other work. Here each stream first
+//! gives its cached key per request, then the hashes run over all the
+//! requests in loops the compiler vectorises ([`crate::simd::dispatch`]):
+//! the Kensler step of every [`Sampler::Sobol`] index, the cycle walk
+//! and rotation (no step at all when the count is a power of two), then
+//! the scrambled points. The other samplers' requests are drawn one by one.
+//!
+//! A 1D request of the Sobol' family is the first coordinate of the 2D
+//! request of the same dimension ([`Stream::get1`] scrambles the same first
+//! coordinate with the same seed), so every request is drawn as a pair.
+
+use super::{Sampler, Stream, zorder};
+use crate::alloc;
+use crate::error::Result;
+use crate::math::Real;
+use crate::qmc::patterns::{kensler_step, rotate, walk};
+use crate::qmc::sobol::owen_reversed_pair;
+use crate::simd::dispatch;
+
+/// One request: coordinate `dim` (and `dim + 1` when `two`) of sample
+/// `index` of the stream `stream` of a batch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Request {
+    /// Which of the batch's streams.
+    pub stream: u32,
+    /// The sample's index in its stream.
+    pub index: u32,
+    /// The (first) dimension.
+    pub dim: u32,
+    /// A 2D request ([`Stream::get2`]) rather than 1D ([`Stream::get1`]).
+    pub two: bool,
+}
+
+/// The values of a batch's requests, and the scratch they are drawn in
+/// (kept between batches, so drawing allocates only while the batches
+/// grow).
+#[derive(Clone, Debug, Default)]
+pub struct Drawn {
+    /// `values[k]`: request `k`'s coordinates (a 1D request's in `[0]`,
+    /// `[1]` then meaningless).
+    pub values: Vec<[f32; 2]>,
+    /// The Sobol' index of each request: the sample's index until the
+    /// permutation of [`Sampler::Sobol`] replaces it.
+    index: Vec<u64>,
+    /// The scrambles' seeds (low half the first coordinate's).
+    seed: Vec<u64>,
+    /// [`Sampler::Sobol`]: the permutation's seed, its rotation and the
+    /// stream's count.
+    permutation: Vec<[u32; 3]>,
+}
+
+impl Drawn {
+    /// Draws `requests` from `streams`: `values[k]` is what
+    /// `streams[s].start(index)` followed by `get1::<f32>(dim)` or
+    /// `get2::<f32>(dim)` gives. Not for [`Sampler::Independent`], whose
+    /// numbers depend on the order they are asked in (debug-checked; its
+    /// streams would be advanced).
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when the memory for the values cannot be
+    /// had.
+    ///
+    /// # Panics
+    /// When a request names a stream out of `streams`.
+    pub fn draw(&mut self, streams: &mut [Stream], requests: &[Request]) -> Result<()> {
+        const WHAT: &str = "a batch of sample numbers";
+        let n = requests.len();
+        self.values.clear();
+        alloc::reserve(&mut self.values, n, WHAT)?;
+        let Some(sampler) = streams.first().map(Stream::sampler) else {
+            return Ok(());
+        };
+        debug_assert!(sampler != Sampler::Independent);
+        if !matches!(sampler, Sampler::Sobol | Sampler::ZSobol) {
+            self.values.extend(requests.iter().map(|r| {
+                let stream = &mut streams[r.stream as usize];
+                stream.start(r.index);
+                if r.two {
+                    stream.get2(r.dim)
+                } else {
+                    [stream.get1(r.dim), 0.0]
+                }
+            }));
+            return Ok(());
+        }
+        let Drawn {
+            values,
+            index,
+            seed,
+            permutation,
+        } = self;
+        // Sized first, then written through slices (no length kept up to
+        // date per request).
+        for v in [&mut *index, &mut *seed] {
+            v.clear();
+            alloc::reserve(v, n, WHAT)?;
+            v.resize(n, 0);
+        }
+        permutation.clear();
+        if sampler == Sampler::Sobol {
+            alloc::reserve(permutation, n, WHAT)?;
+            permutation.resize(n, [0; 3]);
+        }
+        values.resize(n, [0.0; 2]);
+        let keyed = requests.iter().zip(index.iter_mut()).zip(seed.iter_mut());
+        if sampler == Sampler::ZSobol {
+            for ((r, i), s) in keyed {
+                let stream = &mut streams[r.stream as usize];
+                let key = stream.key(r.dim);
+                (*i, *s) = (
+                    key.block | stream.zorder.within(r.index, key.seed),
+                    key.seed,
+                );
+            }
+        } else {
+            for (((r, i), s), p) in keyed.zip(permutation.iter_mut()) {
+                let stream = &mut streams[r.stream as usize];
+                let key = stream.key(r.dim);
+                (*i, *s) = (u64::from(r.index), key.seed);
+                *p = [key.block as u32, key.rotation, stream.count];
+            }
+        }
+        dispatch(
+            #[inline(always)]
+            |_| {
+                for (i, &[seed, _, count]) in index.iter_mut().zip(&*permutation) {
+                    *i = u64::from(kensler_step(*i as u32, count, seed));
+                }
+                for (i, &[seed, rotation, count]) in index.iter_mut().zip(&*permutation) {
+                    *i = u64::from(rotate(walk(*i as u32, count, seed), count, rotation));
+                }
+                for ((v, &i), &seed) in values.iter_mut().zip(&*index).zip(&*seed) {
+                    let (x, y) = zorder::sobol01_reversed(i);
+                    let seeds = [seed as u32, (seed >> 32) as u32];
+                    *v = owen_reversed_pair([x, y], seeds).map(f32::from_random_bits);
+                }
+            },
+        );
+        Ok(())
+    }
+}
