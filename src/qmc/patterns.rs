@@ -83,98 +83,149 @@ impl Patterns {
         let n = check_range(out.len(), d, 0, MAX_POINTS)? as u32;
         let key = mix64(self.seed ^ mix64(draw));
         // One 32-bit seed per dimension (LHS) or pair (the others).
-        let seeds: Vec<u32> = (0..d as u64)
-            .map(|j| (mix64(key ^ j) >> 32) as u32)
+        let layouts: Vec<Layout> = (0..d as u64)
+            .map(|j| Layout::new(n, (mix64(key ^ j) >> 32) as u32))
             .collect();
         let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
         parallel::for_each_chunk(n as usize, Rows::new(out, d), |range, rows| {
             for (s, row) in (range.start as u32..).zip(rows.chunks_mut()) {
-                self.point(s, n, &seeds, row, unit);
+                self.point(s, &layouts, row, unit);
             }
             true
         })
         .map(|_| ())
     }
 
-    /// Point `s` of `n` into `row`.
-    fn point<F>(&self, s: u32, n: u32, seeds: &[u32], row: &mut [F], unit: impl Fn(f64) -> F) {
-        let n_f = f64::from(n);
-        // The last dimension of an odd count (and every LHS dimension):
-        // stratified in n intervals.
-        let single = |p: u32, centered: bool| {
-            let jitter = if centered { 0.5 } else { jitter(s, p) };
-            (f64::from(permute(s, n, p)) + jitter) / n_f
-        };
+    /// Point `s` into `row` (`layouts`: one per seed).
+    fn point<F>(&self, s: u32, layouts: &[Layout], row: &mut [F], unit: impl Fn(f64) -> F) {
         match self.pattern {
             Pattern::LatinHypercube { centered } => {
-                for (x, &p) in row.iter_mut().zip(seeds) {
-                    *x = unit(single(p, centered));
+                for (x, l) in row.iter_mut().zip(layouts) {
+                    *x = unit(l.single(s, centered));
                 }
             }
             Pattern::Stratified | Pattern::MultiJitter => {
                 let mut pairs = row.chunks_exact_mut(2);
-                for (pair, &p) in pairs.by_ref().zip(seeds) {
+                for (pair, l) in pairs.by_ref().zip(layouts) {
                     let (x, y) = if self.pattern == Pattern::Stratified {
-                        stratified(s, n, p)
+                        l.stratified(s)
                     } else {
-                        multi_jitter(s, n, p)
+                        l.multi_jitter(s)
                     };
                     pair[0] = unit(x);
                     pair[1] = unit(y);
                 }
                 if let [last] = pairs.into_remainder() {
-                    *last = unit(single(seeds[self.dims / 2], false));
+                    *last = unit(layouts[self.dims / 2].single(s, false));
                 }
             }
         }
     }
 }
 
-/// Point `s` of `n` in a shuffled `r × r` grid of strata, `r = ⌈√n⌉`.
-pub(crate) fn stratified(s: u32, n: u32, p: u32) -> (f64, f64) {
-    let r = (f64::from(n).sqrt().ceil() as u32).max(1);
-    let cell = permute(s, r * r, p);
-    let r_f = f64::from(r);
-    (
-        (f64::from(cell % r) + jitter(s, p ^ 0x68bc_21eb)) / r_f,
-        (f64::from(cell / r) + jitter(s, p ^ 0x02e5_be93)) / r_f,
-    )
+/// The permutations of a pattern of `n` points for one seed `p`, laid out
+/// once for all its points: the grids' sides (`r = ⌈√n⌉` of
+/// [`Pattern::Stratified`], `m = ⌊√n⌋` and `k = ⌈n/m⌉` of
+/// [`Pattern::MultiJitter`]) and the rotation (`seed mod length`) of each
+/// of Kensler's permutations its points draw.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Layout {
+    n: u32,
+    p: u32,
+    r: u32,
+    m: u32,
+    k: u32,
+    /// Of the permutations of `0 .. n` by `p`, of the `r²` strata by `p`,
+    /// and of [`Layout::multi_jitter`]'s three (of `0 .. n`, `0 .. m` and
+    /// `0 .. k`, by `p` times [`MULTI_JITTER`]'s first three constants).
+    rotations: [u32; 5],
 }
 
-/// Point `s` of `n` of Kensler's correlated multi-jittered pattern.
-pub(crate) fn multi_jitter(s: u32, n: u32, p: u32) -> (f64, f64) {
-    let m = (f64::from(n).sqrt() as u32).max(1);
-    let k = n.div_ceil(m);
-    let s = permute(s, n, p.wrapping_mul(0x5163_3e2d));
-    let sx = permute(s % m, m, p.wrapping_mul(0x68bc_21eb));
-    let sy = permute(s / m, k, p.wrapping_mul(0x02e5_be93));
-    let (jx, jy) = (
-        jitter(s, p.wrapping_mul(0x967a_889b)),
-        jitter(s, p.wrapping_mul(0x368c_c8b7)),
-    );
-    let (m, k, n) = (f64::from(m), f64::from(k), f64::from(n));
-    (
-        (f64::from(sx) + (f64::from(sy) + jx) / k) / m,
-        (f64::from(s) + jy) / n,
-    )
+/// The multipliers of the multi-jittered pattern's seed: for the
+/// permutations of the points, of the columns and of the rows, then for
+/// the two jitters.
+const MULTI_JITTER: [u32; 5] = [
+    0x5163_3e2d,
+    0x68bc_21eb,
+    0x02e5_be93,
+    0x967a_889b,
+    0x368c_c8b7,
+];
+
+impl Layout {
+    /// The layout of `n` points for seed `p`.
+    pub(crate) fn new(n: u32, p: u32) -> Self {
+        let r = (f64::from(n).sqrt().ceil() as u32).max(1);
+        let m = (f64::from(n).sqrt() as u32).max(1);
+        let k = n.div_ceil(m);
+        let rotation = |seed: u32, len: u32| seed % len.max(1);
+        let c = MULTI_JITTER;
+        Layout {
+            n,
+            p,
+            r,
+            m,
+            k,
+            rotations: [
+                rotation(p, n),
+                rotation(p, r * r),
+                rotation(p.wrapping_mul(c[0]), n),
+                rotation(p.wrapping_mul(c[1]), m),
+                rotation(p.wrapping_mul(c[2]), k),
+            ],
+        }
+    }
+
+    /// Point `s` stratified in `n` intervals: `(π(s) + ξ)/n` (`ξ = 1/2`
+    /// when `centered`).
+    #[inline]
+    pub(crate) fn single(&self, s: u32, centered: bool) -> f64 {
+        let (n, p) = (self.n, self.p);
+        let jitter = if centered { 0.5 } else { jitter(s, p) };
+        (f64::from(permute_rotated(s, n, p, self.rotations[0])) + jitter) / f64::from(n)
+    }
+
+    /// Point `s` of the shuffled `r × r` grid of strata.
+    #[inline]
+    pub(crate) fn stratified(&self, s: u32) -> (f64, f64) {
+        let (r, p) = (self.r, self.p);
+        let cell = permute_rotated(s, r * r, p, self.rotations[1]);
+        let r_f = f64::from(r);
+        (
+            (f64::from(cell % r) + jitter(s, p ^ 0x68bc_21eb)) / r_f,
+            (f64::from(cell / r) + jitter(s, p ^ 0x02e5_be93)) / r_f,
+        )
+    }
+
+    /// Point `s` of Kensler's correlated multi-jittered pattern.
+    #[inline]
+    pub(crate) fn multi_jitter(&self, s: u32) -> (f64, f64) {
+        let (n, m, k) = (self.n, self.m, self.k);
+        let [c0, c1, c2, c3, c4] = MULTI_JITTER.map(|c| self.p.wrapping_mul(c));
+        let [_, _, r0, r1, r2] = self.rotations;
+        let s = permute_rotated(s, n, c0, r0);
+        let sx = permute_rotated(s % m, m, c1, r1);
+        let sy = permute_rotated(s / m, k, c2, r2);
+        let (jx, jy) = (jitter(s, c3), jitter(s, c4));
+        let (m, k, n) = (f64::from(m), f64::from(k), f64::from(n));
+        (
+            (f64::from(sx) + (f64::from(sy) + jx) / k) / m,
+            (f64::from(s) + jy) / n,
+        )
+    }
 }
 
 /// Kensler's hashed permutation of `0 .. len` (2013): a bijection on the
 /// smallest power-of-two range holding `len` ([`kensler_step`]), applied
 /// again while the result is `≥ len` (cycle walking), then rotated by
-/// `seed`. `i < len`.
-pub(crate) fn permute(i: u32, len: u32, seed: u32) -> u32 {
-    permute_rotated(i, len, seed, (u64::from(seed) % u64::from(len)) as u32)
-}
-
-/// [`permute`] given its rotation `seed mod len` (a caller that permutes
-/// many indices by one seed divides once).
+/// `seed` (`rotation = seed mod len`, which a caller that permutes many
+/// indices by one seed computes once). `i < len`.
 #[inline]
 pub(crate) fn permute_rotated(i: u32, len: u32, seed: u32, rotation: u32) -> u32 {
     rotate(walk(kensler_step(i, len, seed), len, seed), len, rotation)
 }
 
-/// The cycle walk of [`permute`]: [`kensler_step`] again while `i ≥ len`
+/// The cycle walk of [`permute_rotated`]: [`kensler_step`] again while `i ≥ len`
 /// (never, when `len` is a power of two).
 #[inline(always)]
 pub(crate) fn walk(mut i: u32, len: u32, seed: u32) -> u32 {
@@ -251,7 +302,7 @@ mod tests {
             for seed in [0, 1, 0xdead_beef] {
                 let mut seen = vec![false; len as usize];
                 for i in 0..len {
-                    let j = permute(i, len, seed) as usize;
+                    let j = permute_rotated(i, len, seed, seed % len) as usize;
                     assert!(!seen[j], "len {len} seed {seed}");
                     seen[j] = true;
                 }

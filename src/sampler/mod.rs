@@ -37,7 +37,7 @@ pub mod zorder;
 
 use crate::error::{Error, Result};
 use crate::math::Real;
-use crate::qmc::patterns::{jitter, mix64, multi_jitter, permute, permute_rotated, stratified};
+use crate::qmc::patterns::{Layout, mix64, permute_rotated};
 use crate::qmc::sobol::{owen_reversed, owen_reversed_pair};
 use crate::rng::Rng;
 use zorder::ZOrder;
@@ -119,6 +119,9 @@ struct DimKey {
     /// [`Sampler::Sobol`]: the rotation that ends the index permutation,
     /// its seed modulo the stream's count.
     rotation: u32,
+    /// [`Sampler::Stratified`] and [`Sampler::MultiJitter`]: the
+    /// dimension's pattern, its permutations laid out.
+    layout: Layout,
 }
 
 /// The samples `0 .. count` of one pixel or one estimate.
@@ -209,15 +212,21 @@ impl Stream {
             DimKey {
                 seed,
                 block: self.zorder.block(seed),
-                rotation: 0,
+                ..DimKey::default()
             }
         } else {
             let seed = mix64(self.key ^ dim);
             let block = mix64(seed);
+            let patterned = matches!(self.sampler, Sampler::Stratified | Sampler::MultiJitter);
             DimKey {
                 seed,
                 block,
                 rotation: (u64::from(block as u32) % u64::from(self.count)) as u32,
+                layout: if patterned {
+                    Layout::new(self.count, (seed >> 32) as u32)
+                } else {
+                    Layout::default()
+                },
             }
         }
     }
@@ -245,13 +254,11 @@ impl Stream {
 
     /// [`Stream::get1`] of the samplers other than the independent one.
     fn stratified1<F: Real>(&mut self, dim: u32) -> F {
-        let (s, n) = (self.index, self.count);
         let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
         match self.sampler {
             Sampler::Independent => self.rng.next_float(),
             Sampler::Stratified | Sampler::MultiJitter => {
-                let p = (self.key(dim).seed >> 32) as u32;
-                unit((f64::from(permute(s, n, p)) + jitter(s, p)) / f64::from(n))
+                unit(self.key(dim).layout.single(self.index, false))
             }
             Sampler::Sobol | Sampler::ZSobol => {
                 let (i, k) = self.sobol_index(dim);
@@ -262,16 +269,15 @@ impl Stream {
 
     /// [`Stream::get2`] of the samplers other than the independent one.
     fn stratified2<F: Real>(&mut self, dim: u32) -> [F; 2] {
-        let (s, n) = (self.index, self.count);
         let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
         match self.sampler {
             Sampler::Independent => [self.rng.next_float(), self.rng.next_float()],
             Sampler::Stratified | Sampler::MultiJitter => {
-                let p = (self.key(dim).seed >> 32) as u32;
+                let (s, layout) = (self.index, self.key(dim).layout);
                 let (x, y) = if self.sampler == Sampler::Stratified {
-                    stratified(s, n, p)
+                    layout.stratified(s)
                 } else {
-                    multi_jitter(s, n, p)
+                    layout.multi_jitter(s)
                 };
                 [unit(x), unit(y)]
             }
