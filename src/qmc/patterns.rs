@@ -84,7 +84,7 @@ impl Patterns {
         let key = mix64(self.seed ^ mix64(draw));
         // One 32-bit seed per dimension (LHS) or pair (the others).
         let layouts: Vec<Layout> = (0..d as u64)
-            .map(|j| Layout::new(n, (mix64(key ^ j) >> 32) as u32))
+            .map(|j| Layout::new(n, (mix64(key ^ j) >> 32) as u32, self.pattern))
             .collect();
         let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
         parallel::for_each_chunk(n as usize, Rows::new(out, d), |range, rows| {
@@ -153,27 +153,35 @@ const MULTI_JITTER: [u32; 5] = [
 ];
 
 impl Layout {
-    /// The layout of `n` points for seed `p`.
-    pub(crate) fn new(n: u32, p: u32) -> Self {
-        let r = (f64::from(n).sqrt().ceil() as u32).max(1);
-        let m = (f64::from(n).sqrt() as u32).max(1);
-        let k = n.div_ceil(m);
+    /// The layout of `n` points for seed `p`, for [`Layout::single`] and,
+    /// when `pairs` is a stratified pattern, for its points (the rotations
+    /// of the other pattern left 0: its points would not be stratified).
+    pub(crate) fn new(n: u32, p: u32, pairs: Pattern) -> Self {
         let rotation = |seed: u32, len: u32| seed % len.max(1);
-        let c = MULTI_JITTER;
-        Layout {
+        let mut layout = Layout {
             n,
             p,
-            r,
-            m,
-            k,
-            rotations: [
-                rotation(p, n),
-                rotation(p, r * r),
-                rotation(p.wrapping_mul(c[0]), n),
-                rotation(p.wrapping_mul(c[1]), m),
-                rotation(p.wrapping_mul(c[2]), k),
-            ],
+            rotations: [rotation(p, n), 0, 0, 0, 0],
+            ..Layout::default()
+        };
+        let c = MULTI_JITTER;
+        match pairs {
+            Pattern::LatinHypercube { .. } => {}
+            Pattern::Stratified => {
+                let r = (f64::from(n).sqrt().ceil() as u32).max(1);
+                layout.r = r;
+                layout.rotations[1] = rotation(p, r * r);
+            }
+            Pattern::MultiJitter => {
+                let m = (f64::from(n).sqrt() as u32).max(1);
+                let k = n.div_ceil(m);
+                (layout.m, layout.k) = (m, k);
+                layout.rotations[2] = rotation(p.wrapping_mul(c[0]), n);
+                layout.rotations[3] = rotation(p.wrapping_mul(c[1]), m);
+                layout.rotations[4] = rotation(p.wrapping_mul(c[2]), k);
+            }
         }
+        layout
     }
 
     /// Point `s` stratified in `n` intervals: `(π(s) + ξ)/n` (`ξ = 1/2`
@@ -226,7 +234,7 @@ pub(crate) fn permute_rotated(i: u32, len: u32, seed: u32, rotation: u32) -> u32
 }
 
 /// The cycle walk of [`permute_rotated`]: [`kensler_step`] again while `i ≥ len`
-/// (never, when `len` is a power of two).
+/// (never when `len` is a power of two above 1).
 #[inline(always)]
 pub(crate) fn walk(mut i: u32, len: u32, seed: u32) -> u32 {
     while i >= len {

@@ -261,12 +261,8 @@ impl Batch {
             for i in 0..u64::from(spp) {
                 start_sample(stream, key, pixel, samples.first + i);
                 let first = (p * spp as usize + i as usize) * per_sample;
-                let drawn =
-                    first.min(self.requests.len())..(first + per_sample).min(self.requests.len());
-                let mut numbers = Numbers {
-                    stream,
-                    drawn: (&self.requests[drawn.clone()], &self.drawn.values[drawn]),
-                };
+                let drawn = (&self.requests[..], &self.drawn.values[..]);
+                let mut numbers = Numbers::new(stream, drawn, first..first + per_sample);
                 let film = numbers.get2(dims::FILM);
                 let lens = if lens_drawn {
                     numbers.get2(dims::LENS)

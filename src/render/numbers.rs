@@ -15,21 +15,37 @@ pub struct Numbers<'a> {
     /// The pixel's stream, at the sample.
     pub stream: &'a mut Stream,
     /// The requests drawn for the sample beforehand, and their values.
-    pub drawn: (&'a [Request], &'a [[f32; 2]]),
+    drawn: (&'a [Request], &'a [[f32; 2]]),
 }
 
-impl Numbers<'_> {
+impl<'a> Numbers<'a> {
+    /// The numbers of a sample of `stream` whose requests, among the
+    /// batch's `drawn` (requests and their values), are those of `range`
+    /// (none when out of bounds: then all are asked of the stream).
+    pub fn new(
+        stream: &'a mut Stream,
+        (requests, values): (&'a [Request], &'a [[f32; 2]]),
+        range: std::ops::Range<usize>,
+    ) -> Self {
+        let mine = requests.get(range.clone()).zip(values.get(range));
+        Numbers {
+            stream,
+            drawn: mine.unwrap_or((&[], &[])),
+        }
+    }
+
     /// Coordinate `dim` of the sample ([`Stream::get1`]).
     #[inline]
     pub fn get1(&mut self, dim: u32) -> f32 {
-        self.find(dim)
+        self.find(dim, false)
             .map_or_else(|| self.stream.get1(dim), |v| v[0])
     }
 
     /// Coordinates `dim` and `dim + 1` ([`Stream::get2`]).
     #[inline]
     pub fn get2(&mut self, dim: u32) -> [f32; 2] {
-        self.find(dim).unwrap_or_else(|| self.stream.get2(dim))
+        self.find(dim, true)
+            .unwrap_or_else(|| self.stream.get2(dim))
     }
 
     /// [`Stream::independent`].
@@ -38,14 +54,19 @@ impl Numbers<'_> {
         self.stream.independent()
     }
 
-    /// The value drawn beforehand for `dim`, if it was (a request the
-    /// shading makes that [`bounce_requests`] did not foresee is asked of
-    /// the stream: slower, the same bits).
+    /// The value drawn beforehand for the 1D or 2D (`two`) request of
+    /// `dim`, if it was. A request that [`camera_requests`] or
+    /// [`bounce_requests`] did not foresee is asked of the stream: the same
+    /// bits, only slower; debug builds check that none is missed.
     #[inline]
-    fn find(&self, dim: u32) -> Option<[f32; 2]> {
+    fn find(&self, dim: u32, two: bool) -> Option<[f32; 2]> {
         let (requests, values) = self.drawn;
-        let k = requests.iter().position(|r| r.dim == dim)?;
-        values.get(k).copied()
+        let found = requests.iter().position(|r| r.dim == dim && r.two == two);
+        debug_assert!(
+            requests.is_empty() || found.is_some(),
+            "dimension {dim} not drawn"
+        );
+        values.get(found?).copied()
     }
 }
 
@@ -77,7 +98,7 @@ pub fn camera_requests(pixel: u32, index: u32, (lens, time): (bool, bool), out: 
 /// independent one: none at the last vertex; the light's choice and
 /// position unless only the BSDF is sampled; the BSDF's component and
 /// direction unless emitter sampling stops there; Russian roulette from
-/// `rr_depth` on.
+/// `rr_depth` on (path integrator).
 pub fn bounce_requests(
     settings: &Settings,
     (pixel, index, depth): (u32, u32, u32),

@@ -274,14 +274,12 @@ impl Wavefront {
                 let stream = &mut streams[path.pixel as usize];
                 stream.start(path.index);
                 swap_generators(stream, &mut path);
-                let drawn = match (self.first.get(k), self.first.get(k + 1)) {
+                let mine = match (self.first.get(k), self.first.get(k + 1)) {
                     (Some(&a), Some(&b)) => a as usize..b as usize,
                     _ => 0..0,
                 };
-                let mut numbers = Numbers {
-                    stream,
-                    drawn: (&self.requests[drawn.clone()], &self.drawn.values[drawn]),
-                };
+                let drawn = (&self.requests[..], &self.drawn.values[..]);
+                let mut numbers = Numbers::new(stream, drawn, mine);
                 let bounce = Bounce {
                     scene,
                     settings,

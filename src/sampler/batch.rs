@@ -9,7 +9,7 @@
 //! gives its cached key per request, then the hashes run over all the
 //! requests in loops the compiler vectorises ([`crate::simd::dispatch`]):
 //! the Kensler step of every [`Sampler::Sobol`] index, the cycle walk
-//! and rotation (no step at all when the count is a power of two), then
+//! and rotation (no step when the count is a power of two above 1), then
 //! the scrambled points. The other samplers' requests are drawn one by one.
 //!
 //! A 1D request of the Sobol' family is the first coordinate of the 2D
@@ -59,9 +59,10 @@ pub struct Drawn {
 impl Drawn {
     /// Draws `requests` from `streams`: `values[k]` is what
     /// `streams[s].start(index)` followed by `get1::<f32>(dim)` or
-    /// `get2::<f32>(dim)` gives. Not for [`Sampler::Independent`], whose
-    /// numbers depend on the order they are asked in (debug-checked; its
-    /// streams would be advanced).
+    /// `get2::<f32>(dim)` gives. Nothing is drawn for
+    /// [`Sampler::Independent`], whose numbers depend on the order they
+    /// are asked in. The stratified samplers' streams are left at the last
+    /// request's sample ([`Stream::start`] them again before asking).
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the memory for the values cannot be
@@ -77,7 +78,9 @@ impl Drawn {
         let Some(sampler) = streams.first().map(Stream::sampler) else {
             return Ok(());
         };
-        debug_assert!(sampler != Sampler::Independent);
+        if sampler == Sampler::Independent {
+            return Ok(());
+        }
         if !matches!(sampler, Sampler::Sobol | Sampler::ZSobol) {
             self.values.extend(requests.iter().map(|r| {
                 let stream = &mut streams[r.stream as usize];
@@ -124,7 +127,8 @@ impl Drawn {
                 let stream = &mut streams[r.stream as usize];
                 let key = stream.key(r.dim);
                 (*i, *s) = (u64::from(r.index), key.seed);
-                *p = [key.block as u32, key.rotation, stream.count];
+                let (seed, rotation) = key.permutation();
+                *p = [seed, rotation, stream.count];
             }
         }
         dispatch(

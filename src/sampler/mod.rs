@@ -37,7 +37,7 @@ pub mod zorder;
 
 use crate::error::{Error, Result};
 use crate::math::Real;
-use crate::qmc::patterns::{Layout, mix64, permute_rotated};
+use crate::qmc::patterns::{Layout, Pattern, mix64, permute_rotated};
 use crate::qmc::sobol::{owen_reversed, owen_reversed_pair};
 use crate::rng::Rng;
 use zorder::ZOrder;
@@ -107,21 +107,29 @@ impl Sampler {
 /// lighting sample uses 12, each bounce of a path 7 more).
 const CACHED: usize = 32;
 
+/// Samples a stream must have for its patterns' layouts to be kept (a
+/// layout costs a few divisions, and the table of them an allocation:
+/// worth it when each is read many times).
+const LAID_OUT_MIN: u32 = 16;
+
 /// What a dimension's values need besides the sample index.
 #[derive(Clone, Copy, Debug, Default)]
 struct DimKey {
     /// The 64-bit seed of the dimension's scrambles or pattern.
     seed: u64,
     /// [`Sampler::ZSobol`]: the shuffled digits above the pixel's samples
-    /// ([`ZOrder::block`]); [`Sampler::Sobol`]: the seed of the index
-    /// permutation.
+    /// ([`ZOrder::block`]); [`Sampler::Sobol`]: the index permutation's
+    /// seed (low half) and the rotation that ends it, that seed modulo the
+    /// stream's count (high half).
     block: u64,
-    /// [`Sampler::Sobol`]: the rotation that ends the index permutation,
-    /// its seed modulo the stream's count.
-    rotation: u32,
-    /// [`Sampler::Stratified`] and [`Sampler::MultiJitter`]: the
-    /// dimension's pattern, its permutations laid out.
-    layout: Layout,
+}
+
+impl DimKey {
+    /// [`Sampler::Sobol`]: the index permutation's seed and rotation.
+    #[inline(always)]
+    fn permutation(self) -> (u32, u32) {
+        (self.block as u32, (self.block >> 32) as u32)
+    }
 }
 
 /// The samples `0 .. count` of one pixel or one estimate.
@@ -140,6 +148,11 @@ pub struct Stream {
     /// `cached` is set.
     keys: [DimKey; CACHED],
     cached: u32,
+    /// [`Sampler::Stratified`] and [`Sampler::MultiJitter`]: the patterns
+    /// of dimensions below [`CACHED`] once laid out (bit `dim` of
+    /// `laid_out`), allocated at the first.
+    layouts: Vec<Layout>,
+    laid_out: u32,
 }
 
 impl Stream {
@@ -157,6 +170,8 @@ impl Stream {
             zorder,
             keys: [DimKey::default(); CACHED],
             cached: 0,
+            layouts: Vec::new(),
+            laid_out: 0,
         }
     }
 
@@ -212,23 +227,41 @@ impl Stream {
             DimKey {
                 seed,
                 block: self.zorder.block(seed),
-                ..DimKey::default()
             }
         } else {
             let seed = mix64(self.key ^ dim);
-            let block = mix64(seed);
-            let patterned = matches!(self.sampler, Sampler::Stratified | Sampler::MultiJitter);
+            let permutation = mix64(seed) as u32;
+            let rotation = permutation % self.count;
             DimKey {
                 seed,
-                block,
-                rotation: (u64::from(block as u32) % u64::from(self.count)) as u32,
-                layout: if patterned {
-                    Layout::new(self.count, (seed >> 32) as u32)
-                } else {
-                    Layout::default()
-                },
+                block: u64::from(rotation) << 32 | u64::from(permutation),
             }
         }
+    }
+
+    /// The pattern of dimension `dim` ([`Sampler::Stratified`] and
+    /// [`Sampler::MultiJitter`]), laid out once for dimensions below
+    /// [`CACHED`] of a stream of at least [`LAID_OUT_MIN`] samples.
+    #[inline]
+    fn layout(&mut self, dim: u32) -> Layout {
+        let p = (self.key(dim).seed >> 32) as u32;
+        let pairs = if self.sampler == Sampler::Stratified {
+            Pattern::Stratified
+        } else {
+            Pattern::MultiJitter
+        };
+        let slot = dim as usize;
+        if slot >= CACHED || self.count < LAID_OUT_MIN {
+            return Layout::new(self.count, p, pairs);
+        }
+        if self.laid_out >> dim & 1 == 0 {
+            if self.layouts.is_empty() {
+                self.layouts.resize(CACHED, Layout::default());
+            }
+            self.layouts[slot] = Layout::new(self.count, p, pairs);
+            self.laid_out |= 1 << dim;
+        }
+        self.layouts[slot]
     }
 
     /// Coordinate `dim` of the current sample, in `[0, 1)`.
@@ -258,7 +291,7 @@ impl Stream {
         match self.sampler {
             Sampler::Independent => self.rng.next_float(),
             Sampler::Stratified | Sampler::MultiJitter => {
-                unit(self.key(dim).layout.single(self.index, false))
+                unit(self.layout(dim).single(self.index, false))
             }
             Sampler::Sobol | Sampler::ZSobol => {
                 let (i, k) = self.sobol_index(dim);
@@ -273,7 +306,7 @@ impl Stream {
         match self.sampler {
             Sampler::Independent => [self.rng.next_float(), self.rng.next_float()],
             Sampler::Stratified | Sampler::MultiJitter => {
-                let (s, layout) = (self.index, self.key(dim).layout);
+                let (s, layout) = (self.index, self.layout(dim));
                 let (x, y) = if self.sampler == Sampler::Stratified {
                     layout.stratified(s)
                 } else {
@@ -299,12 +332,8 @@ impl Stream {
         let i = if self.sampler == Sampler::ZSobol {
             k.block | self.zorder.within(self.index, k.seed)
         } else {
-            u64::from(permute_rotated(
-                self.index,
-                self.count,
-                k.block as u32,
-                k.rotation,
-            ))
+            let (seed, rotation) = k.permutation();
+            u64::from(permute_rotated(self.index, self.count, seed, rotation))
         };
         (i, k)
     }
