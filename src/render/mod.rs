@@ -244,23 +244,35 @@ impl Batch {
         // time (likewise).
         let independent = settings.sampler == Sampler::Independent;
         let lens_drawn = scene.camera().has_lens() || independent;
-        // The other samplers' camera numbers, drawn together.
-        self.requests.clear();
         let per_sample = 1 + usize::from(lens_drawn) + usize::from(moves);
         if !independent {
-            alloc::reserve(&mut self.requests, n * per_sample, WHAT)?;
-            for (p, i) in (0..streams.len() as u32).flat_map(|p| (0..spp).map(move |i| (p, i))) {
-                let index = (samples.first + u64::from(i)) as u32;
-                camera_requests(p, index, (lens_drawn, moves), &mut self.requests);
-            }
-            self.drawn.draw(&mut streams, &self.requests)?;
+            self.requests.clear();
+            alloc::reserve(&mut self.requests, BATCH.min(n) * per_sample, WHAT)?;
         }
-        for (p, (x, stream)) in pixels.zip(&mut streams).enumerate() {
+        let spp = spp.max(1) as usize;
+        let index = |i: usize| samples.first + i as u64;
+        // The other samplers' camera numbers drawn together, BATCH
+        // samples at a time (a pixel may have many more); `j` counts the
+        // samples, pixel after pixel.
+        let mut j = 0;
+        for p in 0..streams.len() {
+            let x = pixels.start + p;
             let pixel = (y * width + x) as u64;
             let key = mix(seed, pixel);
-            for i in 0..u64::from(spp) {
-                start_sample(stream, key, pixel, samples.first + i);
-                let first = (p * spp as usize + i as usize) * per_sample;
+            for i in 0..spp {
+                if !independent && j % BATCH == 0 {
+                    self.requests.clear();
+                    let (mut q, mut k) = (p, i);
+                    for _ in j..(j + BATCH).min(n) {
+                        let index = index(k) as u32;
+                        camera_requests(q as u32, index, (lens_drawn, moves), &mut self.requests);
+                        (q, k) = if k + 1 == spp { (q + 1, 0) } else { (q, k + 1) };
+                    }
+                    self.drawn.draw(&mut streams, &self.requests)?;
+                }
+                let stream = &mut streams[p];
+                start_sample(stream, key, pixel, index(i));
+                let first = j % BATCH * per_sample;
                 let drawn = (&self.requests[..], &self.drawn.values[..]);
                 let mut numbers = Numbers::new(stream, drawn, first..first + per_sample);
                 let film = numbers.get2(dims::FILM);
@@ -281,6 +293,7 @@ impl Batch {
                 if let Some(rng) = numbers.independent() {
                     self.resume.push(rng.clone());
                 }
+                j += 1;
             }
         }
         self.rays.resize(self.camera_u.len(), Ray::default());
@@ -303,7 +316,6 @@ impl Batch {
                 *hit = integrator::skip_emitters(scene, ray, *hit, time(i));
             }
         }
-        let spp = spp.max(1) as usize;
         self.radiance.resize(self.rays.len(), [0.0; 3]);
         // The paths in groups of at most BATCH (a pixel's samples may be
         // many more): the memory of the paths in flight stays bounded.

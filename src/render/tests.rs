@@ -652,36 +652,39 @@ fn camera_samples_draw_their_own_numbers() {
         motion: Some(Motion::new("to_world", DAffine3::IDENTITY, moved).unwrap()),
     };
     let scene = Scene::new(vec![moving], None, cam, 4, 4).unwrap();
+    // Three pixels of 5 samples; two of 300, in more than one group.
+    let cases = [(5, 11, 3, 1..4), (300, 600, 7, 2..4)];
     for &(_, sampler) in &Sampler::NAMES[1..] {
-        let settings = Settings {
-            sampler,
-            ..settings(Integrator::Direct, Strategy::Mis)
-        };
-        let samples = Samples {
-            first: 3,
-            count: 5,
-            total: 11,
-            keep_sums: false,
-        };
-        let (seed, y) = (7, 2);
-        let mut batch = Batch::default();
-        batch
-            .run(&scene, &settings, seed, samples, y, 1..4)
-            .unwrap();
-        for (j, (u, &time)) in batch.camera_u.iter().zip(&batch.times).enumerate() {
-            let x = 1 + j / 5;
-            let pixel = (y * 4 + x) as u64;
-            let key = mix(seed, pixel);
-            let zorder = ZOrder::new((x, y), (4, 4), 11, seed);
-            let mut s = Stream::new(sampler, key, Rng::new(key, pixel), 11, zorder);
-            s.start(3 + (j % 5) as u32);
-            let film = s.get2::<f32>(dims::FILM);
-            assert_eq!(u[2..], s.get2::<f32>(dims::LENS), "{sampler:?} {j}");
-            assert_eq!(time, s.get1::<f32>(dims::TIME), "{sampler:?} {j}");
-            let on_film = [u[0] * 4.0 - x as f32, u[1] * 4.0 - y as f32];
-            assert!((on_film[0] - film[0]).abs() < 1e-5, "{sampler:?} {j}");
-            assert!((on_film[1] - film[1]).abs() < 1e-5, "{sampler:?} {j}");
+        for (count, total, first, pixels) in cases.clone() {
+            let settings = Settings {
+                sampler,
+                ..settings(Integrator::Direct, Strategy::Mis)
+            };
+            let samples = Samples {
+                first,
+                count,
+                total,
+                keep_sums: false,
+            };
+            let (seed, y) = (7, 2);
+            let mut batch = Batch::default();
+            (batch.run(&scene, &settings, seed, samples, y, pixels.clone())).unwrap();
+            let each = batch.camera_u.iter().zip(&batch.times).enumerate();
+            for (j, (u, &time)) in each {
+                let x = pixels.start + j / count as usize;
+                let pixel = (y * 4 + x) as u64;
+                let key = mix(seed, pixel);
+                let zorder = ZOrder::new((x, y), (4, 4), total, seed);
+                let mut s = Stream::new(sampler, key, Rng::new(key, pixel), total, zorder);
+                s.start(first as u32 + (j % count as usize) as u32);
+                let film = s.get2::<f32>(dims::FILM);
+                assert_eq!(u[2..], s.get2::<f32>(dims::LENS), "{sampler:?} {j}");
+                assert_eq!(time, s.get1::<f32>(dims::TIME), "{sampler:?} {j}");
+                let on_film = [u[0] * 4.0 - x as f32, u[1] * 4.0 - y as f32];
+                assert!((on_film[0] - film[0]).abs() < 1e-5, "{sampler:?} {j}");
+                assert!((on_film[1] - film[1]).abs() < 1e-5, "{sampler:?} {j}");
+            }
+            assert_eq!(batch.times.len(), pixels.len() * count as usize);
         }
-        assert_eq!(batch.times.len(), 15);
     }
 }

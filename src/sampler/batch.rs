@@ -16,12 +16,10 @@
 //! request of the same dimension ([`Stream::get1`] scrambles the same first
 //! coordinate with the same seed), so every request is drawn as a pair.
 
-use super::{Sampler, Stream, zorder};
+use super::{Sampler, Stream, scrambled_pair};
 use crate::alloc;
 use crate::error::Result;
-use crate::math::Real;
 use crate::qmc::patterns::{kensler_step, rotate, walk};
-use crate::qmc::sobol::owen_reversed_pair;
 use crate::simd::dispatch;
 
 /// One request: coordinate `dim` (and `dim + 1` when `two`) of sample
@@ -141,9 +139,7 @@ impl Drawn {
                     *i = u64::from(rotate(walk(*i as u32, count, seed), count, rotation));
                 }
                 for ((v, &i), &seed) in values.iter_mut().zip(&*index).zip(&*seed) {
-                    let (x, y) = zorder::sobol01_reversed(i);
-                    let seeds = [seed as u32, (seed >> 32) as u32];
-                    *v = owen_reversed_pair([x, y], seeds).map(f32::from_random_bits);
+                    *v = scrambled_pair(i, seed);
                 }
             },
         );

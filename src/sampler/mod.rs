@@ -316,9 +316,7 @@ impl Stream {
             }
             Sampler::Sobol | Sampler::ZSobol => {
                 let (i, k) = self.sobol_index(dim);
-                let (x, y) = zorder::sobol01_reversed(i);
-                let seeds = [k.seed as u32, (k.seed >> 32) as u32];
-                owen_reversed_pair([x, y], seeds).map(F::from_random_bits)
+                scrambled_pair(i, k.seed)
             }
         }
     }
@@ -337,6 +335,14 @@ impl Stream {
         };
         (i, k)
     }
+}
+
+/// The first two Sobol' dimensions at index `i`, each Owen-scrambled by
+/// a half of `seed` (the low half the first coordinate's).
+#[inline(always)]
+fn scrambled_pair<F: Real>(i: u64, seed: u64) -> [F; 2] {
+    let (x, y) = zorder::sobol01_reversed(i);
+    owen_reversed_pair([x, y], [seed as u32, (seed >> 32) as u32]).map(F::from_random_bits)
 }
 
 #[cfg(test)]
