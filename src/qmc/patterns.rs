@@ -107,11 +107,7 @@ impl Patterns {
             Pattern::Stratified | Pattern::MultiJitter => {
                 let mut pairs = row.chunks_exact_mut(2);
                 for (pair, l) in pairs.by_ref().zip(layouts) {
-                    let (x, y) = if self.pattern == Pattern::Stratified {
-                        l.stratified(s)
-                    } else {
-                        l.multi_jitter(s)
-                    };
+                    let (x, y) = l.pair(s, self.pattern);
                     pair[0] = unit(x);
                     pair[1] = unit(y);
                 }
@@ -191,6 +187,17 @@ impl Layout {
         let (n, p) = (self.n, self.p);
         let jitter = if centered { 0.5 } else { jitter(s, p) };
         (f64::from(permute_rotated(s, n, p, self.rotations[0])) + jitter) / f64::from(n)
+    }
+
+    /// Point `s` of the 2D pattern `pattern`: [`Layout::stratified`] or,
+    /// for any other, [`Layout::multi_jitter`].
+    #[inline]
+    pub(crate) fn pair(&self, s: u32, pattern: Pattern) -> (f64, f64) {
+        if pattern == Pattern::Stratified {
+            self.stratified(s)
+        } else {
+            self.multi_jitter(s)
+        }
     }
 
     /// Point `s` of the shuffled `r × r` grid of strata.

@@ -186,9 +186,10 @@ struct Batch {
     hits: Vec<Option<Hit>>,
     /// Embree's records of the camera rays.
     stream: embree::Stream,
-    /// The camera's numbers drawn beforehand (the samplers other than the
-    /// independent one): sample `j`'s requests and values are those from
-    /// `j · (1 + lens + time)` on.
+    /// The camera's numbers drawn beforehand, `BATCH` samples at a time
+    /// (the samplers other than the independent one): the `j`-th sample's
+    /// requests and values are those from `(j mod BATCH)·(1 + lens + time)`
+    /// on.
     requests: Vec<Request>,
     drawn: Drawn,
     /// One pixel's sums per block at a time.

@@ -59,7 +59,7 @@ impl Drawn {
     /// `streams[s].start(index)` followed by `get1::<f32>(dim)` or
     /// `get2::<f32>(dim)` gives. Nothing is drawn for
     /// [`Sampler::Independent`], whose numbers depend on the order they
-    /// are asked in. The stratified samplers' streams are left at the last
+    /// are asked in. The streams of the samplers other than Sobol's are left at the last
     /// request's sample ([`Stream::start`] them again before asking).
     ///
     /// # Errors
@@ -114,11 +114,9 @@ impl Drawn {
         if sampler == Sampler::ZSobol {
             for ((r, i), s) in keyed {
                 let stream = &mut streams[r.stream as usize];
-                let key = stream.key(r.dim);
-                (*i, *s) = (
-                    key.block | stream.zorder.within(r.index, key.seed),
-                    key.seed,
-                );
+                stream.start(r.index);
+                let (index, key) = stream.sobol_index(r.dim);
+                (*i, *s) = (index, key.seed);
             }
         } else {
             for (((r, i), s), p) in keyed.zip(permutation.iter_mut()) {

@@ -239,17 +239,21 @@ impl Stream {
         }
     }
 
+    /// The 2D pattern of [`Sampler::Stratified`] (else Kensler's).
+    fn pattern(&self) -> Pattern {
+        if self.sampler == Sampler::Stratified {
+            Pattern::Stratified
+        } else {
+            Pattern::MultiJitter
+        }
+    }
+
     /// The pattern of dimension `dim` ([`Sampler::Stratified`] and
     /// [`Sampler::MultiJitter`]), laid out once for dimensions below
     /// [`CACHED`] of a stream of at least [`LAID_OUT_MIN`] samples.
     #[inline]
     fn layout(&mut self, dim: u32) -> Layout {
-        let p = (self.key(dim).seed >> 32) as u32;
-        let pairs = if self.sampler == Sampler::Stratified {
-            Pattern::Stratified
-        } else {
-            Pattern::MultiJitter
-        };
+        let (p, pairs) = ((self.key(dim).seed >> 32) as u32, self.pattern());
         let slot = dim as usize;
         if slot >= CACHED || self.count < LAID_OUT_MIN {
             return Layout::new(self.count, p, pairs);
@@ -306,12 +310,7 @@ impl Stream {
         match self.sampler {
             Sampler::Independent => [self.rng.next_float(), self.rng.next_float()],
             Sampler::Stratified | Sampler::MultiJitter => {
-                let (s, layout) = (self.index, self.layout(dim));
-                let (x, y) = if self.sampler == Sampler::Stratified {
-                    layout.stratified(s)
-                } else {
-                    layout.multi_jitter(s)
-                };
+                let (x, y) = self.layout(dim).pair(self.index, self.pattern());
                 [unit(x), unit(y)]
             }
             Sampler::Sobol | Sampler::ZSobol => {
