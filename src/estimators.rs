@@ -407,9 +407,9 @@ pub fn reflected_radiance(
         scaled(view.eval(wo), wo[2].max(0.0))
     };
     let bsdf_sample = |stream: &mut Stream| {
-        let lobe = stream.get1(0);
         let [u1, u2] = stream.get2(1);
-        let s = view.sample([lobe, u1, u2]);
+        let lobe = stream.get1(0);
+        let s = view.sample([u1, u2, lobe]);
         (frame.to_world(s.wo), s)
     };
     let times = |a: V3<f64>, b: V3<f64>| [a[0] * b[0], a[1] * b[1], a[2] * b[2]];

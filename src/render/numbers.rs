@@ -96,8 +96,8 @@ pub fn camera_requests(pixel: u32, index: u32, (lens, time): (bool, bool), out: 
 /// sample `index` of the batch's pixel `pixel` makes (`Bounce::shade` of
 /// [`super::wavefront`], in its order) for a sampler other than the
 /// independent one: none at the last vertex; the light's choice and
-/// position unless only the BSDF is sampled; the BSDF's component and
-/// direction unless emitter sampling stops there; Russian roulette from
+/// position unless only the BSDF is sampled; the BSDF's direction and
+/// component unless emitter sampling stops there; Russian roulette from
 /// `rr_depth` on (path integrator).
 pub fn bounce_requests(
     settings: &Settings,
@@ -123,8 +123,8 @@ pub fn bounce_requests(
             return;
         }
     }
-    push(dims::BSDF_COMPONENT, false);
     push(dims::BSDF_DIRECTION, true);
+    push(dims::BSDF_COMPONENT, false);
     if settings.integrator == Integrator::Path && depth + 1 >= settings.rr_depth {
         push(dims::ROULETTE, false);
     }

@@ -86,11 +86,9 @@ impl Paths for LightPaths<'_> {
             0.0
         };
         if !settings.hide_emitters {
-            let u = [
-                stream.get1(dims::DIRECT_CHOICE),
-                stream.get1(dims::DIRECT_POSITION),
-                stream.get1(dims::DIRECT_POSITION + 1),
-            ];
+            let choice = stream.get1(dims::DIRECT_CHOICE);
+            let [u1, u2] = stream.get2(dims::DIRECT_POSITION);
+            let u = [choice, u1, u2];
             let lens = stream.get2(dims::DIRECT_LENS);
             out.extend(seen_directly(scene, u, lens, tau));
         }

@@ -508,9 +508,12 @@ impl Bounce<'_> {
             }
         }
 
-        let component = numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT));
+        // The direction from the 2D request, the part from the 1D one
+        // (`sample_one`'s `u[0..2]` and `u[2]`; drawn in this order, the
+        // independent sampler's numbers come in the argument's order).
         let [u1, u2] = numbers.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
-        let s = view.sample_one([component, u1, u2]);
+        let component = numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT));
+        let s = view.sample_one([u1, u2, component]);
         if s.weight.iter().all(|&v| v <= 0.0) {
             return false;
         }

@@ -73,15 +73,17 @@ pub mod dims {
     pub const DIRECT_LENS: u32 = 13;
     /// Dimensions before depth 0.
     pub const START: u32 = 15;
-    /// Camera vertex: the BSDF sample (3D).
+    /// Camera vertex: the BSDF sample (3D: its direction, 2D, then its
+    /// part).
     pub const CAMERA_BSDF: u32 = 0;
-    /// Camera vertex: next-event estimation's light and point (3D).
+    /// Camera vertex: next-event estimation's light (1D) and point (2D).
     pub const CAMERA_LIGHT: u32 = 3;
     /// Camera vertex: Russian roulette.
     pub const CAMERA_ROULETTE: u32 = 6;
     /// Light vertex: the lens point of its connection to the camera (2D).
     pub const LIGHT_LENS: u32 = 7;
-    /// Light vertex: the BSDF sample (3D).
+    /// Light vertex: the BSDF sample (3D: its direction, 2D, then its
+    /// part).
     pub const LIGHT_BSDF: u32 = 9;
     /// Light vertex: Russian roulette.
     pub const LIGHT_ROULETTE: u32 = 12;

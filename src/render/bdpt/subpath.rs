@@ -186,11 +186,8 @@ pub(super) fn walk(
         } else {
             (dims::CAMERA_BSDF, dims::CAMERA_ROULETTE)
         };
-        let u = [
-            stream.get1(dims::at(k, bsdf_u)),
-            stream.get1(dims::at(k, bsdf_u + 1)),
-            stream.get1(dims::at(k, bsdf_u + 2)),
-        ];
+        let [u1, u2] = stream.get2(dims::at(k, bsdf_u));
+        let u = [u1, u2, stream.get1(dims::at(k, bsdf_u + 2))];
         let s = view.sample_one(u);
         if s.weight.iter().all(|&w| w <= 0.0) {
             return;
@@ -360,11 +357,9 @@ pub(super) fn start_light_path(
     stream: &mut Stream,
     (choice, position, direction): (u32, u32, u32),
 ) -> Option<(Emission, Ray, [f32; 3])> {
-    let u = [
-        stream.get1(choice),
-        stream.get1(position),
-        stream.get1(position + 1),
-    ];
+    let choice = stream.get1(choice);
+    let [u1, u2] = stream.get2(position);
+    let u = [choice, u1, u2];
     let emission = scene.sample_emission(u)?;
     let (ray, beta) = emitted_ray(scene, emission, stream.get2(direction));
     Some((emission, ray, beta))
