@@ -15,6 +15,17 @@ def rng() -> np.random.Generator:
     return np.random.default_rng(12345)
 
 
+@pytest.fixture
+def sigint_interrupts():
+    """Python's own SIGINT handler (KeyboardInterrupt) for the test, also
+    where the suite runs with SIGINT ignored (a shell's background job)."""
+    import signal
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
 @pytest.fixture(scope="session")
 def mi():
     """The mitsuba module with a variant set: llvm_ad_rgb when a usable

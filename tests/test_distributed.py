@@ -110,7 +110,7 @@ def test_a_worker_lost_mid_run_changes_nothing(client, scene, monkeypatch):
     assert pids[victim] not in client.run(os.getpid).values()
 
 
-def test_ctrl_c_cancels_the_chunks(client, scene, monkeypatch):
+def test_ctrl_c_cancels_the_chunks(client, scene, monkeypatch, sigint_interrupts):
     """Ctrl-C (SIGINT to this process) when the first chunk arrives: the
     render raises KeyboardInterrupt and the workers drop the rest."""
     def progress_bar(total, enabled):

@@ -158,7 +158,7 @@ def test_render_argument_errors(kwargs, message):
         mcs.render(s, **args)
 
 
-def test_ctrl_c_stops_a_long_render_quickly():
+def test_ctrl_c_stops_a_long_render_quickly(sigint_interrupts):
     """A signal handler raising KeyboardInterrupt fires while Rust renders;
     the render stops within about a second."""
     import signal
