@@ -1,10 +1,11 @@
 //! A density on the unit square that is the bilinear interpolant of values
-//! on a grid of vertices, the form of Mitsuba 3's `Hierarchical2D` (which
-//! its `envmap` emitter samples).
+//! on a grid of vertices, sampled as Mitsuba 3's `Hierarchical2D` (which
+//! its `envmap` emitter samples) warps the square.
 
+use super::pyramid::Pyramid;
 use crate::alloc;
-use crate::distr::{Discrete2D, GROUP};
-use crate::error::Result;
+use crate::distr::GROUP;
+use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::simd;
 
@@ -17,22 +18,27 @@ use crate::simd;
 /// #patches` the mean of the interpolant. Per unit area.
 ///
 /// # Sampling
-/// A patch from the [`Discrete2D`] of the patch integrals (row by `u[1]`,
-/// column by `u[0]`), then a point in it by the bilinear warp with the
-/// rescaled `u`: the marginal in y, then the conditional in x, each a linear
-/// density inverted in closed form.
+/// A patch in proportion to its integral by hierarchical sample warping
+/// ([`Pyramid`]: a 2×2 block per level, row by `u[1]`, column by `u[0]`),
+/// then a point in it by the bilinear warp with the rescaled `u`: the
+/// marginal in y, then the conditional in x, each a linear density
+/// inverted in closed form. The same map from `u` to points as Mitsuba's
+/// `Hierarchical2D` (up to rounding at the boundaries of its choices).
 #[derive(Clone, Debug)]
 pub struct BilinearGrid {
     values: Vec<f64>,
     cols: usize,
     rows: usize,
     inv_mean: f64,
-    patches: Discrete2D,
+    patches: Pyramid,
 }
 
 impl BilinearGrid {
     /// The density of the row-major vertex `values` (`rows × cols`, both
-    /// at least 2), checked by [`Discrete2D::new`] on the patch integrals.
+    /// at least 2; finite and non-negative: the caller checks).
+    ///
+    /// # Errors
+    /// [`Error::AllZero`] when every patch integral is 0, [`Error::Memory`].
     pub fn new(values: Vec<f64>, cols: usize, rows: usize) -> Result<Self> {
         let (px, py) = (cols - 1, rows - 1);
         let mut patch = alloc::with_capacity(px * py, "the sampling grid's patches")?;
@@ -44,8 +50,12 @@ impl BilinearGrid {
                 );
             }
         }
-        let patches = Discrete2D::with_arg("image", &patch, py, px)?;
-        let inv_mean = (px * py) as f64 / patches.sum();
+        let sum: f64 = patch.iter().sum();
+        if sum <= 0.0 {
+            return Err(Error::AllZero { arg: "image" });
+        }
+        let patches = Pyramid::new(&patch, px, py)?;
+        let inv_mean = (px * py) as f64 / sum;
         Ok(BilinearGrid {
             values,
             cols,
@@ -80,7 +90,7 @@ impl BilinearGrid {
     }
 
     /// `out[i] = sample(us[i])` for a batch: the patches by
-    /// [`Discrete2D::sample_reuse_into`], then their corners prefetched
+    /// [`Pyramid::sample_reuse_into`], then their corners prefetched
     /// before any is read.
     pub fn sample_into(&self, us: &[[f64; 2]], out: &mut [([f64; 2], f64)]) {
         let mut patches = [((0, 0), [0.0; 2]); GROUP];

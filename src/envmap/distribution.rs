@@ -14,7 +14,7 @@ use super::sample::angular_uv;
 use super::{Options, Sampling};
 use crate::buffer::Buffer;
 use crate::distr::PiecewiseConstant2D;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::{alloc, parallel};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -237,5 +237,9 @@ fn mitsuba_grid(image: &Image, compensate: bool) -> Result<Distribution> {
         let row = &lum[y * w..(y + 1) * w];
         values.extend(row.iter().chain(&row[..1]).map(|l| l * sin_theta));
     }
-    Ok(BilinearGrid::new(values, w + 1, h).map_or(Distribution::Black, Distribution::Bilinear))
+    match BilinearGrid::new(values, w + 1, h) {
+        Ok(grid) => Ok(Distribution::Bilinear(grid)),
+        Err(Error::AllZero { .. }) => Ok(Distribution::Black),
+        Err(e) => Err(e),
+    }
 }

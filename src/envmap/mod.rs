@@ -60,6 +60,7 @@ mod image;
 mod luminance;
 mod mapping;
 mod polar;
+mod pyramid;
 mod sample;
 
 pub use batch::EnvSamples;
