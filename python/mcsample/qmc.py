@@ -8,10 +8,11 @@ thread count; ``fast_forward`` costs O(1)), and draws float64 or, with
 
 - ``Sobol(d, scramble=True, seed=None)``: Joe and Kuo's direction numbers in
   scipy's Gray-code order. ``scramble=True`` is Owen's nested uniform
-  scrambling (a hash per dimension, Burley 2020), ``"lms"`` a random linear
-  matrix scramble with a digital shift (scipy's kind of scrambling, other
-  random bits), ``False`` the plain sequence: ``scipy.stats.qmc.Sobol(d,
-  scramble=False)``'s points, bit for bit. At most 2**32 points.
+  scrambling (a hash per dimension, Burley 2020, with Vegdahl's
+  constants), ``"lms"`` a random linear matrix scramble with a digital
+  shift (scipy's kind of scrambling, other random bits), ``False`` the
+  plain sequence: ``scipy.stats.qmc.Sobol(d, scramble=False)``'s points,
+  bit for bit. At most 2**32 points.
 - ``Halton(d, scramble=True, seed=None)``: the first ``d`` primes as bases;
   ``scramble=True`` permutes the digits at random per digit position and
   dimension (as scipy does), ``False`` gives ``scipy.stats.qmc.Halton(d,

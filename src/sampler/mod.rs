@@ -20,7 +20,7 @@
 //!   `PaddedSobolSampler`): every request the first one or two Sobol'
 //!   dimensions (a (0, m, 2)-net for every power-of-two prefix, which
 //!   consecutive higher dimensions are not) at the sample's index shuffled
-//!   by a permutation of `0 .. count`, Owen-scrambled (Burley 2020's hash),
+//!   by a permutation of `0 .. count`, Owen-scrambled (Burley 2020's hash, Vegdahl's constants),
 //!   each with its own seeds per pixel and dimension;
 //! - [`Sampler::ZSobol`]: Ahmed and Wronski's (2020) z-ordered Sobol', as
 //!   pbrt-v4's `ZSobolSampler` ([`zorder`]): every request the first two
