@@ -91,7 +91,8 @@ impl BilinearGrid {
 
     /// `out[i] = sample(us[i])` for a batch: the patches by
     /// [`Pyramid::sample_reuse_into`], then their corners prefetched
-    /// before any is read.
+    /// before any is read. Inlined into the caller's vector-unit dispatch.
+    #[inline(always)]
     pub fn sample_into(&self, us: &[[f64; 2]], out: &mut [([f64; 2], f64)]) {
         let mut patches = [((0, 0), [0.0; 2]); GROUP];
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {

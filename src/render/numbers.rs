@@ -7,8 +7,8 @@
 
 use super::integrator::{Integrator, Settings, Strategy, dims};
 use crate::rng::Rng;
-use crate::sampler::Stream;
 use crate::sampler::batch::Request;
+use crate::sampler::{Sampler, Stream};
 
 /// The numbers of one camera sample, or of one path's bounce.
 pub struct Numbers<'a> {
@@ -92,15 +92,26 @@ pub fn camera_requests(pixel: u32, index: u32, (lens, time): (bool, bool), out: 
     }
 }
 
+/// Whether the shading draws the light's choice: when the scene has more
+/// than one light (`many_lights`), and always under the independent
+/// sampler, whose draws keep their order (the others' numbers depend only
+/// on the dimension, and a choice among one light reads none).
+#[inline]
+pub fn draws_light_choice(many_lights: bool, sampler: Sampler) -> bool {
+    many_lights || sampler == Sampler::Independent
+}
+
 /// Pushes the requests the shading of the vertex at `depth` of a path of
 /// sample `index` of the batch's pixel `pixel` makes (`Bounce::shade` of
 /// [`super::wavefront`], in its order) for a sampler other than the
-/// independent one: none at the last vertex; the light's choice and
-/// position unless only the BSDF is sampled; the BSDF's direction and
-/// component unless emitter sampling stops there; Russian roulette from
-/// `rr_depth` on (path integrator).
+/// independent one: none at the last vertex; the light's choice (when
+/// `many_lights`, [`draws_light_choice`]) and position unless only the
+/// BSDF is sampled; the BSDF's direction and component unless emitter
+/// sampling stops there; Russian roulette from `rr_depth` on (path
+/// integrator).
 pub fn bounce_requests(
     settings: &Settings,
+    many_lights: bool,
     (pixel, index, depth): (u32, u32, u32),
     out: &mut Vec<Request>,
 ) {
@@ -117,7 +128,9 @@ pub fn bounce_requests(
         });
     };
     if settings.strategy != Strategy::Bsdf {
-        push(dims::LIGHT_CHOICE, false);
+        if many_lights {
+            push(dims::LIGHT_CHOICE, false);
+        }
         push(dims::LIGHT_POSITION, true);
         if settings.strategy == Strategy::Emitter && depth + 2 >= max_depth {
             return;

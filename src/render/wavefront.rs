@@ -35,7 +35,7 @@ use super::integrator::{
     Escaped, Integrator, Settings, Strategy, add_scaled, dims, emission_weight, mul, offset,
     shading, shadow_ray,
 };
-use super::numbers::{Numbers, bounce_requests};
+use super::numbers::{Numbers, bounce_requests, draws_light_choice};
 use super::scene::{InvertedSamples, LightSample, Scene};
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
@@ -260,6 +260,7 @@ impl Wavefront {
                     self.first.push(self.requests.len() as u32);
                     bounce_requests(
                         settings,
+                        scene.chooses_among_lights(),
                         (path.pixel, path.index, path.depth),
                         &mut self.requests,
                     );
@@ -467,7 +468,12 @@ impl Bounce<'_> {
         let (frame, view) = shading(scene, shape, sp.ns, wi);
 
         if settings.strategy != Strategy::Bsdf {
-            let choice = numbers.get1(dims::bounce(depth, dims::LIGHT_CHOICE));
+            let many = scene.chooses_among_lights();
+            let choice = if draws_light_choice(many, numbers.stream.sampler()) {
+                numbers.get1(dims::bounce(depth, dims::LIGHT_CHOICE))
+            } else {
+                0.0
+            };
             let [u1, u2] = numbers.get2(dims::bounce(depth, dims::LIGHT_POSITION));
             // The independent sampler picks environment cells from extra
             // random bits (an alias table); the others by inversion, which

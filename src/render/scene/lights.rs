@@ -377,6 +377,13 @@ impl Scene {
         }
     }
 
+    /// Whether the scene has more than one light, so that
+    /// [`Scene::choose_light`] reads its number.
+    #[inline]
+    pub fn chooses_among_lights(&self) -> bool {
+        self.lights.len() > 1
+    }
+
     /// The light emitter sampling draws by `u` (by power), or `None` when
     /// the scene has none.
     #[inline]
