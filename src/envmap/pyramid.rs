@@ -14,31 +14,19 @@
 use crate::alloc;
 use crate::error::Result;
 
-/// One level: `width × height` sums (both even; cells past the table are
-/// 0), stored in 2×2 blocks so that the four cells a step reads are
-/// adjacent.
+/// One level of the pyramid: per 2×2 block of cells (row-major,
+/// `blocks_per_row` a row), the splits of its sums `v00 v10 / v01 v11`:
+/// the first row's share `(v00 + v10) / Σ`, and in each row the first
+/// cell's share (`v00 / (v00 + v10)`, `v01 / (v01 + v11)`).
 #[derive(Clone, Debug)]
 struct Level {
-    width: usize,
-    values: Vec<f64>,
+    blocks_per_row: usize,
+    splits: Vec<[f64; 3]>,
 }
 
-impl Level {
-    /// Index of the first (top-left) cell of the 2×2 block at even `(x, y)`.
-    #[inline(always)]
-    fn block(&self, x: usize, y: usize) -> usize {
-        (y / 2 * (self.width / 2) + x / 2) * 4
-    }
-
-    /// Index of cell `(x, y)`.
-    #[inline(always)]
-    fn index(&self, x: usize, y: usize) -> usize {
-        self.block(x & !1, y & !1) + (y & 1) * 2 + (x & 1)
-    }
-}
-
-/// The MIP pyramid of a `cols × rows` table of weights, finest level first,
-/// up to the level that is one 2×2 block.
+/// The pyramid of a table of weights, finest level first, up to the level
+/// that is one 2×2 block (tables of odd sides padded with cells of weight
+/// 0 at each level, as Mitsuba's).
 #[derive(Clone, Debug)]
 pub struct Pyramid {
     levels: Vec<Level>,
@@ -47,89 +35,148 @@ pub struct Pyramid {
 impl Pyramid {
     /// The pyramid of the row-major `weights` (`rows × cols`, non-negative,
     /// not all 0: the caller checks).
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when the levels cannot be had.
     pub fn new(weights: &[f64], cols: usize, rows: usize) -> Result<Self> {
-        let even = |n: usize| n + (n & 1);
-        let (mut w, mut h) = (even(cols), even(rows));
-        let mut finest = alloc::filled(w * h, 0.0, "the sampling pyramid")?;
-        let mut level = Level {
-            width: w,
-            values: Vec::new(),
-        };
-        for y in 0..rows {
-            for x in 0..cols {
-                finest[level.index(x, y)] = weights[y * cols + x];
-            }
-        }
-        level.values = finest;
-        let mut levels = vec![level];
-        while w > 2 || h > 2 {
-            let below = &levels[levels.len() - 1];
-            let (cw, ch) = (w / 2, h / 2);
-            (w, h) = (even(cw), even(ch));
-            let mut values = alloc::filled(w * h, 0.0, "the sampling pyramid")?;
-            let up = Level {
-                width: w,
-                values: Vec::new(),
-            };
-            for y in 0..ch {
-                for x in 0..cw {
-                    let b = below.block(2 * x, 2 * y);
-                    values[up.index(x, y)] = below.values[b..b + 4].iter().sum();
+        let (mut w, mut h) = (cols, rows);
+        let mut sums = alloc::copy(weights, "the sampling pyramid")?;
+        let mut levels = Vec::new();
+        loop {
+            let (bw, bh) = (w.div_ceil(2), h.div_ceil(2));
+            let at = |x: usize, y: usize| if x < w && y < h { sums[y * w + x] } else { 0.0 };
+            let mut splits = alloc::with_capacity(bw * bh, "the sampling pyramid")?;
+            let mut above = alloc::with_capacity(bw * bh, "the sampling pyramid")?;
+            for y in (0..bh).map(|y| 2 * y) {
+                for x in (0..bw).map(|x| 2 * x) {
+                    let [v00, v10, v01, v11] =
+                        [at(x, y), at(x + 1, y), at(x, y + 1), at(x + 1, y + 1)];
+                    splits.push([
+                        share(v00 + v10, v01 + v11),
+                        share(v00, v10),
+                        share(v01, v11),
+                    ]);
+                    above.push(v00 + v10 + v01 + v11);
                 }
             }
-            levels.push(Level { values, ..up });
+            alloc::reserve(&mut levels, 1, "the sampling pyramid")?;
+            levels.push(Level {
+                blocks_per_row: bw,
+                splits,
+            });
+            if bw == 1 && bh == 1 {
+                return Ok(Pyramid { levels });
+            }
+            (sums, w, h) = (above, bw, bh);
         }
-        Ok(Pyramid { levels })
     }
 
     /// The cell `(row, col)` that `u ∈ [0, 1]²` chooses, with probability
     /// `w / Σw`, and `u` rescaled to `[0, 1]²` within the choices.
     #[inline]
-    pub fn sample_reuse(&self, mut u: [f64; 2]) -> ((usize, usize), [f64; 2]) {
-        let (mut x, mut y) = (0, 0);
+    pub fn sample_reuse(&self, u: [f64; 2]) -> ((usize, usize), [f64; 2]) {
+        let mut at = Descent::new(u);
         for level in self.levels.iter().rev() {
-            (x, y) = step(level, (2 * x, 2 * y), &mut u);
+            at.step(level);
         }
-        ((y, x), u)
+        at.finish()
     }
 
     /// `out[i] = sample_reuse(us[i])`, the batch descending one level at a
     /// time (its lookups at a level are independent of one another).
+    /// Inlined into the caller's vector-unit dispatch.
+    #[inline(always)]
     pub fn sample_reuse_into(&self, us: &[[f64; 2]], out: &mut [((usize, usize), [f64; 2])]) {
-        for (o, &u) in out.iter_mut().zip(us) {
-            *o = ((0, 0), u);
-        }
-        for level in self.levels.iter().rev() {
-            for ((row, col), u) in out.iter_mut() {
-                (*col, *row) = step(level, (2 * *col, 2 * *row), u);
+        let mut at = [Descent::new([0.0; 2]); crate::distr::GROUP];
+        for (us, out) in us.chunks(at.len()).zip(out.chunks_mut(at.len())) {
+            let at = &mut at[..us.len()];
+            for (a, &u) in at.iter_mut().zip(us) {
+                *a = Descent::new(u);
+            }
+            for level in self.levels.iter().rev() {
+                for a in at.iter_mut() {
+                    a.step(level);
+                }
+            }
+            for (o, a) in out.iter_mut().zip(at.iter()) {
+                *o = a.finish();
             }
         }
     }
 }
 
-/// One step down: in the block at even `(x, y)` of `level`, the row by
-/// `u[1]` (first row with probability `r0 / (r0 + r1)`, its two sums),
-/// then the column of that row by `u[0]`, each coordinate rescaled to
-/// `[0, 1]` within its choice. A row or cell of weight 0 is never chosen.
-#[inline(always)]
-fn step(level: &Level, (x, y): (usize, usize), u: &mut [f64; 2]) -> (usize, usize) {
-    let b = level.block(x, y);
-    let v = &level.values[b..b + 4];
-    let lower = choose(&mut u[1], v[0] + v[1], v[2] + v[3]);
-    let row = &v[2 * usize::from(lower)..][..2];
-    let right = choose(&mut u[0], row[0], row[1]);
-    (x + usize::from(right), y + usize::from(lower))
+/// `a / (a + b)`, or 1/2 for a block of weight 0 (never reached).
+fn share(a: f64, b: f64) -> f64 {
+    if a + b > 0.0 { a / (a + b) } else { 0.5 }
 }
 
-/// Whether `u` picks the second of two weights `a`, `b` (not both 0):
-/// when `u (a + b) > a`, or `a = 0`; `u` is rescaled to `[0, 1]` within
-/// the chosen one.
-#[inline(always)]
-fn choose(u: &mut f64, a: f64, b: f64) -> bool {
-    let t = *u * (a + b);
-    let second = t > a || a == 0.0;
-    *u = if second { (t - a) / b } else { t / a }.clamp(0.0, 1.0);
-    second
+/// Where a descent is: the cell `(x, y)` of the level above, and for each
+/// coordinate of `u` the interval `[lo, lo + width)` of the unit square
+/// that the choices so far leave (`u` is not rescaled at each step, as in
+/// Mitsuba's code, but the interval narrowed: the same choices, without a
+/// division per step).
+#[derive(Clone, Copy, Debug)]
+struct Descent {
+    cell: [usize; 2],
+    u: [f64; 2],
+    lo: [f64; 2],
+    width: [f64; 2],
+}
+
+impl Descent {
+    fn new(u: [f64; 2]) -> Self {
+        Descent {
+            cell: [0, 0],
+            u: u.map(|v| v.clamp(0.0, 1.0)),
+            lo: [0.0; 2],
+            width: [1.0; 2],
+        }
+    }
+
+    /// One level down, into the block under the current cell: the row by
+    /// `u[1]` (the first with probability `(v00 + v10) / Σ`), then the
+    /// column of that row by `u[0]`. A row or cell of weight 0 is never
+    /// chosen. Branch-free: the choices are as likely as the weights make
+    /// them, which a branch predictor cannot guess.
+    #[inline(always)]
+    fn step(&mut self, level: &Level) {
+        let [x, y] = self.cell;
+        let block = y * level.blocks_per_row + x;
+        let [row, first, second] = level.splits.get(block).copied().unwrap_or([0.5; 3]);
+        let lower = self.choose(1, row);
+        let right = self.choose(0, [first, second][lower]);
+        self.cell = [2 * x + right, 2 * y + lower];
+    }
+
+    /// 1 when coordinate `k` picks the second part of its interval, split
+    /// at the share `f` of the first: when `u` lies past the split, or the
+    /// first part has weight 0, and the second has weight (`f < 1`); else
+    /// 0. The interval becomes the chosen part.
+    #[inline(always)]
+    fn choose(&mut self, k: usize, f: f64) -> usize {
+        let first = self.width[k] * f;
+        let split = self.lo[k] + first;
+        let second = (f < 1.0) & ((self.u[k] > split) | (f == 0.0));
+        // Arithmetic on 0 or 1 (exact), where a select compiles to a jump.
+        let s = f64::from(u8::from(second));
+        self.lo[k] += s * first;
+        self.width[k] = s * (self.width[k] - first) + (1.0 - s) * first;
+        usize::from(second)
+    }
+
+    /// The cell `(row, col)` reached, and `u` rescaled to `[0, 1]²` in it
+    /// (the middle where the weights' ratios underflowed its interval).
+    fn finish(&self) -> ((usize, usize), [f64; 2]) {
+        let r = std::array::from_fn(|k| {
+            let w = self.width[k];
+            if w > 0.0 {
+                ((self.u[k] - self.lo[k]) / w).clamp(0.0, 1.0)
+            } else {
+                0.5
+            }
+        });
+        ((self.cell[1], self.cell[0]), r)
+    }
 }
 
 #[cfg(test)]
