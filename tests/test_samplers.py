@@ -91,7 +91,7 @@ def test_every_sampler_is_unbiased_and_the_stratified_ones_lower_the_error():
     seeds is within 4 standard errors (of the seeds' spread) of an
     independent render at 1024 spp; the mean squared error per pixel
     against that render is below 0.8x the independent sampler's (measured:
-    0.38-0.60x)."""
+    0.52-0.75x)."""
     scene = mcs.Scene.from_mitsuba(demo_scene(120, 45))
     ref = mcs.render(scene, 1024, seed=99, progress=False)
     ref_mean = float(ref.image.mean())
@@ -144,8 +144,8 @@ def _slope(ns, errors) -> float:
 def test_estimators_converge_faster_with_every_stratified_sampler():
     """Irradiance under the packaged sky (MIS), 16 seeds, n = 2^6 .. 2^16:
     the RMSE against an unbiased reference (the mean of 16 Sobol'
-    estimates at n = 2^20, seeds other than the tested ones) falls as n^-0.48 independently and n^-0.78 to
-    n^-0.84 with the stratified samplers (the integrand has edges: -0.75 is
+    estimates at n = 2^20, seeds other than the tested ones) falls as n^-0.48 independently and n^-0.83 to
+    n^-0.94 with the stratified samplers (the integrand has edges: -0.75 is
     the theory for a 2D discontinuity); every sampler is unbiased at n =
     2^10 (mean over the seeds within 4 standard errors)."""
     env, normal = mcs.EnvMap(), [0.3, 0.9, 0.1]

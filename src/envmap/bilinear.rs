@@ -19,7 +19,7 @@ use crate::simd;
 ///
 /// # Sampling
 /// A patch in proportion to its integral by hierarchical sample warping
-/// ([`Pyramid`]: a 2×2 block per level, row by `u[1]`, column by `u[0]`),
+/// (`envmap::pyramid`: a 2×2 block per level, row by `u[1]`, column by `u[0]`),
 /// then a point in it by the bilinear warp with the rescaled `u`: the
 /// marginal in y, then the conditional in x, each a linear density
 /// inverted in closed form. The same map from `u` to points as Mitsuba's
@@ -90,7 +90,7 @@ impl BilinearGrid {
     }
 
     /// `out[i] = sample(us[i])` for a batch: the patches by
-    /// [`Pyramid::sample_reuse_into`], then their corners prefetched
+    /// `Pyramid::sample_reuse_into`, then their corners prefetched
     /// before any is read. Inlined into the caller's vector-unit dispatch.
     #[inline(always)]
     pub fn sample_into(&self, us: &[[f64; 2]], out: &mut [([f64; 2], f64)]) {

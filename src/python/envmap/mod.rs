@@ -69,7 +69,8 @@ record! {
 ///     maps): piecewise-constant over the cells of the bilinear radiance.
 ///     Both have pdf > 0 wherever eval > 0. "mitsuba" (lat-long only):
 ///     Mitsuba's bilinear density, equal to its envmap emitter's
-///     ``pdf_direction``.
+///     ``pdf_direction``, sampled by Mitsuba's hierarchical warping: the
+///     same ``u`` gives the emitter's direction (to float32 precision).
 /// compensate : bool
 ///     MIS compensation: the mean luminance is subtracted before the
 ///     sampling density is built (Karlik et al. 2019), as Mitsuba's
