@@ -34,8 +34,9 @@ Sampler = Literal["independent", "stratified", "multijitter", "sobol", "zsobol"]
 #: The end of both estimators' docstrings.
 _COMMON_DOC = """heuristic : "power" (default) or "balance"
     sampler : "independent" (default), "stratified", "multijitter", "sobol" or "zsobol"
-        Where sample i's uniform numbers come from (dimensions 0, 1, ... in
-        the order the strategy draws them; see :func:`mcsample.render`).
+        Where sample i's uniform numbers come from (dimensions 0, 1, ...;
+        a BRDF sample's lobe is dimension 0, its direction the pair 1-2;
+        see :func:`mcsample.render`).
         Independent keeps the bits of every earlier release. Under the
         others the n evaluations are stratified together: the estimate
         converges faster, and ``.stderr`` (the error of independent

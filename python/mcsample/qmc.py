@@ -8,8 +8,8 @@ thread count; ``fast_forward`` costs O(1)), and draws float64 or, with
 
 - ``Sobol(d, scramble=True, seed=None)``: Joe and Kuo's direction numbers in
   scipy's Gray-code order. ``scramble=True`` is Owen's nested uniform
-  scrambling (a hash per dimension, Burley 2020, with Vegdahl's
-  constants), ``"lms"`` a random linear matrix scramble with a digital
+  scrambling (a hash per dimension: Vegdahl's Laine-Karras hash, as
+  pbrt-v4's FastOwenScrambler), ``"lms"`` a random linear matrix scramble with a digital
   shift (scipy's kind of scrambling, other random bits), ``False`` the
   plain sequence: ``scipy.stats.qmc.Sobol(d, scramble=False)``'s points,
   bit for bit. At most 2**32 points.

@@ -116,8 +116,10 @@ def render(scene: Scene, spp: int | None = None, *,
         error; best with power-of-two spp).
         Every random decision has its own dimension, in this order: film
         position (2), lens (2), time (1, drawn only when something moves), then per shading point
-        BSDF lobe (1), BSDF direction (2), light choice (1), light position
-        (2), Russian roulette (1).
+        BSDF lobe (1), BSDF direction (2, stratified as a pair), light
+        choice (1; under the direct and path integrators the samplers other
+        than "independent" draw it only when the scene has more than one
+        light), light position (2), Russian roulette (1).
         Under these samplers a pixel's samples are not independent, and
         ``variance`` (that of independent samples) usually overstates the
         error. The nets and blocks above are whole for power-of-two spp.

@@ -49,7 +49,8 @@
 //! table of `pdf` in `polar.rs`; resampling in `convert.rs`; [`CellSampler`]
 //! (one O(1) draw at a time) in `cell_sampler.rs`; the parameterisations,
 //! the texels, the luminance density and Mitsuba's bilinear density in
-//! `mapping.rs`, `image.rs`, `luminance.rs` and `bilinear.rs`.
+//! `mapping.rs`, `image.rs`, `luminance.rs` and `bilinear.rs`; the
+//! hierarchical warping that samples the latter in `pyramid.rs`.
 
 mod batch;
 mod bilinear;

@@ -2,7 +2,8 @@
 //! Mitsuba 3's `Hierarchical2D`): a cell of a 2D table of non-negative
 //! weights is chosen by descending a MIP pyramid of its sums, one 2×2
 //! block per level, the row by `u[1]` and then the column by `u[0]`, each
-//! coordinate rescaled to `[0, 1]` after each choice.
+//! coordinate's interval of `[0, 1]` narrowed to the chosen part after each
+//! choice (Mitsuba rescales `u` to `[0, 1]` instead: the same choices).
 //!
 //! A cell is chosen with probability `w / Σw`, as by a marginal and a
 //! conditional table, but the map from `u` to cells is local at every
@@ -24,6 +25,34 @@ struct Level {
     splits: Vec<[f64; 3]>,
 }
 
+impl Level {
+    /// The level of the row-major `w × h` table `sums` (padded with 0 to
+    /// even sides), and the sums of its blocks (the table of the level
+    /// above).
+    fn of(sums: &[f64], w: usize, h: usize) -> Result<(Self, Vec<f64>)> {
+        let (bw, bh) = (w.div_ceil(2), h.div_ceil(2));
+        let at = |x: usize, y: usize| if x < w && y < h { sums[y * w + x] } else { 0.0 };
+        let mut splits = alloc::with_capacity(bw * bh, "the sampling pyramid")?;
+        let mut above = alloc::with_capacity(bw * bh, "the sampling pyramid")?;
+        for y in (0..bh).map(|y| 2 * y) {
+            for x in (0..bw).map(|x| 2 * x) {
+                let [v00, v10, v01, v11] = [at(x, y), at(x + 1, y), at(x, y + 1), at(x + 1, y + 1)];
+                splits.push([
+                    share(v00 + v10, v01 + v11),
+                    share(v00, v10),
+                    share(v01, v11),
+                ]);
+                above.push(v00 + v10 + v01 + v11);
+            }
+        }
+        let level = Level {
+            blocks_per_row: bw,
+            splits,
+        };
+        Ok((level, above))
+    }
+}
+
 /// The pyramid of a table of weights, finest level first, up to the level
 /// that is one 2×2 block (tables of odd sides padded with cells of weight
 /// 0 at each level, as Mitsuba's).
@@ -39,35 +68,17 @@ impl Pyramid {
     /// # Errors
     /// [`crate::Error::Memory`] when the levels cannot be had.
     pub fn new(weights: &[f64], cols: usize, rows: usize) -> Result<Self> {
-        let (mut w, mut h) = (cols, rows);
-        let mut sums = alloc::copy(weights, "the sampling pyramid")?;
+        let (mut level, mut sums) = Level::of(weights, cols, rows)?;
+        let (mut w, mut h) = (cols.div_ceil(2), rows.div_ceil(2));
         let mut levels = Vec::new();
         loop {
-            let (bw, bh) = (w.div_ceil(2), h.div_ceil(2));
-            let at = |x: usize, y: usize| if x < w && y < h { sums[y * w + x] } else { 0.0 };
-            let mut splits = alloc::with_capacity(bw * bh, "the sampling pyramid")?;
-            let mut above = alloc::with_capacity(bw * bh, "the sampling pyramid")?;
-            for y in (0..bh).map(|y| 2 * y) {
-                for x in (0..bw).map(|x| 2 * x) {
-                    let [v00, v10, v01, v11] =
-                        [at(x, y), at(x + 1, y), at(x, y + 1), at(x + 1, y + 1)];
-                    splits.push([
-                        share(v00 + v10, v01 + v11),
-                        share(v00, v10),
-                        share(v01, v11),
-                    ]);
-                    above.push(v00 + v10 + v01 + v11);
-                }
-            }
             alloc::reserve(&mut levels, 1, "the sampling pyramid")?;
-            levels.push(Level {
-                blocks_per_row: bw,
-                splits,
-            });
-            if bw == 1 && bh == 1 {
+            levels.push(level);
+            if w == 1 && h == 1 {
                 return Ok(Pyramid { levels });
             }
-            (sums, w, h) = (above, bw, bh);
+            (level, sums) = Level::of(&sums, w, h)?;
+            (w, h) = (w.div_ceil(2), h.div_ceil(2));
         }
     }
 
@@ -105,7 +116,8 @@ impl Pyramid {
     }
 }
 
-/// `a / (a + b)`, or 1/2 for a block of weight 0 (never reached).
+/// `a / (a + b)`, or 1/2 for parts of weight 0 (a split no descent uses:
+/// it never enters a block or row of weight 0).
 fn share(a: f64, b: f64) -> f64 {
     if a + b > 0.0 { a / (a + b) } else { 0.5 }
 }
@@ -127,7 +139,8 @@ impl Descent {
     fn new(u: [f64; 2]) -> Self {
         Descent {
             cell: [0, 0],
-            u: u.map(|v| v.clamp(0.0, 1.0)),
+            // A NaN to 0 (`clamp` would keep it).
+            u: u.map(|v| if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) }),
             lo: [0.0; 2],
             width: [1.0; 2],
         }
@@ -141,6 +154,7 @@ impl Descent {
     #[inline(always)]
     fn step(&mut self, level: &Level) {
         let [x, y] = self.cell;
+        debug_assert!(x < level.blocks_per_row, "a cell of the padding");
         let block = y * level.blocks_per_row + x;
         let [row, first, second] = level.splits.get(block).copied().unwrap_or([0.5; 3]);
         let lower = self.choose(1, row);
@@ -204,6 +218,9 @@ mod tests {
         }
         let total: f64 = weights.iter().sum();
         for (c, w) in counts.iter().zip(&weights) {
+            if *w == 0.0 {
+                assert_eq!(*c, 0);
+            }
             let expected = w / total * (n * n) as f64;
             assert!(
                 (*c as f64 - expected).abs() <= 2.0 * n as f64 + 4.0,
@@ -220,11 +237,33 @@ mod tests {
         assert_eq!(p.sample_reuse([0.2, 0.3]), ((0, 0), [0.4, 0.6]));
         assert_eq!(p.sample_reuse([0.7, 0.3]).0, (0, 1));
         assert_eq!(p.sample_reuse([0.2, 0.8]).0, (1, 0));
-        let batch = [[0.2, 0.3], [0.9, 0.9], [0.0, 0.0]];
-        let mut out = [((0, 0), [0.0; 2]); 3];
+    }
+
+    /// The batch draws what one at a time does, on a table of several
+    /// levels; the corners of the square and a NaN land on cells of
+    /// weight, where the first row or cell has none (Mitsuba would take
+    /// the first part at `u = 0` and divide 0 by 0).
+    #[test]
+    fn batches_and_edges() {
+        let (cols, rows) = (5, 3);
+        let mut weights: Vec<f64> = (0..cols * rows).map(|i| (i % 4) as f64).collect();
+        weights[..cols].fill(0.0);
+        let p = Pyramid::new(&weights, cols, rows).unwrap();
+        let batch = [
+            [0.2, 0.3],
+            [0.9, 0.9],
+            [0.0, 0.0],
+            [1.0, 1.0],
+            [f64::NAN, 0.5],
+            [0.5, 0.0],
+        ];
+        let mut out = [((0, 0), [0.0; 2]); 6];
         p.sample_reuse_into(&batch, &mut out);
         for (u, o) in batch.iter().zip(out) {
             assert_eq!(o, p.sample_reuse(*u));
+            let ((row, col), r) = o;
+            assert!(weights[row * cols + col] > 0.0, "{u:?} -> {row}, {col}");
+            assert!(r.iter().all(|v| (0.0..=1.0).contains(v)), "{u:?} -> {r:?}");
         }
     }
 }

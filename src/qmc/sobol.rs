@@ -15,9 +15,10 @@ pub enum Scramble {
     /// scramble=False)`, bit for bit (its first point is the origin).
     None,
     /// Owen's nested uniform scrambling, each dimension with its own seed,
-    /// by a hash (Burley 2020, after Laine and Karras 2011; Vegdahl's
-    /// constants): every point is uniform on `[0, 1)^d` over seeds, and
-    /// every `2^m`-point prefix keeps the sequence's net structure.
+    /// by a hash (Vegdahl's Laine–Karras hash, pbrt-v4's
+    /// `FastOwenScrambler`): every point is uniform on `[0, 1)^d` over
+    /// seeds, and every `2^m`-point prefix keeps the sequence's net
+    /// structure.
     Owen,
     /// A random lower-triangular (in bit significance) binary matrix with
     /// ones on its diagonal applied to every generator matrix, then a

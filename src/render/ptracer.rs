@@ -86,9 +86,7 @@ impl Paths for LightPaths<'_> {
             0.0
         };
         if !settings.hide_emitters {
-            let choice = stream.get1(dims::DIRECT_CHOICE);
-            let [u1, u2] = stream.get2(dims::DIRECT_POSITION);
-            let u = [choice, u1, u2];
+            let u = stream.get1_then2(dims::DIRECT_CHOICE, dims::DIRECT_POSITION);
             let lens = stream.get2(dims::DIRECT_LENS);
             out.extend(seen_directly(scene, u, lens, tau));
         }

@@ -20,8 +20,9 @@
 //!   `PaddedSobolSampler`): every request the first one or two Sobol'
 //!   dimensions (a (0, m, 2)-net for every power-of-two prefix, which
 //!   consecutive higher dimensions are not) at the sample's index shuffled
-//!   by a permutation of `0 .. count`, Owen-scrambled (Burley 2020's hash, Vegdahl's constants),
-//!   each with its own seeds per pixel and dimension;
+//!   by a permutation of `0 .. count`, Owen-scrambled (Vegdahl's
+//!   Laine–Karras hash, pbrt-v4's `FastOwenScrambler`), each with its own
+//!   seeds per pixel and dimension;
 //! - [`Sampler::ZSobol`]: Ahmed and Wronski's (2020) z-ordered Sobol', as
 //!   pbrt-v4's `ZSobolSampler` ([`zorder`]): every request the first two
 //!   Sobol' dimensions at the pixel's Morton index, shuffled by base-4
@@ -287,6 +288,15 @@ impl Stream {
         } else {
             self.stratified2(dim)
         }
+    }
+
+    /// A 1D request at `one`, then a 2D one at `two`, as three numbers
+    /// `[u(one), u(two), u(two + 1)]` (a light's choice and a point on it).
+    #[inline]
+    pub fn get1_then2<F: Real>(&mut self, one: u32, two: u32) -> [F; 3] {
+        let a = self.get1(one);
+        let [b, c] = self.get2(two);
+        [a, b, c]
     }
 
     /// [`Stream::get1`] of the samplers other than the independent one.

@@ -70,7 +70,9 @@ record! {
 ///     Both have pdf > 0 wherever eval > 0. "mitsuba" (lat-long only):
 ///     Mitsuba's bilinear density, equal to its envmap emitter's
 ///     ``pdf_direction``, sampled by Mitsuba's hierarchical warping: the
-///     same ``u`` gives the emitter's direction (to float32 precision).
+///     same ``u`` gives the emitter's direction to float32 precision, but
+///     for the rare ``u`` that Mitsuba's float32 arithmetic sends across
+///     a boundary of its choices.
 /// compensate : bool
 ///     MIS compensation: the mean luminance is subtracted before the
 ///     sampling density is built (Karlik et al. 2019), as Mitsuba's

@@ -93,9 +93,10 @@ pub(super) fn connect(
             return None;
         }
         let k = t as u32 - 2;
-        let choice = stream.get1(dims::at(k, dims::CAMERA_LIGHT));
-        let [u1, u2] = stream.get2(dims::at(k, dims::CAMERA_LIGHT + 1));
-        let u = [choice, u1, u2];
+        let u = stream.get1_then2(
+            dims::at(k, dims::CAMERA_LIGHT),
+            dims::at(k, dims::CAMERA_LIGHT + 1),
+        );
         let ls = scene.sample_light(pt.p, u, None::<fn() -> u64>)?;
         let mut y = match ls.point {
             Some((point, shape)) => Vertex {

@@ -357,9 +357,7 @@ pub(super) fn start_light_path(
     stream: &mut Stream,
     (choice, position, direction): (u32, u32, u32),
 ) -> Option<(Emission, Ray, [f32; 3])> {
-    let choice = stream.get1(choice);
-    let [u1, u2] = stream.get2(position);
-    let u = [choice, u1, u2];
+    let u = stream.get1_then2(choice, position);
     let emission = scene.sample_emission(u)?;
     let (ray, beta) = emitted_ray(scene, emission, stream.get2(direction));
     Some((emission, ray, beta))
