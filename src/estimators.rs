@@ -8,7 +8,8 @@
 //! the plan's [`Sampler`], as the formulas below number them (a BRDF sample:
 //! its lobe dimension 0, its direction the pair 1–2, drawn first; under the
 //! independent sampler the draws' order is their meaning: the PCG32 stream
-//! of `seed` advanced to `i · draws`), so the result is the same bits whatever the thread count.
+//! of `seed` advanced to `i · draws`), so the result is the same bits
+//! whatever the thread count.
 //! With a stratified or low-discrepancy sampler the `f_i` are no longer
 //! independent, and `s/√n` usually overstates the error (it is the error of
 //! independent sampling): compare seeds to measure it.

@@ -367,14 +367,16 @@ impl<F: Real> PhongView<F> {
         (self.eval_with_lobe(wo, lobe), self.pdf_with_lobe(wo, lobe))
     }
 
-    /// A sample as [`PhongView::sample`].
+    /// A sample as [`PhongView::sample`] of `[u[0], u[1], part]`: the part
+    /// by `part`, the direction by the pair `u` (named apart, so that a
+    /// caller cannot take a direction from the part's number).
     #[inline]
-    pub fn sample_one(&self, u: [F; 3]) -> PhongSample<F> {
-        let diffuse = u[2] < self.diffuse_probability;
+    pub fn sample_one(&self, part: F, u: [F; 2]) -> PhongSample<F> {
+        let diffuse = part < self.diffuse_probability;
         let wo = if diffuse {
-            warp::square_to_cosine_hemisphere([u[0], u[1]])
+            warp::square_to_cosine_hemisphere(u)
         } else {
-            let local = warp::square_to_cosine_power_hemisphere([u[0], u[1]], self.exponent);
+            let local = warp::square_to_cosine_power_hemisphere(u, self.exponent);
             self.mirror_frame.to_world(local)
         };
         self.finish_sample(wo, self.lobe_if_glossy(wo), diffuse)
@@ -437,7 +439,7 @@ mod tests {
                     (k as f64 * 0.414_214) % 1.0,
                     (k as f64 * 0.732_051) % 1.0,
                 ];
-                let (a, b) = (view.sample(u), view.sample_one(u));
+                let (a, b) = (view.sample(u), view.sample_one(u[2], [u[0], u[1]]));
                 assert_eq!(a.wo, b.wo);
                 assert_eq!(a.component, b.component);
                 assert!((a.pdf - b.pdf).abs() <= 1e-12 * a.pdf);
@@ -598,7 +600,7 @@ mod tests {
                 (k as f64 * 0.732_051) % 1.0,
                 u2,
             ];
-            for s in [view.sample(u), view.sample_one(u)] {
+            for s in [view.sample(u), view.sample_one(u[2], [u[0], u[1]])] {
                 assert_eq!(s.component, u8::from(u2 >= pd), "u = {u:?}");
                 let f = p.eval(wi, s.wo);
                 let cos = s.wo[2].max(0.0);

@@ -515,11 +515,11 @@ impl Bounce<'_> {
         }
 
         // The direction from the 2D request, the part from the 1D one
-        // (`sample_one`'s `u[0..2]` and `u[2]`; drawn in this order, the
-        // independent sampler's numbers come in the argument's order).
-        let [u1, u2] = numbers.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
+        // (drawn in this order, the independent sampler's numbers are
+        // those of `PhongView::sample`'s `[u0, u1, part]`).
+        let u = numbers.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
         let component = numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT));
-        let s = view.sample_one([u1, u2, component]);
+        let s = view.sample_one(component, u);
         if s.weight.iter().all(|&v| v <= 0.0) {
             return false;
         }

@@ -186,9 +186,8 @@ pub(super) fn walk(
         } else {
             (dims::CAMERA_BSDF, dims::CAMERA_ROULETTE)
         };
-        let [u1, u2] = stream.get2(dims::at(k, bsdf_u));
-        let u = [u1, u2, stream.get1(dims::at(k, bsdf_u + 2))];
-        let s = view.sample_one(u);
+        let u = stream.get2(dims::at(k, bsdf_u));
+        let s = view.sample_one(stream.get1(dims::at(k, bsdf_u + 2)), u);
         if s.weight.iter().all(|&w| w <= 0.0) {
             return;
         }
