@@ -1,8 +1,8 @@
 //! The batch engine: one way to run a kernel over `n` items on all cores.
 //!
 //! A batch of `n` items is cut into chunks of [`CHUNK`] items (boundaries at
-//! multiples of `CHUNK`), which rayon runs in any order on a pool of
-//! [`num_threads`] threads. Kernels are pure functions of the item index (and,
+//! multiples of `CHUNK`), which the threads of a rayon pool of
+//! [`num_threads`] threads take in turn. Kernels are pure functions of the item index (and,
 //! for kernels that draw randomness, of a generator advanced to that index),
 //! so the result is bit-identical whatever the number of threads.
 //!
@@ -13,8 +13,8 @@
 use crate::error::{Error, Result};
 use rayon::ThreadPool;
 use std::ops::Range;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, OnceLock};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError};
 
 /// Items per work unit. Batches up to twice this size run on the calling
 /// thread, where starting the pool would cost more than it saves.
@@ -163,7 +163,12 @@ fn pool(threads: usize) -> Result<Arc<ThreadPool>> {
 
 /// Runs `kernel(range, outputs)` over items `0..n`, in chunks of [`CHUNK`]
 /// items on the pool (or at once on this thread for small batches or one
-/// thread). `outputs` holds one element per item; each call gets the
+/// thread). Every thread of the pool is started at once (a broadcast) and
+/// takes chunks in order until none are left: rayon's work splitting wakes
+/// its sleeping threads one by one as work is split, and after the pool
+/// has idled for a millisecond or more, a batch of a few milliseconds often ran on one
+/// thread to its end (2^20 Sobol' points in 8 dimensions: 7.7 ms on two
+/// threads after a 0.1 s pause, as on one; 3.6 ms without the pause). `outputs` holds one element per item; each call gets the
 /// elements of its range. The kernel returns whether every input of its
 /// range was valid; the result is true when all were.
 ///
@@ -179,7 +184,45 @@ where
         return Ok(kernel(0..n, outputs));
     }
     let pool = pool(threads)?;
-    Ok(pool.install(|| split(0..n, outputs, &kernel)))
+    let chunks = Mutex::new(Chunks {
+        next: 0,
+        n,
+        rest: Some(outputs),
+    });
+    let valid = AtomicBool::new(true);
+    pool.broadcast(|_| {
+        loop {
+            let next = chunks.lock().unwrap_or_else(PoisonError::into_inner).take();
+            let Some((range, outputs)) = next else { break };
+            if !kernel(range, outputs) {
+                valid.store(false, Ordering::Relaxed);
+            }
+        }
+    });
+    Ok(valid.into_inner())
+}
+
+/// The chunks of a batch not yet taken: items `next..n` and their outputs.
+struct Chunks<O> {
+    next: usize,
+    n: usize,
+    rest: Option<O>,
+}
+
+impl<O: Outputs> Chunks<O> {
+    /// The next chunk's items and outputs, if any are left.
+    fn take(&mut self) -> Option<(Range<usize>, O)> {
+        let rest = self.rest.take()?;
+        let start = self.next;
+        let len = CHUNK.min(self.n - start);
+        self.next = start + len;
+        if self.next == self.n {
+            return Some((start..self.n, rest));
+        }
+        let (chunk, rest) = rest.split_at_item(len);
+        self.rest = Some(rest);
+        Some((start..start + len, chunk))
+    }
 }
 
 /// Runs `f` inside mcsample's pool, so that rayon's parallel iterators in
@@ -193,25 +236,6 @@ pub fn install<R: Send>(f: impl FnOnce() -> R + Send) -> Result<R> {
     // Also for one thread: outside the pool, rayon's iterators would run on
     // its global pool, one thread per core.
     Ok(pool(num_threads()?)?.install(f))
-}
-
-fn split<O, K>(range: Range<usize>, outputs: O, kernel: &K) -> bool
-where
-    O: Outputs,
-    K: Fn(Range<usize>, O) -> bool + Sync,
-{
-    let len = range.len();
-    if len <= CHUNK {
-        return kernel(range, outputs);
-    }
-    let mid = len.div_ceil(CHUNK) / 2 * CHUNK;
-    let (left, right) = outputs.split_at_item(mid);
-    let at = range.start + mid;
-    let (a, b) = rayon::join(
-        || split(range.start..at, left, kernel),
-        || split(at..range.end, right, kernel),
-    );
-    a && b
 }
 
 #[cfg(test)]

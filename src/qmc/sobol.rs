@@ -45,10 +45,13 @@ pub struct Sobol {
     keys: Vec<u32>,
 }
 
-/// Values per block of [`Sobol::fill`]: the walk writes a block's bits, and
-/// the scramble and the conversion to floats then run over it in one
-/// vectorised pass.
-const BLOCK_VALUES: usize = 4096;
+/// Values in the table of [`Sobol::fill`] (at most): 16 KiB of bits, which
+/// stay in the first-level cache while a block's rows are written.
+const TABLE_VALUES: usize = 4096;
+
+/// Rows in the pattern [`Sobol::fill`] XORs over the table in one pass: 8,
+/// so that a pass is a whole number of vectors of up to 8 lanes whatever `d`.
+const PATTERN_ROWS: usize = 8;
 
 impl Sobol {
     /// The first `dims` dimensions of the sequence, scrambled by `scramble`
@@ -112,48 +115,64 @@ impl Sobol {
     /// Points `first ..` into `out` (row-major, `dims` values a row, as many
     /// rows as fit), on all cores; the same bits at any thread count.
     ///
+    /// Blocks of `R` rows (a power of two, `R·d ≤` [`TABLE_VALUES`]) that start
+    /// at a multiple of `R` differ only in their high bits: for `i = B·R + r`,
+    /// `g(i) = g(B·R) ⊕ g(r)`, so point `i` is `x_{B·R} ⊕ T[r]` with the table
+    /// `T[r] = ⊕_{b : bit b of g(r) set} v_b` (the low `log2 R` columns) the
+    /// same for every block. A block is one vectorised pass of XORs with its
+    /// first point over the table, then the scramble and the conversion; the
+    /// next block's first point is `x_{B·R} ⊕ T[R − 1] ⊕ v_{tz((B+1)·R)}` (the
+    /// Gray-code step into it).
+    ///
     /// # Errors
     /// [`crate::Error::Integer`] if the points would pass index `2^32 − 1`, or
     /// if `out` does not hold whole rows.
     pub fn fill<F: Real>(&self, first: u64, out: &mut [F]) -> Result<()> {
         let d = self.dims;
         let n = check_range(out.len(), d, first, 1 << BITS)?;
-        let block_rows = (BLOCK_VALUES / d).max(1);
-        // The keys of a block's values, row after row.
-        let keys: Vec<u32> = self
-            .keys
-            .iter()
-            .copied()
-            .cycle()
-            .take(block_rows * d)
-            .collect();
-        parallel::for_each_chunk(n, Rows::new(out, d), |range, rows| {
-            let start = (first + range.start as u64) as u32;
-            let mut x: Vec<u32> = (0..d).map(|j| self.unscrambled(start, j)).collect();
-            let mut bits = vec![0u32; block_rows * d];
-            for (b, block) in rows.values.chunks_mut(block_rows * d).enumerate() {
-                let bits = &mut bits[..block.len()];
-                for (r, row_bits) in bits.chunks_exact_mut(d).enumerate() {
-                    let r = (b * block_rows + r) as u32;
-                    if r > 0 {
-                        // g(i) ⊕ g(i − 1) is the lowest set bit of i. (One
-                        // pass that steps and stores: a separate copy of a
-                        // short row is a call to memmove.)
-                        let bit = (start + r).trailing_zeros() as usize;
-                        let step = x.iter_mut().zip(self.column(bit));
-                        for ((x, v), out) in step.zip(row_bits.iter_mut()) {
-                            *x ^= v;
-                            *out = *x;
-                        }
-                    } else {
-                        row_bits.copy_from_slice(&x);
+        let rows = prev_power_of_two((TABLE_VALUES / d).max(1));
+        let mut table = vec![0u32; rows * d];
+        for r in 1..rows {
+            let (before, row) = table.split_at_mut(r * d);
+            let step = row[..d].iter_mut().zip(&before[(r - 1) * d..]);
+            for ((t, &previous), &v) in step.zip(self.column(r.trailing_zeros() as usize)) {
+                *t = previous ^ v;
+            }
+        }
+        let keys = repeat_rows(&self.keys, PATTERN_ROWS);
+        parallel::for_each_chunk(n, Rows::new(out, d), |range, rows_out| {
+            let start = first + range.start as u64;
+            let mut block = start / rows as u64;
+            let mut r = (start % rows as u64) as usize;
+            let mut base: Vec<u32> = (0..d)
+                .map(|j| self.unscrambled((block * rows as u64) as u32, j))
+                .collect();
+            let mut pattern = vec![0u32; PATTERN_ROWS * d];
+            let mut values = rows_out.values;
+            while !values.is_empty() {
+                let take = (rows - r).min(values.len() / d);
+                let (now, later) = values.split_at_mut(take * d);
+                match self.scramble {
+                    Scramble::Owen => {
+                        fill_pattern(&mut pattern, &base, |b, _| b);
+                        xor_finish(now, &table[r * d..], &pattern, &keys, owen);
+                    }
+                    Scramble::None | Scramble::LinearMatrix => {
+                        fill_pattern(&mut pattern, &base, |b, j| b ^ self.keys[j]);
+                        xor_finish(now, &table[r * d..], &pattern, &keys, |x, _| x);
                     }
                 }
-                match self.scramble {
-                    Scramble::Owen => finish(block, bits, &keys, owen),
-                    Scramble::None | Scramble::LinearMatrix => {
-                        finish(block, bits, &keys, |x, key| x ^ key)
+                values = later;
+                if !values.is_empty() {
+                    // Into the next block: its first point is one Gray-code
+                    // step from this block's last.
+                    block += 1;
+                    let bit = (block * rows as u64).trailing_zeros() as usize;
+                    let last = &table[(rows - 1) * d..];
+                    for ((b, &t), &v) in base.iter_mut().zip(last).zip(self.column(bit)) {
+                        *b ^= t ^ v;
                     }
+                    r = 0;
                 }
             }
             true
@@ -162,15 +181,49 @@ impl Sobol {
     }
 }
 
-/// `out[k] = step(bits[k], keys[k])` as a float in `[0, 1)`, in a loop
-/// compiled for the widest vector unit.
+/// The largest power of two at most `n ≥ 1`.
+fn prev_power_of_two(n: usize) -> usize {
+    1 << (usize::BITS - 1 - n.leading_zeros())
+}
+
+/// `row` repeated `times` times.
+fn repeat_rows(row: &[u32], times: usize) -> Vec<u32> {
+    row.iter()
+        .copied()
+        .cycle()
+        .take(row.len() * times)
+        .collect()
+}
+
+/// `pattern`, [`PATTERN_ROWS`] rows of `base.len()` values: `f(base[j], j)`
+/// in column `j` of every row.
+fn fill_pattern(pattern: &mut [u32], base: &[u32], f: impl Fn(u32, usize) -> u32) {
+    for row in pattern.chunks_exact_mut(base.len()) {
+        for (j, (p, &b)) in row.iter_mut().zip(base).enumerate() {
+            *p = f(b, j);
+        }
+    }
+}
+
+/// `out[k] = step(table[k] ⊕ pattern[k mod P], keys[k mod P])` as a float in `[0, 1)`,
+/// `P` the pattern's length (whole rows), in a loop compiled for the widest vector unit.
 #[inline(always)]
-fn finish<F: Real>(out: &mut [F], bits: &[u32], keys: &[u32], step: impl Fn(u32, u32) -> u32) {
+fn xor_finish<F: Real>(
+    out: &mut [F],
+    table: &[u32],
+    pattern: &[u32],
+    keys: &[u32],
+    step: impl Fn(u32, u32) -> u32,
+) {
+    let p = pattern.len();
     simd::dispatch(
         #[inline(always)]
         |_| {
-            for ((value, &x), &key) in out.iter_mut().zip(bits).zip(keys) {
-                *value = F::from_random_bits(step(x, key));
+            for (out, table) in out.chunks_mut(p).zip(table.chunks(p)) {
+                let lanes = out.iter_mut().zip(table).zip(pattern).zip(keys);
+                for (((value, &t), &x), &key) in lanes {
+                    *value = F::from_random_bits(step(t ^ x, key));
+                }
             }
         },
     );
@@ -261,11 +314,18 @@ mod tests {
     /// points computed one at a time.
     #[test]
     fn fill_agrees_with_bits_from_any_start() {
-        for scramble in [Scramble::None, Scramble::Owen, Scramble::LinearMatrix] {
-            let s = Sobol::new(5, scramble, 7).unwrap();
+        // 5 dimensions: tables of 512 rows; 600: of 4 rows; 5000: of one.
+        for (scramble, d) in [
+            (Scramble::None, 5),
+            (Scramble::Owen, 5),
+            (Scramble::LinearMatrix, 5),
+            (Scramble::Owen, 600),
+            (Scramble::None, 5000),
+        ] {
+            let s = Sobol::new(d, scramble, 7).unwrap();
             let first = 123_456;
-            let out = points(&s, first, 70_000);
-            for (r, row) in out.chunks(5).enumerate().step_by(997) {
+            let out = points(&s, first, 70_000 * 5 / d);
+            for (r, row) in out.chunks(d).enumerate().step_by(97) {
                 for (j, &x) in row.iter().enumerate() {
                     let bits = s.bits((first + r as u64) as u32, j);
                     assert_eq!(x, f64::from(bits) / 2f64.powi(32));
