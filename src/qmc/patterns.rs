@@ -9,7 +9,7 @@
 use super::{Rows, check_dims, check_range};
 use crate::error::Result;
 use crate::math::Real;
-use crate::parallel;
+use crate::{parallel, simd};
 
 /// Dimensions a pattern accepts.
 pub const MAX_DIMENSIONS: usize = 1 << 16;
@@ -81,39 +81,92 @@ impl Patterns {
     pub fn fill<F: Real>(&self, draw: u64, out: &mut [F]) -> Result<()> {
         let d = self.dims;
         let n = check_range(out.len(), d, 0, MAX_POINTS)? as u32;
-        let key = mix64(self.seed ^ mix64(draw));
-        // One 32-bit seed per dimension (LHS) or pair (the others).
-        let layouts: Vec<Layout> = (0..d as u64)
-            .map(|j| Layout::new(n, (mix64(key ^ j) >> 32) as u32, self.pattern))
-            .collect();
-        let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
+        let layouts = self.layouts(draw, n);
         parallel::for_each_chunk(n as usize, Rows::new(out, d), |range, rows| {
-            for (s, row) in (range.start as u32..).zip(rows.chunks_mut()) {
-                self.point(s, &layouts, row, unit);
+            if let Pattern::LatinHypercube { centered } = self.pattern {
+                latin_hypercube(range.start as u32, &layouts, centered, rows.values);
+            } else {
+                for (s, row) in (range.start as u32..).zip(rows.chunks_mut()) {
+                    self.pairs(s, &layouts, row);
+                }
             }
             true
         })
         .map(|_| ())
     }
 
-    /// Point `s` into `row` (`layouts`: one per seed).
-    fn point<F>(&self, s: u32, layouts: &[Layout], row: &mut [F], unit: impl Fn(f64) -> F) {
-        match self.pattern {
-            Pattern::LatinHypercube { centered } => {
-                for (x, l) in row.iter_mut().zip(layouts) {
-                    *x = unit(l.single(s, centered));
-                }
+    /// The layouts of pattern `draw` of `n` points: one 32-bit seed per
+    /// dimension (LHS) or pair (the others).
+    fn layouts(&self, draw: u64, n: u32) -> Vec<Layout> {
+        let key = mix64(self.seed ^ mix64(draw));
+        (0..self.dims as u64)
+            .map(|j| Layout::new(n, (mix64(key ^ j) >> 32) as u32, self.pattern))
+            .collect()
+    }
+
+    /// Point `s` of a pattern by pairs of dimensions into `row`
+    /// (`layouts`: one per pair).
+    fn pairs<F: Real>(&self, s: u32, layouts: &[Layout], row: &mut [F]) {
+        let unit = |x: f64| F::c(x).min(F::ONE_MINUS_EPSILON);
+        let mut pairs = row.chunks_exact_mut(2);
+        for (pair, l) in pairs.by_ref().zip(layouts) {
+            let (x, y) = l.pair(s, self.pattern);
+            pair[0] = unit(x);
+            pair[1] = unit(y);
+        }
+        if let [last] = pairs.into_remainder() {
+            *last = unit(layouts[self.dims / 2].single(s, false));
+        }
+    }
+}
+
+/// Rows in a tile of [`latin_hypercube`].
+const TILE_ROWS: usize = 256;
+
+/// Points `first ..` of a Latin hypercube into `values` (whole rows, one
+/// layout a dimension), [`Layout::single`] of each: a tile of rows one
+/// dimension after another, each column computed in one vectorised pass
+/// (the permutation's step, the jitter, the division), then the few
+/// indices the permutation's cycle walk must step again, then stored.
+fn latin_hypercube<F: Real>(first: u32, layouts: &[Layout], centered: bool, values: &mut [F]) {
+    let d = layouts.len();
+    let mut column = [0.0f64; TILE_ROWS];
+    let mut steps = [0u32; TILE_ROWS];
+    for (t, tile) in values.chunks_mut(TILE_ROWS * d).enumerate() {
+        let first = first + (t * TILE_ROWS) as u32;
+        let rows = tile.len() / d;
+        for (j, l) in layouts.iter().enumerate() {
+            let (n, p) = (l.n, l.p);
+            let (column, steps) = (&mut column[..rows], &mut steps[..rows]);
+            simd::dispatch(
+                #[inline(always)]
+                |_| {
+                    for (s, step) in (first..).zip(steps.iter_mut()) {
+                        *step = kensler_step(s, n, p);
+                    }
+                },
+            );
+            for step in steps.iter_mut().filter(|step| **step >= n) {
+                *step = walk(*step, n, p);
             }
-            Pattern::Stratified | Pattern::MultiJitter => {
-                let mut pairs = row.chunks_exact_mut(2);
-                for (pair, l) in pairs.by_ref().zip(layouts) {
-                    let (x, y) = l.pair(s, self.pattern);
-                    pair[0] = unit(x);
-                    pair[1] = unit(y);
-                }
-                if let [last] = pairs.into_remainder() {
-                    *last = unit(layouts[self.dims / 2].single(s, false));
-                }
+            let (key, rotation, scale) = (lowbias32(p), l.rotations[0], f64::from(n));
+            let value =
+                move |k: u32, jitter: f64| (f64::from(rotate(k, n, rotation)) + jitter) / scale;
+            simd::dispatch(
+                #[inline(always)]
+                |_| {
+                    let cells = steps.iter().zip(column.iter_mut());
+                    if centered {
+                        cells.for_each(|(&k, x)| *x = value(k, 0.5));
+                    } else {
+                        for (s, (&k, x)) in (first..).zip(cells) {
+                            *x = value(k, hashed_jitter(s, key));
+                        }
+                    }
+                },
+            );
+            for (row, &x) in tile.chunks_exact_mut(d).zip(column.iter()) {
+                row[j] = F::c(x).min(F::ONE_MINUS_EPSILON);
             }
         }
     }
@@ -254,7 +307,8 @@ pub(crate) fn walk(mut i: u32, len: u32, seed: u32) -> u32 {
 #[inline(always)]
 pub(crate) fn rotate(i: u32, len: u32, rotation: u32) -> u32 {
     let sum = u64::from(i) + u64::from(rotation);
-    sum.checked_sub(u64::from(len)).unwrap_or(sum) as u32
+    let len = u64::from(len);
+    (if sum >= len { sum - len } else { sum }) as u32
 }
 
 /// One step of Kensler's permutation: a bijection of the bits of `i`
@@ -287,10 +341,17 @@ pub(crate) fn kensler_step(mut i: u32, len: u32, seed: u32) -> u32 {
 /// A uniform jitter in `[0, 1)` for index `i` and seed `p`: 32 bits of
 /// Wellons' `lowbias32` hash, as a multiple of `2^−32`.
 pub(crate) fn jitter(i: u32, p: u32) -> f64 {
-    f64::from(lowbias32(i ^ lowbias32(p))) * (1.0 / 4_294_967_296.0)
+    hashed_jitter(i, lowbias32(p))
+}
+
+/// [`jitter`] with the seed's hash `key = lowbias32(p)` computed once.
+#[inline(always)]
+fn hashed_jitter(i: u32, key: u32) -> f64 {
+    f64::from(lowbias32(i ^ key)) * (1.0 / 4_294_967_296.0)
 }
 
 /// Chris Wellons' `lowbias32` integer hash.
+#[inline(always)]
 fn lowbias32(mut x: u32) -> u32 {
     x ^= x >> 16;
     x = x.wrapping_mul(0x7feb_352d);
@@ -349,6 +410,24 @@ mod tests {
         for centered in [false, true] {
             let x = pattern(Pattern::LatinHypercube { centered }, 3, 1000);
             assert!((0..3).all(|j| one_per_interval(&x, 3, j, 1000)));
+        }
+    }
+
+    /// The Latin hypercube's columns, filled on several threads in tiles
+    /// (a length whose permutation walks its cycles, and a power of two),
+    /// are its points one at a time.
+    #[test]
+    fn latin_hypercube_fill_agrees_with_single_points() {
+        for (centered, n) in [(false, 70_001u32), (true, 70_001), (false, 1 << 16)] {
+            let patterns = Patterns::new(Pattern::LatinHypercube { centered }, 3, 5).unwrap();
+            let mut out = vec![0.0f64; n as usize * 3];
+            patterns.fill(9, &mut out).unwrap();
+            let layouts = patterns.layouts(9, n);
+            for (s, row) in (0..n).zip(out.chunks(3)) {
+                for (&x, l) in row.iter().zip(&layouts) {
+                    assert_eq!(x, l.single(s, centered).min(f64::ONE_MINUS_EPSILON));
+                }
+            }
         }
     }
 
