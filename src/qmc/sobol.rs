@@ -115,7 +115,7 @@ impl Sobol {
     /// Points `first ..` into `out` (row-major, `dims` values a row, as many
     /// rows as fit), on all cores; the same bits at any thread count.
     ///
-    /// Blocks of `R` rows (a power of two, `R·d ≤` [`TABLE_VALUES`]) that start
+    /// Blocks of `R` rows (a power of two, `R·d ≤ 4096`) that start
     /// at a multiple of `R` differ only in their high bits: for `i = B·R + r`,
     /// `g(i) = g(B·R) ⊕ g(r)`, so point `i` is `x_{B·R} ⊕ T[r]` with the table
     /// `T[r] = ⊕_{b : bit b of g(r) set} v_b` (the low `log2 R` columns) the
