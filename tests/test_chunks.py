@@ -17,7 +17,7 @@ import mcsample as mcs
 from mcsample.demo import demo_scene
 from scenes import lit_room
 
-SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "zsobol")
+SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "ldsampler", "zsobol")
 FIELDS = ("image", "variance", "luminance_variance")
 
 

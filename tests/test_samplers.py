@@ -15,7 +15,7 @@ import mcsample as mcs
 from mcsample.demo import demo_scene
 from scenes import ground, sensor, sphere_on_plane, sunless_sky
 
-SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "zsobol")
+SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "ldsampler", "zsobol")
 STRATIFIED = SAMPLERS[1:]
 
 #: Sums of the image weighted by (k mod 7) + 1 (k the flat index), of
@@ -67,12 +67,13 @@ def test_independent_estimators_keep_their_bits():
 
 #: The same sums for the other samplers (direct and path, MIS), as of
 #: c5a47b8: the BSDF's direction drawn as a 2D request, Owen scrambling by
-#: Vegdahl's hash, the light's choice not drawn with one light. A change
-#: of any sampler's numbers changes these.
+#: Vegdahl's hash, the light's choice not drawn with one light ("ldsampler"
+#: as of its introduction). A change of any sampler's numbers changes these.
 PINNED_STRATIFIED = {
     ("stratified", "direct"): 9225.903692432054, ("stratified", "path"): 10979.67584848404,
     ("multijitter", "direct"): 10542.918340805554, ("multijitter", "path"): 12311.753103338648,
     ("sobol", "direct"): 10672.759597992175, ("sobol", "path"): 12457.793382707983,
+    ("ldsampler", "direct"): 10123.992950267653, ("ldsampler", "path"): 11787.720492241904,
     ("zsobol", "direct"): 9560.61211070366, ("zsobol", "path"): 11472.300339601934}
 
 
@@ -292,7 +293,7 @@ def test_bad_sampler_arguments():
     with pytest.raises(ValueError, match="sampler"):
         mcs.render(scene, 1, sampler="halton", progress=False)
     with pytest.raises(ValueError, match="sampler"):
-        mcs.estimators.irradiance(mcs.EnvMap(), [0, 0, 1], 10, sampler="ldsampler")
+        mcs.estimators.irradiance(mcs.EnvMap(), [0, 0, 1], 10, sampler="orthogonal")
     with pytest.raises(ValueError, match=r"n = 4294967296.*sampler=\"sobol\""):
         mcs.estimators.irradiance(mcs.EnvMap(), [0, 0, 1], 2**32, sampler="sobol")
     with pytest.raises(ValueError, match=r"spp = 1073741825.*stratified"):
@@ -301,7 +302,7 @@ def test_bad_sampler_arguments():
 
 MITSUBA_TYPES = {"independent": "independent", "stratified": "stratified",
                  "multijitter": "multijitter", "orthogonal": "multijitter",
-                 "ldsampler": "sobol"}
+                 "ldsampler": "ldsampler"}
 
 
 @pytest.mark.parametrize("kind", list(MITSUBA_TYPES))

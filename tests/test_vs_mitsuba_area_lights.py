@@ -32,7 +32,7 @@ from scenes import LIGHT_PLACES, LIGHT_SHAPES, area_lit_floor, lit_room
 pytestmark = pytest.mark.mitsuba
 
 STRATEGIES = ("emitter", "bsdf", "mis")
-SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "zsobol")
+SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "ldsampler", "zsobol")
 
 #: Samples per pixel of mcsample's renders: BSDF sampling finds a small,
 #: distant light rarely, so it takes many more.

@@ -27,7 +27,7 @@ from scenes import (diffuse_sphere_under_sky, ground, icosphere, mesh_scene, pho
 pytestmark = pytest.mark.mitsuba
 
 SPP = 256
-SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "zsobol")
+SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "ldsampler", "zsobol")
 
 _references: dict = {}
 

@@ -5,7 +5,7 @@ point, and their quadrature references.
   :func:`reflected_radiance` from a Phong surface ("bsdf", "emitter", "mis")
   run in Rust on all cores; same seed, same bits on any thread count.
   ``sampler=`` picks where the uniform numbers come from: "independent"
-  (default), "stratified", "multijitter", "sobol" or "zsobol" (see
+  (default), "stratified", "multijitter", "sobol", "ldsampler" or "zsobol" (see
   :mod:`mcsample.qmc` and :func:`mcsample.render`).
   "emitter" samples the environment map ("envmap" is accepted as the same);
   MIS weights by the power heuristic unless ``heuristic="balance"`` (the
@@ -29,11 +29,11 @@ from ._core.estimators import Estimate, estimate as _estimate
 from .seeds import SeedLike
 from .stats import EnvMapDomain
 
-Sampler = Literal["independent", "stratified", "multijitter", "sobol", "zsobol"]
+Sampler = Literal["independent", "stratified", "multijitter", "sobol", "ldsampler", "zsobol"]
 
 #: The end of both estimators' docstrings.
 _COMMON_DOC = """heuristic : "power" (default) or "balance"
-    sampler : "independent" (default), "stratified", "multijitter", "sobol" or "zsobol"
+    sampler : "independent" (default), "stratified", "multijitter", "sobol", "ldsampler" or "zsobol"
         Where sample i's uniform numbers come from (dimensions 0, 1, ...;
         a BRDF sample's lobe is dimension 0, its direction the pair 1-2;
         see :func:`mcsample.render`).

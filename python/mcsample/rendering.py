@@ -101,17 +101,20 @@ def render(scene: Scene, spp: int | None = None, *,
         Leave out emitters seen straight from the camera (area lights and
         the environment), as Mitsuba's ``hide_emitters``. Default: the
         scene dict's integrator, else False.
-    sampler : "independent", "stratified", "multijitter", "sobol" or "zsobol", optional
+    sampler : "independent", "stratified", "multijitter", "sobol", "ldsampler" or "zsobol", optional
         Where each pixel's uniform numbers come from. Default: the scene
         dict's sensor sampler (Mitsuba's ``stratified``, ``multijitter``,
-        ``orthogonal`` (as "multijitter") and ``ldsampler`` (as "sobol")),
+        ``orthogonal`` (as "multijitter") and ``ldsampler``),
         else "independent": PCG32 numbers, a generator for each sample
         (seeded by its pixel and its index in the pixel's sequence).
         "stratified" and "multijitter" jitter the strata of a grid (Mitsuba's
         samplers of those names); "sobol" is padded Owen-scrambled Sobol'
         (pbrt-v4's PaddedSobolSampler: each request a (0, m, 2)-net of the
         first two Sobol' dimensions, its index shuffled, scrambled per pixel
-        and dimension); "zsobol" is pbrt-v4's z-ordered Sobol' (the same
+        and dimension); "ldsampler" is the same shuffled nets randomised by a
+        random XOR of their bits (a digital shift) instead of Owen's scramble,
+        as Mitsuba's ``ldsampler`` (Kollig and Keller's scrambled
+        (0, 2)-sequence); "zsobol" is pbrt-v4's z-ordered Sobol' (the same
         nets, ordered along a Morton curve over the screen: blue-noise
         error; best with power-of-two spp).
         Every random decision has its own dimension, in this order: film
@@ -134,7 +137,7 @@ def render(scene: Scene, spp: int | None = None, *,
         as one render of ``S`` spp with the same seed and settings.
     total_spp : int, optional
         Length of the sequence the chunk is part of (default
-        ``first_sample + spp``): the "stratified", "multijitter", "sobol"
+        ``first_sample + spp``): the "stratified", "multijitter", "sobol", "ldsampler"
         and "zsobol" samplers lay their patterns over it, so the chunks of
         one render must all give it (the independent sampler ignores it: an
         independent render can be continued with more samples).

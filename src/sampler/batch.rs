@@ -2,13 +2,14 @@
 //! get from [`Stream::get1`] or [`Stream::get2`], bit for bit, at SIMD width
 //! for the Sobol' family.
 //!
-//! A request of [`Sampler::Sobol`] or [`Sampler::ZSobol`] is a chain of
+//! A request of the Sobol' family ([`Sampler::Sobol`],
+//! [`Sampler::LowDiscrepancy`], [`Sampler::ZSobol`]) is a chain of
 //! integer hashes (the index permutation or z-order shuffle, the second
-//! dimension's matrix, two Owen scrambles, a bit reversal) whose latency a
+//! dimension's matrix, two scrambles, a bit reversal) whose latency a
 //! scalar caller waits on between its other work. Here each stream first
 //! gives its cached key per request, then the hashes run over all the
 //! requests in loops the compiler vectorises ([`crate::simd::dispatch`]):
-//! the Kensler step of every [`Sampler::Sobol`] index, the cycle walk
+//! the Kensler step of every shuffled index (all but [`Sampler::ZSobol`]), the cycle walk
 //! and rotation (no step when the count is a power of two above 1), then
 //! the scrambled points. The other samplers' requests are drawn one by one.
 //!
@@ -16,9 +17,10 @@
 //! request of the same dimension ([`Stream::get1`] scrambles the same first
 //! coordinate with the same seed), so every request is drawn as a pair.
 
-use super::{Sampler, Stream, scrambled_pair};
+use super::{Sampler, Stream, randomized_pair, zorder};
 use crate::alloc;
 use crate::error::Result;
+use crate::math::Real;
 use crate::qmc::patterns::{kensler_step, rotate, walk};
 use crate::simd::dispatch;
 
@@ -45,11 +47,11 @@ pub struct Drawn {
     /// `[1]` then meaningless).
     pub values: Vec<[f32; 2]>,
     /// The Sobol' index of each request: the sample's index until the
-    /// permutation of [`Sampler::Sobol`] replaces it.
+    /// permutation of [`Sampler::Sobol`] or [`Sampler::LowDiscrepancy`] replaces it.
     index: Vec<u64>,
     /// The scrambles' seeds (low half the first coordinate's).
     seed: Vec<u64>,
-    /// [`Sampler::Sobol`]: the permutation's seed, its rotation and the
+    /// [`Sampler::Sobol`], [`Sampler::LowDiscrepancy`]: the permutation's seed, its rotation and the
     /// stream's count.
     permutation: Vec<[u32; 3]>,
 }
@@ -79,7 +81,10 @@ impl Drawn {
         if sampler == Sampler::Independent {
             return Ok(());
         }
-        if !matches!(sampler, Sampler::Sobol | Sampler::ZSobol) {
+        if !matches!(
+            sampler,
+            Sampler::Sobol | Sampler::LowDiscrepancy | Sampler::ZSobol
+        ) {
             self.values.extend(requests.iter().map(|r| {
                 let stream = &mut streams[r.stream as usize];
                 stream.start(r.index);
@@ -105,7 +110,7 @@ impl Drawn {
             v.resize(n, 0);
         }
         permutation.clear();
-        if sampler == Sampler::Sobol {
+        if sampler != Sampler::ZSobol {
             alloc::reserve(permutation, n, WHAT)?;
             permutation.resize(n, [0; 3]);
         }
@@ -137,7 +142,8 @@ impl Drawn {
                     *i = u64::from(rotate(walk(*i as u32, count, seed), count, rotation));
                 }
                 for ((v, &i), &seed) in values.iter_mut().zip(&*index).zip(&*seed) {
-                    *v = scrambled_pair(i, seed);
+                    let pair = randomized_pair(sampler, zorder::sobol01_reversed(i), seed);
+                    *v = pair.map(f32::from_random_bits);
                 }
             },
         );

@@ -23,6 +23,12 @@
 //!   by a permutation of `0 .. count`, Owen-scrambled (Vegdahl's
 //!   Laine–Karras hash, pbrt-v4's `FastOwenScrambler`), each with its own
 //!   seeds per pixel and dimension;
+//! - [`Sampler::LowDiscrepancy`]: the same padded Sobol' points as
+//!   [`Sampler::Sobol`], each request's shuffled index as there, randomised
+//!   by a random XOR of its bits (a digital shift; pbrt-v4's
+//!   `PermuteDigits` in base 2) in place of Owen's scramble: Mitsuba's
+//!   `ldsampler` (Kollig and Keller's scrambled (0, 2)-sequence, shuffled
+//!   per dimension), with seeds of its own per pixel and dimension;
 //! - [`Sampler::ZSobol`]: Ahmed and Wronski's (2020) z-ordered Sobol', as
 //!   pbrt-v4's `ZSobolSampler` ([`zorder`]): every request the first two
 //!   Sobol' dimensions at the pixel's Morton index, shuffled by base-4
@@ -39,7 +45,7 @@ pub mod zorder;
 use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::qmc::patterns::{Layout, Pattern, mix64, permute_rotated};
-use crate::qmc::sobol::{owen_reversed, owen_reversed_pair};
+use crate::qmc::sobol::owen_reversed_pair;
 use crate::rng::Rng;
 use zorder::ZOrder;
 
@@ -55,6 +61,9 @@ pub enum Sampler {
     MultiJitter,
     /// Padded Owen-scrambled Sobol', seeded per pixel.
     Sobol,
+    /// Padded Sobol' randomised by a digital shift (Mitsuba's
+    /// `ldsampler`), seeded per pixel.
+    LowDiscrepancy,
     /// Z-ordered, Owen-scrambled Sobol' (pbrt-v4's `ZSobolSampler`).
     ZSobol,
 }
@@ -66,6 +75,7 @@ impl Sampler {
         ("stratified", Sampler::Stratified),
         ("multijitter", Sampler::MultiJitter),
         ("sobol", Sampler::Sobol),
+        ("ldsampler", Sampler::LowDiscrepancy),
         ("zsobol", Sampler::ZSobol),
     ];
 
@@ -77,7 +87,7 @@ impl Sampler {
         match self {
             Sampler::Independent => u64::MAX,
             Sampler::Stratified | Sampler::MultiJitter => crate::qmc::PATTERN_MAX_POINTS,
-            Sampler::Sobol | Sampler::ZSobol => u64::from(u32::MAX),
+            Sampler::Sobol | Sampler::LowDiscrepancy | Sampler::ZSobol => u64::from(u32::MAX),
         }
     }
 
@@ -307,9 +317,10 @@ impl Stream {
             Sampler::Stratified | Sampler::MultiJitter => {
                 unit(self.layout(dim).single(self.index, false))
             }
-            Sampler::Sobol | Sampler::ZSobol => {
+            Sampler::Sobol | Sampler::LowDiscrepancy | Sampler::ZSobol => {
                 let (i, k) = self.sobol_index(dim);
-                F::from_random_bits(owen_reversed(zorder::sobol0_reversed(i), k.seed as u32))
+                let [x, _] = randomized_pair(self.sampler, zorder::sobol01_reversed(i), k.seed);
+                F::from_random_bits(x)
             }
         }
     }
@@ -323,9 +334,10 @@ impl Stream {
                 let (x, y) = self.layout(dim).pair(self.index, self.pattern());
                 [unit(x), unit(y)]
             }
-            Sampler::Sobol | Sampler::ZSobol => {
+            Sampler::Sobol | Sampler::LowDiscrepancy | Sampler::ZSobol => {
                 let (i, k) = self.sobol_index(dim);
-                scrambled_pair(i, k.seed)
+                randomized_pair(self.sampler, zorder::sobol01_reversed(i), k.seed)
+                    .map(F::from_random_bits)
             }
         }
     }
@@ -346,12 +358,20 @@ impl Stream {
     }
 }
 
-/// The first two Sobol' dimensions at index `i`, each Owen-scrambled by
-/// a half of `seed` (the low half the first coordinate's).
+/// The first two Sobol' dimensions `(x, y)` of an index (32 bits each,
+/// reversed, as [`zorder::sobol01_reversed`] gives them) randomised by
+/// `sampler`'s scramble with a half of `seed` each (the low half the first
+/// coordinate's): Owen's ([`owen_reversed_pair`]), or for
+/// [`Sampler::LowDiscrepancy`] a digital shift (`x ⊕ seed`), as 32 bits
+/// each. Its first coordinate is every 1D request's.
 #[inline(always)]
-fn scrambled_pair<F: Real>(i: u64, seed: u64) -> [F; 2] {
-    let (x, y) = zorder::sobol01_reversed(i);
-    owen_reversed_pair([x, y], [seed as u32, (seed >> 32) as u32]).map(F::from_random_bits)
+fn randomized_pair(sampler: Sampler, (x, y): (u32, u32), seed: u64) -> [u32; 2] {
+    let seeds = [seed as u32, (seed >> 32) as u32];
+    if sampler == Sampler::LowDiscrepancy {
+        [x.reverse_bits() ^ seeds[0], y.reverse_bits() ^ seeds[1]]
+    } else {
+        owen_reversed_pair([x, y], seeds)
+    }
 }
 
 #[cfg(test)]

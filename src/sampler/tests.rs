@@ -1,10 +1,11 @@
 use super::*;
 
-const ALL: [Sampler; 5] = [
+const ALL: [Sampler; 6] = [
     Sampler::Independent,
     Sampler::Stratified,
     Sampler::MultiJitter,
     Sampler::Sobol,
+    Sampler::LowDiscrepancy,
     Sampler::ZSobol,
 ];
 
@@ -83,12 +84,13 @@ fn is_net(p: &[[f64; 2]]) -> bool {
 
 #[test]
 fn sobol_pixels_are_nets() {
-    // Every 2D request of either Sobol' sampler is a (0, m, 2)-net in each
-    // pixel (any power-of-two spp).
+    // Every 2D request of each Sobol' sampler is a (0, m, 2)-net in each
+    // pixel (any power-of-two spp): Owen's scramble and the digital shift
+    // both keep the net.
     for m in 0..9 {
         let n = 1u32 << m;
         for key in [1u64, 77] {
-            for sampler in [Sampler::Sobol, Sampler::ZSobol] {
+            for sampler in [Sampler::Sobol, Sampler::LowDiscrepancy, Sampler::ZSobol] {
                 let mut s = stream(sampler, key, u64::from(n));
                 for dim in [0, 3, 12, 5000] {
                     assert!(

@@ -27,7 +27,7 @@ class Estimate:
 def estimate(env: EnvMap, normal: ArrayLike, n: int, *, phong: Phong | None = None,
              wi: ArrayLike | None = None, strategy: _Strategy,
              seed: int | np.random.Generator | None, heuristic: Literal["balance", "power"],
-             sampler: Literal["independent", "stratified", "multijitter", "sobol", "zsobol"],
+             sampler: Literal["independent", "stratified", "multijitter", "sobol", "ldsampler", "zsobol"],
              first_sample: int | None = None, total_n: int | None = None) -> Estimate:
     """The irradiance (without phong) or the reflected radiance (with phong
     and wi): see mcsample.estimators."""

@@ -46,7 +46,7 @@ def render(
     heuristic: Literal["balance", "power"],
     max_depth: int, rr_depth: int, hide_emitters: bool = False,
     callback: Callable[[int], object] | None = None,
-    sampler: Literal["independent", "stratified", "multijitter", "sobol", "zsobol"] = "independent",
+    sampler: Literal["independent", "stratified", "multijitter", "sobol", "ldsampler", "zsobol"] = "independent",
     first_sample: int | None = None, total_spp: int | None = None, keep_sums: bool = False,
     strategies: bool = False,
 ) -> _Film: ...

@@ -121,10 +121,10 @@ def _time_to_relmse(scene: mcs.Scene, ours: dict[str, dict], reference: dict,
     return out
 
 
-SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "zsobol")
+SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "ldsampler", "zsobol")
 #: Mitsuba's samplers beside mcsample's equivalents.
 MITSUBA_SAMPLERS = {"independent": "independent", "stratified": "stratified",
-                    "multijitter": "multijitter", "ldsampler": "sobol"}
+                    "multijitter": "multijitter", "ldsampler": "ldsampler"}
 
 
 def sampler_relmse(mi, spp_list=(16, 64), seeds: int = 4, ref_spp: int = 4096,

@@ -178,14 +178,16 @@ class Camera:
 
 #: Mitsuba's samplers, the keys each takes, and the mcsample sampler that
 #: does the same (``orthogonal``'s orthogonal arrays stratify each 1D and 2D
-#: projection, as the multi-jittered pattern does; ``ldsampler``'s padded
-#: (0, 2)-sequences, shuffled per pixel, are what "sobol" draws).
+#: projection, as the multi-jittered pattern does; ``ldsampler`` is
+#: mcsample's sampler of that name: the padded (0, 2)-sequences of "sobol",
+#: shuffled per pixel and dimension, randomised by a digital shift as
+#: Mitsuba's are, not by Owen's scramble).
 MITSUBA_SAMPLERS: dict[str, tuple[set[str], str]] = {
     "independent": ({"sample_count", "seed"}, "independent"),
     "stratified": ({"sample_count", "seed", "jitter"}, "stratified"),
     "multijitter": ({"sample_count", "seed", "jitter"}, "multijitter"),
     "orthogonal": ({"sample_count", "seed", "jitter", "strength"}, "multijitter"),
-    "ldsampler": ({"sample_count", "seed"}, "sobol"),
+    "ldsampler": ({"sample_count", "seed"}, "ldsampler"),
 }
 
 
