@@ -14,7 +14,9 @@ use std::ops::Range;
 pub const MAX_DIMENSIONS: usize = 1 << 16;
 
 /// Entries a scrambled [`Halton`]'s digit tables may hold in all (`2^26`
-/// values of 8 bytes, 512 MiB): `d ≤ 1946` dimensions.
+/// values of 8 bytes, 512 MiB): `d ≤ 1946` dimensions. (Each dimension
+/// also keeps a table of at most 1024 sums of its low positions: 16 MiB
+/// at most for 1946 dimensions.)
 pub const MAX_PERMUTATION_ENTRIES: usize = 1 << 26;
 
 /// Indices [`Halton`] accepts: below `2^53`, where every index is an exact
@@ -33,8 +35,10 @@ pub const MAX_INDEX: u64 = 1 << 53;
 /// down to a double's resolution (so that the leading zeros are permuted
 /// too).
 ///
-/// Consecutive points update their digits by adding one (an odometer), so
-/// a value costs a sum over its digits and no division.
+/// A block of points is filled without a division per digit: plain, by
+/// sums over digits counted up by one (an odometer), sixteen points at a
+/// time; scrambled, by a table of the low positions' sums plus the sum of
+/// the higher positions, which changes once every `b^P` points.
 #[derive(Clone, Debug)]
 pub struct Halton {
     radices: Vec<Radix>,
@@ -192,6 +196,15 @@ impl Radix {
         sum + self.tail[m]
     }
 
+    /// Scrambled: `index = q·b^P + r` as `r`, the digits of `q` and their
+    /// sum [`Radix::high_sum`].
+    fn split(&self, index: u64) -> (usize, Digits, f64) {
+        let period = self.low.len() as u64;
+        let high = Digits::new(index / period, self.base);
+        let sum = self.high_sum(&high);
+        ((index % period) as usize, high, sum)
+    }
+
     /// Scrambled: `low[r] + high`, below 1.
     #[inline(always)]
     fn scrambled(&self, r: usize, high: f64) -> f64 {
@@ -245,9 +258,8 @@ impl Halton {
     pub fn value(&self, index: u64, dim: usize) -> f64 {
         let radix = &self.radices[dim];
         if self.is_scrambled() {
-            let period = radix.low.len() as u64;
-            let high = radix.high_sum(&Digits::new(index / period, radix.base));
-            radix.scrambled((index % period) as usize, high)
+            let (r, _, high) = radix.split(index);
+            radix.scrambled(r, high)
         } else {
             // A sum of many digits may round up to 1.
             radix
@@ -289,6 +301,9 @@ impl Halton {
     fn fill_plain<F: Real>(&self, start: u64, values: &mut [F]) {
         let d = self.dims();
         let rows = values.len() / d;
+        if rows == 0 {
+            return;
+        }
         let mut columns: Vec<PlainColumn> = (self.radices.iter())
             .map(|radix| PlainColumn::new(start, rows, radix.base))
             .collect();
@@ -302,10 +317,14 @@ impl Halton {
                 );
             }
         }
-        for (j, column) in columns.iter().enumerate() {
-            for r in LANES * column.run..rows {
-                let value = self.value(start + r as u64, j);
-                values[r * d + j] = F::c(value).min(F::ONE_MINUS_EPSILON);
+        // The rows past the lanes: an odometer per dimension.
+        for (j, (radix, column)) in self.radices.iter().zip(&columns).enumerate() {
+            let first = LANES * column.run;
+            let mut digits = Digits::new(start + first as u64, radix.base);
+            for row in values.chunks_exact_mut(d).skip(first) {
+                let value = radix.plain(&digits).min(f64::ONE_MINUS_EPSILON);
+                row[j] = F::c(value).min(F::ONE_MINUS_EPSILON);
+                digits.increment(radix.base);
             }
         }
     }
@@ -317,13 +336,10 @@ impl Halton {
     fn fill_scrambled<F: Real>(&self, start: u64, values: &mut [F]) {
         let d = self.dims();
         // Per dimension: r, the digits of q and h(q).
-        let mut columns: Vec<(usize, Digits, f64)> = (self.radices.iter())
-            .map(|radix| {
-                let period = radix.low.len() as u64;
-                let high = Digits::new(start / period, radix.base);
-                let sum = radix.high_sum(&high);
-                ((start % period) as usize, high, sum)
-            })
+        let mut columns: Vec<(usize, Digits, f64)> = self
+            .radices
+            .iter()
+            .map(|radix| radix.split(start))
             .collect();
         for tile in values.chunks_mut(TILE_ROWS * d) {
             for (j, (radix, (r, high, sum))) in self.radices.iter().zip(&mut columns).enumerate() {
@@ -510,6 +526,7 @@ mod tests {
     fn fill_agrees_with_values_from_any_start() {
         for scramble in [false, true] {
             let h = Halton::new(10, scramble, 5).unwrap();
+            assert!(h.fill::<f64>(0, &mut []).is_ok());
             for first in [0, 1_234_567, MAX_INDEX - 70_001] {
                 let mut out = vec![0.0f64; 70_000 * 10];
                 h.fill(first, &mut out).unwrap();

@@ -45,8 +45,9 @@ pub struct Sobol {
     keys: Vec<u32>,
 }
 
-/// Values in the table of [`Sobol::fill`] (at most): 16 KiB of bits, which
-/// stay in the first-level cache while a block's rows are written.
+/// Values in the table of [`Sobol::fill`]: at most this many (16 KiB of
+/// bits, which stay in the first-level cache while a block's rows are
+/// written), or one row when `d` is larger.
 const TABLE_VALUES: usize = 4096;
 
 /// Rows in the pattern [`Sobol::fill`] XORs over the table in one pass: 8,
@@ -115,8 +116,9 @@ impl Sobol {
     /// Points `first ..` into `out` (row-major, `dims` values a row, as many
     /// rows as fit), on all cores; the same bits at any thread count.
     ///
-    /// Blocks of `R` rows (a power of two, `R·d ≤ 4096`) that start
-    /// at a multiple of `R` differ only in their high bits: for `i = B·R + r`,
+    /// Blocks of `R` rows (the largest power of two with `R·d ≤ 4096`, or
+    /// one row) that start at a multiple of `R` differ only in their high
+    /// bits: for `i = B·R + r`,
     /// `g(i) = g(B·R) ⊕ g(r)`, so point `i` is `x_{B·R} ⊕ T[r]` with the table
     /// `T[r] = ⊕_{b : bit b of g(r) set} v_b` (the low `log2 R` columns) the
     /// same for every block. A block is one vectorised pass of XORs with its
@@ -147,7 +149,7 @@ impl Sobol {
             let mut base: Vec<u32> = (0..d)
                 .map(|j| self.unscrambled((block * rows as u64) as u32, j))
                 .collect();
-            let mut pattern = vec![0u32; PATTERN_ROWS * d];
+            let mut pattern = vec![0u32; PATTERN_ROWS.min(rows) * d];
             let mut values = rows_out.values;
             while !values.is_empty() {
                 let take = (rows - r).min(values.len() / d);

@@ -129,14 +129,16 @@ struct DimKey {
     /// The 64-bit seed of the dimension's scrambles or pattern.
     seed: u64,
     /// [`Sampler::ZSobol`]: the shuffled digits above the pixel's samples
-    /// ([`ZOrder::block`]); [`Sampler::Sobol`]: the index permutation's
+    /// ([`ZOrder::block`]); [`Sampler::Sobol`] and
+    /// [`Sampler::LowDiscrepancy`]: the index permutation's
     /// seed (low half) and the rotation that ends it, that seed modulo the
     /// stream's count (high half).
     block: u64,
 }
 
 impl DimKey {
-    /// [`Sampler::Sobol`]: the index permutation's seed and rotation.
+    /// [`Sampler::Sobol`], [`Sampler::LowDiscrepancy`]: the index
+    /// permutation's seed and rotation.
     #[inline(always)]
     fn permutation(self) -> (u32, u32) {
         (self.block as u32, (self.block >> 32) as u32)
@@ -344,7 +346,8 @@ impl Stream {
 
     /// The Sobol' index of the current sample for dimension `dim`, and
     /// the dimension's key: shuffled by a permutation of `0 .. count`
-    /// ([`Sampler::Sobol`]) or z-ordered ([`Sampler::ZSobol`]).
+    /// ([`Sampler::Sobol`], [`Sampler::LowDiscrepancy`]) or z-ordered
+    /// ([`Sampler::ZSobol`]).
     #[inline]
     fn sobol_index(&mut self, dim: u32) -> (u64, DimKey) {
         let k = self.key(dim);
