@@ -8,19 +8,19 @@ use super::{
     uniform_disk_to_square_concentric,
 };
 use crate::frame::Frame;
-use crate::math::{Real, dot, ln_one_minus, ln_positive, safe_sqrt, sin_cos_turn};
+use crate::math::{Real, dot, ln_positive, safe_sqrt, sin_cos_turn};
 
 /// The standard normal on the plane by the Box–Muller map:
 /// `r = √(−2 ln(1 − u_x))`, `φ = 2π u_y`, the point `(r cos φ, r sin φ)`
 /// (`u_x` is clamped below 1, so `u = 1` gives a finite point; the
-/// logarithm by [`ln_one_minus`], precise near 0 and vectorised). Density
+/// logarithm by [`Real::ln_one_minus`], precise near 0 and vectorised). Density
 /// per unit area.
 ///
 /// # Density
 /// [`square_to_std_normal_pdf`]: `exp(−|x|²/2)/(2π)`.
 #[inline(always)]
 pub fn square_to_std_normal<F: Real>(u: P2<F>) -> P2<F> {
-    let r = F::c(-2.0 * ln_one_minus(u[0].min(F::ONE_MINUS_EPSILON).f64())).sqrt();
+    let r = (F::c(-2.0) * F::ln_one_minus(u[0].min(F::ONE_MINUS_EPSILON))).sqrt();
     let (s, c) = sin_cos_turn(u[1]);
     [c * r, s * r]
 }
@@ -123,7 +123,7 @@ impl<F: Real> VonMisesFisher<F> {
 /// Directions of the von Mises–Fisher lobe around `+z` (Mitsuba's polar
 /// map): `φ = 2π u_x`, `1 − cos θ = −ln(1 − u_y (1 − e^{−2κ}))/κ` (`2u_y`
 /// for `κ = 0`: the uniform sphere, `z = 1 − 2u_y`), the logarithm by
-/// [`ln_one_minus`] (precise near `u_y = 0` for every `κ`, and free of
+/// [`Real::ln_one_minus`] (precise near `u_y = 0` for every `κ`, and free of
 /// library calls, so the loop vectorises). Density per steradian.
 ///
 /// # Density
@@ -136,7 +136,7 @@ impl<F: Real> VonMisesFisher<F> {
 #[inline(always)]
 pub fn square_to_von_mises_fisher<F: Real>(u: P2<F>, lobe: &VonMisesFisher<F>) -> V3<F> {
     let w = if lobe.mass > F::zero() {
-        F::c(-ln_one_minus((u[1] * lobe.mass).f64())) / lobe.kappa
+        -F::ln_one_minus(u[1] * lobe.mass) / lobe.kappa
     } else {
         F::c(2.0) * u[1]
     };
