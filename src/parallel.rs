@@ -2,9 +2,10 @@
 //!
 //! A batch of `n` items is cut into chunks of [`CHUNK`] items (boundaries at
 //! multiples of `CHUNK`), which the threads of a rayon pool of
-//! [`num_threads`] threads take in turn. Kernels are pure functions of the item index (and,
-//! for kernels that draw randomness, of a generator advanced to that index),
-//! so the result is bit-identical whatever the number of threads.
+//! [`num_threads`] threads take in turn. Kernels are pure functions of the
+//! item index (and, for kernels that draw randomness, of a generator
+//! advanced to that index), so the result is bit-identical whatever the
+//! number of threads.
 //!
 //! The pool is private to mcsample (sized by [`set_num_threads`], else
 //! `MCSAMPLE_NUM_THREADS`, else the number of cores), and it is rebuilt in a
@@ -166,10 +167,13 @@ fn pool(threads: usize) -> Result<Arc<ThreadPool>> {
 /// thread). Every thread of the pool is started at once (a broadcast) and
 /// takes chunks in order until none are left: rayon's work splitting wakes
 /// its sleeping threads one by one as work is split, and after the pool
-/// has idled for a millisecond or more, a batch of a few milliseconds often ran on one
-/// thread to its end (2^20 Sobol' points in 8 dimensions: 7.7 ms on two
-/// threads after a 0.1 s pause, as on one; 3.6 ms without the pause). `outputs` holds one element per item; each call gets the
-/// elements of its range. The kernel returns whether every input of its
+/// had idled for a millisecond or more, a batch of a few milliseconds often
+/// ran on one thread to its end (2^20 Sobol' points in 8 dimensions: 7.7 ms
+/// on two threads after a 0.1 s pause, as on one; 3.6 ms without the
+/// pause).
+///
+/// `outputs` holds one element per item; each call gets the elements of
+/// its range. The kernel returns whether every input of its
 /// range was valid; the result is true when all were.
 ///
 /// # Errors
