@@ -383,6 +383,29 @@ pub fn output<'py, T: Element + bytemuck::Pod>(
     Ok(array.cast::<PyArrayDyn<T>>()?.clone())
 }
 
+/// The arrays of an `out` that holds one array per result, as numpy's
+/// ufuncs of several results take them: a tuple of `N` (the results named
+/// by `names`, for the message), or none when `out` is omitted or None.
+pub fn tuple_outputs<'py, const N: usize>(
+    out: Out<'_, 'py>,
+    names: &str,
+) -> PyResult<[Option<Obj<'py>>; N]> {
+    let Some(out) = out.filter(|o| !o.is_none()) else {
+        return Ok(std::array::from_fn(|_| None));
+    };
+    let items = out.cast::<PyTuple>().ok().filter(|t| t.len() == N);
+    let Some(items) = items else {
+        let count = ["no", "one", "two", "three"]
+            .get(N)
+            .copied()
+            .unwrap_or("several");
+        return Err(PyTypeError::new_err(format!(
+            "out must be a tuple of {count} arrays: ({names})"
+        )));
+    };
+    Ok(std::array::from_fn(|k| items.get_item(k).ok()))
+}
+
 /// Write access to an output array, which fails (rather than panics) when
 /// an `out` array shares memory with an input or another output.
 pub fn writable<'py, T: Element>(

@@ -5,7 +5,7 @@
 //! after the pass, naming the first offending index.
 
 use super::arrays::{Check, Indices, Points, PyFloat, broadcast, finish, output, result_shape};
-use super::arrays::{fresh, writable};
+use super::arrays::{fresh, tuple_outputs, writable};
 use super::parallel::run_batch;
 use crate::python::{Obj, Out};
 use crate::simd::{STREAM_MIN_BYTES, map_rows};
@@ -48,21 +48,22 @@ where
 
 /// [`map_into`] for kernels that take a whole chunk of points at once and
 /// write one value per point (for work shared across points, such as
-/// prefetching table cells): every input value is checked first, and the
-/// kernel runs only on chunks that pass.
+/// prefetching table cells), into `out` when it is given: every input
+/// value is checked first, and the kernel runs only on chunks that pass.
 pub fn map_chunks<'py, F, T, const K: usize>(
     py: Python<'py>,
     x: &Points<'py, F, K>,
     check: Check,
+    out: Out<'_, 'py>,
     kernel: impl Fn(&[[F; K]], &mut [T]) + Sync + Send,
 ) -> PyResult<Obj<'py>>
 where
     F: PyFloat,
     T: Element + bytemuck::Pod + Default + Send,
 {
-    let out = fresh::<T>(py, &x.out_shape(1))?;
+    let out = output::<T>(py, &x.out_shape(1), out, "out")?;
     {
-        let mut guard = out.readwrite();
+        let mut guard = writable(&out)?;
         let in_rows = x.rows();
         let valid = run_batch(py, x.n, guard.as_slice_mut()?, |range, chunk: &mut [T]| {
             let inputs = &in_rows[range];
@@ -217,11 +218,14 @@ where
 }
 
 /// As [`map_into`] for kernels with two results (`M` and `L` values per point),
-/// returned as two arrays.
+/// returned as two arrays, or written into the two arrays of `out` when it
+/// is given (a tuple, see [`tuple_outputs`]; `names` names the results in
+/// its message).
 pub fn map2<'py, F, T, S, const K: usize, const M: usize, const L: usize>(
     py: Python<'py>,
     x: &Points<'py, F, K>,
     check: Check,
+    (out, names): (Out<'_, 'py>, &str),
     kernel: impl Fn([F; K]) -> ([T; M], [S; L]) + Sync + Send,
 ) -> PyResult<(Obj<'py>, Obj<'py>)>
 where
@@ -229,10 +233,11 @@ where
     T: Element + bytemuck::Pod + Default + Send,
     S: Element + bytemuck::Pod + Default + Send,
 {
-    let first = fresh::<T>(py, &x.out_shape(M))?;
-    let second = fresh::<S>(py, &x.out_shape(L))?;
+    let [o1, o2] = tuple_outputs::<2>(out, names)?;
+    let first = output::<T>(py, &x.out_shape(M), o1.as_ref(), "out[0]")?;
+    let second = output::<S>(py, &x.out_shape(L), o2.as_ref(), "out[1]")?;
     {
-        let (mut g1, mut g2) = (first.readwrite(), second.readwrite());
+        let (mut g1, mut g2) = (writable(&first)?, writable(&second)?);
         let rows1 = g1.as_slice_mut()?.as_chunks_mut::<M>().0;
         let rows2 = g2.as_slice_mut()?.as_chunks_mut::<L>().0;
         let in_rows = x.rows();
@@ -252,15 +257,16 @@ where
 }
 
 /// Maps every index row to one float64 value: the batch's shape, or a
-/// scalar for an unbatched row.
+/// scalar for an unbatched row; into `out` when it is given.
 pub fn map_indices<'py, const K: usize>(
     py: Python<'py>,
     indices: &Indices<K>,
+    out: Out<'_, 'py>,
     f: impl Fn([usize; K]) -> f64 + Sync + Send,
 ) -> PyResult<Obj<'py>> {
-    let out = fresh::<f64>(py, &indices.batch)?;
+    let out = output::<f64>(py, &indices.batch, out, "out")?;
     {
-        let mut guard = out.readwrite();
+        let mut guard = writable(&out)?;
         let values = guard.as_slice_mut()?;
         let rows = &indices.rows;
         run_batch(py, rows.len(), values, |range, chunk: &mut [f64]| {

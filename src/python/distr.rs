@@ -3,13 +3,13 @@
 //! are built with the GIL released; every `u` is checked to lie in [0, 1]
 //! in the sampling pass.
 
-use super::arrays::{Check, Indices, Points, Table, with_precision};
+use super::arrays::{Check, Indices, Points, Table, output, with_precision, writable};
 use super::batch::{map_chunks, map_indices, map_into, map2};
 use super::parallel::detached;
 use super::pickle::reduce;
 use super::records::record;
 use crate::distr;
-use crate::python::Obj;
+use crate::python::{Obj, Out};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
@@ -25,13 +25,22 @@ fn table_2d<'py>(
         .into_any())
 }
 
-/// The `(N,)` array of `f(i)` for `i in 0..n`.
+/// The array of `f(k)` for each flat (row-major) index `k` of `shape`,
+/// written into `out` when it is given.
 fn per_index<'py>(
     py: Python<'py>,
-    n: usize,
+    shape: &[usize],
+    out: Out<'_, 'py>,
     f: impl Fn(usize) -> f64,
-) -> Bound<'py, PyArray1<f64>> {
-    PyArray1::from_iter(py, (0..n).map(f))
+) -> PyResult<Obj<'py>> {
+    let array = output::<f64>(py, shape, out, "out")?;
+    {
+        let mut guard = writable(&array)?;
+        for (k, v) in guard.as_slice_mut()?.iter_mut().enumerate() {
+            *v = f(k);
+        }
+    }
+    Ok(array.into_any())
 }
 
 /// The Python methods of a 1D index table (`Discrete1D`, `AliasTable`):
@@ -53,18 +62,22 @@ macro_rules! index_table_methods {
             /// Parameters
             /// ----------
             /// u : float or array_like, shape (N,), values in [0, 1]
+            /// out : ndarray, optional, keyword only
+            ///     Written with the result and returned (its shape and dtype).
             ///
             /// Returns
             /// -------
             /// ndarray, shape (N,) int64 (a scalar for a scalar u).
+            #[pyo3(signature = (u, *, out = None))]
             fn sample<'py>(
                 &self,
                 py: Python<'py>,
                 u: &Obj<'py>,
+                out: Out<'_, 'py>,
             ) -> PyResult<Obj<'py>> {
                 with_precision!(u, F => {
                     let u = Points::<F, 1>::extract(u, "u")?;
-                    map_chunks(py, &u, Check::Unit, |u, out: &mut [i64]| {
+                    map_chunks(py, &u, Check::Unit, out, |u, out: &mut [i64]| {
                         self.0.sample_into(u.as_flattened(), out)
                     })
                 })
@@ -76,22 +89,25 @@ macro_rules! index_table_methods {
             /// Parameters
             /// ----------
             /// i : int or array_like of int, shape (N,), optional
+            /// out : ndarray, optional, keyword only
+            ///     Written with the result and returned (its shape, float64).
             ///
             /// Returns
             /// -------
             /// ndarray, shape (N,) float64 (a scalar for a scalar i).
-            #[pyo3(signature = (i = None))]
+            #[pyo3(signature = (i = None, *, out = None))]
             fn pmf<'py>(
                 &self,
                 py: Python<'py>,
                 i: Option<&Obj<'py>>,
+                out: Out<'_, 'py>,
             ) -> PyResult<Obj<'py>> {
                 let table = &self.0;
                 match i {
-                    None => Ok(per_index(py, table.len(), |k| table.pmf(k)).into_any()),
+                    None => per_index(py, &[table.len()], out, |k| table.pmf(k)),
                     Some(i) => {
                         let i = Indices::<1>::extract(i, "i", [table.len()])?;
-                        map_indices(py, &i, |[k]| table.pmf(k))
+                        map_indices(py, &i, out, |[k]| table.pmf(k))
                     }
                 }
             }
@@ -164,14 +180,26 @@ index_table_methods!(PyDiscrete1D, distr::Discrete1D, "Discrete1D", {
     /// Indices as ``sample``, and u rescaled within the chosen entry's share
     /// to [0, 1): (u * sum - C[i-1]) / w[i], a fresh uniform number.
     ///
+    /// Parameters
+    /// ----------
+    /// u : float or array_like, shape (N,), values in [0, 1]
+    /// out : (ndarray, ndarray), optional, keyword only
+    ///     Written with ``index`` and ``u`` and returned in the result.
+    ///
     /// Returns
     /// -------
     /// ReusedSample: ``.index`` ndarray (N,) int64 and ``.u`` ndarray (N,)
     /// float of u's precision; unpacks as ``index, u``.
-    fn sample_reuse<'py>(&self, py: Python<'py>, u: &Obj<'py>) -> PyResult<PyReusedSample> {
+    #[pyo3(signature = (u, *, out = None))]
+    fn sample_reuse<'py>(
+        &self,
+        py: Python<'py>,
+        u: &Obj<'py>,
+        out: Out<'_, 'py>,
+    ) -> PyResult<PyReusedSample> {
         with_precision!(u, F => {
             let u = Points::<F, 1>::extract(u, "u")?;
-            let (index, u) = map2(py, &u, Check::Unit, |u| {
+            let (index, u) = map2(py, &u, Check::Unit, (out, "index, u"), |u| {
                 let (i, r) = self.0.sample_reuse(u[0]);
                 ([i as i64], [r])
             })?;
@@ -181,8 +209,8 @@ index_table_methods!(PyDiscrete1D, distr::Discrete1D, "Discrete1D", {
 
     /// The normalised CDF, shape (n,): P(index <= i); the last entry is 1.
     #[getter]
-    fn cdf<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        per_index(py, self.0.len(), |k| self.0.cdf(k))
+    fn cdf<'py>(&self, py: Python<'py>) -> PyResult<Obj<'py>> {
+        per_index(py, &[self.0.len()], None, |k| self.0.cdf(k))
     }
 });
 
@@ -244,14 +272,17 @@ impl PyDiscrete2D {
     /// Parameters
     /// ----------
     /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    /// out : ndarray, optional, keyword only
+    ///     Written with the result and returned (its shape and dtype).
     ///
     /// Returns
     /// -------
     /// ndarray, shape (N, 2) or (2,) int64: (row, col).
-    fn sample<'py>(&self, py: Python<'py>, u: &Obj<'py>) -> PyResult<Obj<'py>> {
+    #[pyo3(signature = (u, *, out = None))]
+    fn sample<'py>(&self, py: Python<'py>, u: &Obj<'py>, out: Out<'_, 'py>) -> PyResult<Obj<'py>> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
-            map_into(py, &u, Check::Unit, None, |u| {
+            map_into(py, &u, Check::Unit, out, |u| {
                 let (r, c) = self.table.sample(u);
                 [r as i64, c as i64]
             })
@@ -261,14 +292,26 @@ impl PyDiscrete2D {
     /// Cells as ``sample``, and u rescaled within the chosen row and column
     /// shares to [0, 1)^2.
     ///
+    /// Parameters
+    /// ----------
+    /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    /// out : (ndarray, ndarray), optional, keyword only
+    ///     Written with ``index`` and ``u`` and returned in the result.
+    ///
     /// Returns
     /// -------
     /// ReusedSample: ``.index`` ndarray (N, 2) int64 (row, col) and ``.u``
     /// ndarray (N, 2) float of u's precision; unpacks as ``index, u``.
-    fn sample_reuse<'py>(&self, py: Python<'py>, u: &Obj<'py>) -> PyResult<PyReusedSample> {
+    #[pyo3(signature = (u, *, out = None))]
+    fn sample_reuse<'py>(
+        &self,
+        py: Python<'py>,
+        u: &Obj<'py>,
+        out: Out<'_, 'py>,
+    ) -> PyResult<PyReusedSample> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
-            let (index, u) = map2(py, &u, Check::Unit, |u| {
+            let (index, u) = map2(py, &u, Check::Unit, (out, "index, u"), |u| {
                 let ((r, c), v) = self.table.sample_reuse(u);
                 ([r as i64, c as i64], v)
             })?;
@@ -282,21 +325,27 @@ impl PyDiscrete2D {
     /// Parameters
     /// ----------
     /// idx : array_like of int, shape (N, 2) or (2,), optional
+    /// out : ndarray, optional, keyword only
+    ///     Written with the result and returned (its shape, float64).
     ///
     /// Returns
     /// -------
     /// ndarray, shape (N,) float64 (a scalar for one cell).
-    #[pyo3(signature = (idx = None))]
-    fn pmf<'py>(&self, py: Python<'py>, idx: Option<&Obj<'py>>) -> PyResult<Obj<'py>> {
+    #[pyo3(signature = (idx = None, *, out = None))]
+    fn pmf<'py>(
+        &self,
+        py: Python<'py>,
+        idx: Option<&Obj<'py>>,
+        out: Out<'_, 'py>,
+    ) -> PyResult<Obj<'py>> {
         let (rows, cols) = self.table.shape();
         match idx {
-            None => {
-                let flat = per_index(py, rows * cols, |k| self.table.pmf(k / cols, k % cols));
-                Ok(flat.call_method1("reshape", (rows, cols))?)
-            }
+            None => per_index(py, &[rows, cols], out, |k| {
+                self.table.pmf(k / cols, k % cols)
+            }),
             Some(idx) => {
                 let idx = Indices::<2>::extract(idx, "idx", [rows, cols])?;
-                map_indices(py, &idx, |[r, c]| self.table.pmf(r, c))
+                map_indices(py, &idx, out, |[r, c]| self.table.pmf(r, c))
             }
         }
     }
@@ -345,16 +394,24 @@ impl PyPiecewiseConstant1D {
     /// Parameters
     /// ----------
     /// u : float or array_like, shape (N,), values in [0, 1]
+    /// out : (ndarray, ndarray), optional, keyword only
+    ///     Written with ``x`` and ``pdf`` and returned in the result.
     ///
     /// Returns
     /// -------
     /// PiecewiseSample: ``.x`` and ``.pdf``, ndarrays of shape (N,) in u's
     /// precision (scalars for a scalar u), pdf per unit length; unpacks as
     /// ``x, pdf``.
-    fn sample<'py>(&self, py: Python<'py>, u: &Obj<'py>) -> PyResult<PyPiecewiseSample> {
+    #[pyo3(signature = (u, *, out = None))]
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        u: &Obj<'py>,
+        out: Out<'_, 'py>,
+    ) -> PyResult<PyPiecewiseSample> {
         with_precision!(u, F => {
             let u = Points::<F, 1>::extract(u, "u")?;
-            let (x, pdf) = map2(py, &u, Check::Unit, |u| {
+            let (x, pdf) = map2(py, &u, Check::Unit, (out, "x, pdf"), |u| {
                 let (x, pdf) = self.0.sample(u[0]);
                 ([x], [pdf])
             })?;
@@ -367,10 +424,13 @@ impl PyPiecewiseConstant1D {
     /// Parameters
     /// ----------
     /// x : float or array_like, shape (N,)
-    fn pdf<'py>(&self, py: Python<'py>, x: &Obj<'py>) -> PyResult<Obj<'py>> {
+    /// out : ndarray, optional, keyword only
+    ///     Written with the result and returned (its shape and dtype).
+    #[pyo3(signature = (x, *, out = None))]
+    fn pdf<'py>(&self, py: Python<'py>, x: &Obj<'py>, out: Out<'_, 'py>) -> PyResult<Obj<'py>> {
         with_precision!(x, F => {
             let x = Points::<F, 1>::extract(x, "x")?;
-            map_into(py, &x, Check::Finite, None, |x| [self.0.pdf(x[0])])
+            map_into(py, &x, Check::Finite, out, |x| [self.0.pdf(x[0])])
         })
     }
 
@@ -379,10 +439,13 @@ impl PyPiecewiseConstant1D {
     /// Parameters
     /// ----------
     /// x : float or array_like, shape (N,)
-    fn cdf<'py>(&self, py: Python<'py>, x: &Obj<'py>) -> PyResult<Obj<'py>> {
+    /// out : ndarray, optional, keyword only
+    ///     Written with the result and returned (its shape and dtype).
+    #[pyo3(signature = (x, *, out = None))]
+    fn cdf<'py>(&self, py: Python<'py>, x: &Obj<'py>, out: Out<'_, 'py>) -> PyResult<Obj<'py>> {
         with_precision!(x, F => {
             let x = Points::<F, 1>::extract(x, "x")?;
-            map_into(py, &x, Check::Finite, None, |x| [self.0.cdf(x[0])])
+            map_into(py, &x, Check::Finite, out, |x| [self.0.cdf(x[0])])
         })
     }
 
@@ -391,16 +454,19 @@ impl PyPiecewiseConstant1D {
     /// Parameters
     /// ----------
     /// x : float or array_like, shape (N,), values in [a, b]
+    /// out : ndarray, optional, keyword only
+    ///     Written with the result and returned (its shape and dtype).
     ///
     /// Raises
     /// ------
     /// ValueError
     ///     For x outside [a, b], naming the first such index.
-    fn invert<'py>(&self, py: Python<'py>, x: &Obj<'py>) -> PyResult<Obj<'py>> {
+    #[pyo3(signature = (x, *, out = None))]
+    fn invert<'py>(&self, py: Python<'py>, x: &Obj<'py>, out: Out<'_, 'py>) -> PyResult<Obj<'py>> {
         let (a, b) = self.0.domain();
         with_precision!(x, F => {
             let x = Points::<F, 1>::extract(x, "x")?;
-            map_into(py, &x, Check::Within([[a, b], [a, b]]), None, |x| {
+            map_into(py, &x, Check::Within([[a, b], [a, b]]), out, |x| {
                 [self.0.invert(x[0]).unwrap_or(0.0)]
             })
         })
@@ -481,15 +547,23 @@ impl PyPiecewiseConstant2D {
     /// Parameters
     /// ----------
     /// u : array_like, shape (N, 2) or (2,), values in [0, 1]
+    /// out : (ndarray, ndarray), optional, keyword only
+    ///     Written with ``x`` and ``pdf`` and returned in the result.
     ///
     /// Returns
     /// -------
     /// PiecewiseSample: ``.x`` (N, 2) and ``.pdf`` (N,) in u's precision,
     /// pdf per unit area; unpacks as ``x, pdf``.
-    fn sample<'py>(&self, py: Python<'py>, u: &Obj<'py>) -> PyResult<PyPiecewiseSample> {
+    #[pyo3(signature = (u, *, out = None))]
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        u: &Obj<'py>,
+        out: Out<'_, 'py>,
+    ) -> PyResult<PyPiecewiseSample> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
-            let (x, pdf) = map2(py, &u, Check::Unit, |u| {
+            let (x, pdf) = map2(py, &u, Check::Unit, (out, "x, pdf"), |u| {
                 let (p, pdf) = self.0.sample(u);
                 (p, [pdf])
             })?;
@@ -502,10 +576,13 @@ impl PyPiecewiseConstant2D {
     /// Parameters
     /// ----------
     /// xy : array_like, shape (N, 2) or (2,)
-    fn pdf<'py>(&self, py: Python<'py>, xy: &Obj<'py>) -> PyResult<Obj<'py>> {
+    /// out : ndarray, optional, keyword only
+    ///     Written with the result and returned (its shape and dtype).
+    #[pyo3(signature = (xy, *, out = None))]
+    fn pdf<'py>(&self, py: Python<'py>, xy: &Obj<'py>, out: Out<'_, 'py>) -> PyResult<Obj<'py>> {
         with_precision!(xy, F => {
             let xy = Points::<F, 2>::extract(xy, "xy")?;
-            map_into(py, &xy, Check::Finite, None, |p| [self.0.pdf(p)])
+            map_into(py, &xy, Check::Finite, out, |p| [self.0.pdf(p)])
         })
     }
 
@@ -515,16 +592,19 @@ impl PyPiecewiseConstant2D {
     /// Parameters
     /// ----------
     /// xy : array_like, shape (N, 2) or (2,), inside the rectangle
+    /// out : ndarray, optional, keyword only
+    ///     Written with the result and returned (its shape and dtype).
     ///
     /// Raises
     /// ------
     /// ValueError
     ///     For a point outside the rectangle, naming the first such index.
-    fn invert<'py>(&self, py: Python<'py>, xy: &Obj<'py>) -> PyResult<Obj<'py>> {
+    #[pyo3(signature = (xy, *, out = None))]
+    fn invert<'py>(&self, py: Python<'py>, xy: &Obj<'py>, out: Out<'_, 'py>) -> PyResult<Obj<'py>> {
         let domain = self.0.domain();
         with_precision!(xy, F => {
             let xy = Points::<F, 2>::extract(xy, "xy")?;
-            map_into(py, &xy, Check::Within(domain), None, |p| {
+            map_into(py, &xy, Check::Within(domain), out, |p| {
                 self.0.invert(p).unwrap_or([0.0; 2])
             })
         })

@@ -170,9 +170,16 @@ def suite_distr(n: int, repeat: int, mi) -> list[Timing]:
         ("mcsample Discrete1D", "float64", lambda: mcs.Discrete1D(weights)),
         ("mcsample AliasTable", "float64", lambda: mcs.AliasTable(weights)),
     ]
+    # The plain calls, and the same into a reused array (out=).
+    u32 = u.astype(np.float32)
+    reused = np.empty(n, np.int64)
     samplers: list[tuple[str, str, Callable[[], object]]] = [
         ("mcsample Discrete1D", "float64", lambda: d.sample(u)),
+        ("mcsample Discrete1D out=", "float64", lambda: d.sample(u, out=reused)),
+        ("mcsample Discrete1D", "float32", lambda: d.sample(u32)),
+        ("mcsample Discrete1D out=", "float32", lambda: d.sample(u32, out=reused)),
         ("mcsample AliasTable", "float64", lambda: a.sample(u)),
+        ("mcsample AliasTable out=", "float64", lambda: a.sample(u, out=reused)),
     ]
     if mi is not None:
         import drjit as dr
@@ -185,7 +192,7 @@ def suite_distr(n: int, repeat: int, mi) -> list[Timing]:
             dr.sync_thread()
 
         dist = mi.DiscreteDistribution(w32)
-        uf = mi.Float(u.astype(np.float32))
+        uf = mi.Float(u32)
 
         def mi_sample():
             i = dist.sample(uf)

@@ -4,7 +4,8 @@
 mod input;
 
 use super::args::index_arg;
-use super::arrays::{Check, Points, PyFloat, finish, output, with_precision, writable, zeros};
+use super::arrays::{Check, Points, PyFloat, finish, output, tuple_outputs, with_precision};
+use super::arrays::{writable, zeros};
 use super::batch::{map_each, map_into};
 use super::parallel::{detached, run_batch};
 use super::pickle::reduce;
@@ -82,18 +83,6 @@ record! {
 #[pyclass(module = "mcsample._core", name = "EnvMap", frozen)]
 pub struct PyEnvMap(Arc<EnvMap>);
 
-/// The three arrays of `EnvMap.sample`'s `out` (direction, pdf, weight), or
-/// none.
-fn sample_outputs<'py>(out: Out<'_, 'py>) -> PyResult<[Option<Obj<'py>>; 3]> {
-    let Some(out) = out.filter(|o| !o.is_none()) else {
-        return Ok([None, None, None]);
-    };
-    let (d, p, w): (Obj<'py>, Obj<'py>, Obj<'py>) = out.extract().map_err(|_| {
-        PyTypeError::new_err("out must be a tuple of three arrays: (direction, pdf, weight)")
-    })?;
-    Ok([Some(d), Some(p), Some(w)])
-}
-
 /// Whether every coordinate of the direction `x` is finite (the check of
 /// the batch methods, inlined into their loops).
 #[inline(always)]
@@ -159,7 +148,7 @@ impl PyEnvMap {
     ) -> PyResult<PyEnvSample> {
         let u = Points::<F, 2>::extract(u, "u")?;
         let (vec_shape, scalar_shape) = (u.out_shape(3), u.out_shape(1));
-        let [o_d, o_p, o_w] = sample_outputs(out)?;
+        let [o_d, o_p, o_w] = tuple_outputs::<3>(out, "direction, pdf, weight")?;
         let direction = output::<F>(py, &vec_shape, o_d.as_ref(), "out[0]")?;
         let pdf = output::<F>(py, &scalar_shape, o_p.as_ref(), "out[1]")?;
         let weight = output::<F>(py, &vec_shape, o_w.as_ref(), "out[2]")?;

@@ -170,6 +170,8 @@ warps! {
 ///     The corner values, at any scale: the density is their interpolant
 ///     divided by their mean.
 /// sample : array_like, shape (..., 2), values in [0, 1]
+/// out : (ndarray, ndarray), optional, keyword only
+///     Written with the points and densities and returned.
 ///
 /// Returns
 /// -------
@@ -178,6 +180,7 @@ warps! {
 ///     unit area, the batch's shape (Mitsuba returns the interpolant
 ///     itself: the same for corners of mean 1).
 #[pyfunction]
+#[pyo3(signature = (v00, v10, v01, v11, sample, *, out = None))]
 pub fn square_to_bilinear<'py>(
     py: Python<'py>,
     v00: f64,
@@ -185,10 +188,11 @@ pub fn square_to_bilinear<'py>(
     v01: f64,
     v11: f64,
     sample: &Obj<'py>,
+    out: Out<'_, 'py>,
 ) -> PyResult<(Obj<'py>, Obj<'py>)> {
     let corners = [v00, v10, v01, v11];
     with_precision!(sample, F => with_density(
-        py, corners, sample, Check::Unit, warp::square_to_bilinear::<F>,
+        py, corners, sample, (Check::Unit, (out, "points, pdf")), warp::square_to_bilinear::<F>,
     ))
 }
 
@@ -199,6 +203,8 @@ pub fn square_to_bilinear<'py>(
 /// v00, v10, v01, v11 : float >= 0, not all 0
 ///     The corner values, as given to ``square_to_bilinear``.
 /// sample : array_like, shape (..., 2), points of [0, 1]^2
+/// out : (ndarray, ndarray), optional, keyword only
+///     Written with the numbers and densities and returned.
 ///
 /// Returns
 /// -------
@@ -206,6 +212,7 @@ pub fn square_to_bilinear<'py>(
 ///     The numbers in [0, 1]^2 that map to the points, shape (..., 2), and
 ///     the points' densities per unit area, the batch's shape.
 #[pyfunction]
+#[pyo3(signature = (v00, v10, v01, v11, sample, *, out = None))]
 pub fn bilinear_to_square<'py>(
     py: Python<'py>,
     v00: f64,
@@ -213,20 +220,22 @@ pub fn bilinear_to_square<'py>(
     v01: f64,
     v11: f64,
     sample: &Obj<'py>,
+    out: Out<'_, 'py>,
 ) -> PyResult<(Obj<'py>, Obj<'py>)> {
     let corners = [v00, v10, v01, v11];
     with_precision!(sample, F => with_density(
-        py, corners, sample, Check::Finite, warp::bilinear_to_square::<F>,
+        py, corners, sample, (Check::Finite, (out, "u, pdf")), warp::bilinear_to_square::<F>,
     ))
 }
 
-/// Maps the points `sample` through a bilinear `kernel` of the checked
-/// `corners`, returning its points and densities as two arrays.
+/// Maps the points `sample` (checked by `check`) through a bilinear
+/// `kernel` of the checked `corners`, returning its points and densities as
+/// two arrays (into those of `out` when given; see [`map2`]).
 fn with_density<'py, F: PyFloat, K>(
     py: Python<'py>,
     [v00, v10, v01, v11]: [f64; 4],
     sample: &Obj<'py>,
-    check: Check,
+    (check, out): (Check, (Out<'_, 'py>, &str)),
     kernel: K,
 ) -> PyResult<(Obj<'py>, Obj<'py>)>
 where
@@ -234,7 +243,7 @@ where
 {
     let corners = corners_arg(v00, v10, v01, v11)?;
     let points = Points::<F, 2>::extract(sample, "sample")?;
-    map2(py, &points, check, |p| {
+    map2(py, &points, check, out, |p| {
         let (q, pdf) = kernel(corners, p);
         (q, [pdf])
     })
