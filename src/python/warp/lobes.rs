@@ -20,7 +20,7 @@ warps! {
     /// Density of ``square_to_std_normal``: exp(-|x|^2 / 2) / (2 pi).
     fn square_to_std_normal_pdf(v: [2; Finite] "points of the plane")
         -> [1] "per unit area"
-        = |F| |p| [warp::square_to_std_normal_pdf::<F>(p)];
+        = |F| #[inline(always)] |p| [warp::square_to_std_normal_pdf::<F>(p)];
 
     /// Beckmann-distributed microfacet normals (Mitsuba's low-distortion
     /// map): tan^2 theta = -alpha^2 ln(1 - r^2) of the concentric disk
@@ -29,7 +29,7 @@ warps! {
         sample: [2; Unit] "values in [0, 1]",
         alpha: f64 = "float > 0, the roughness"
     ) -> [3] "unit vectors with z >= 0; density exp(-tan^2 theta / alpha^2) / (pi alpha^2 cos^3 theta) per sr"
-        = |F| let alpha = alpha_arg(alpha)?; move |u| warp::square_to_beckmann(u, alpha);
+        = |F| let alpha = alpha_arg(alpha)?; #[inline(always)] move |u| warp::square_to_beckmann(u, alpha);
 
     /// Density of ``square_to_beckmann``: exp(-tan^2 theta / alpha^2) /
     /// (pi alpha^2 cos^3 theta) per steradian for z > 0, else 0.
@@ -37,14 +37,14 @@ warps! {
         v: [3; Finite] "unit vectors",
         alpha: f64 = "float > 0, the roughness"
     ) -> [1] "per steradian"
-        = |F| let alpha = alpha_arg(alpha)?; move |m| [warp::square_to_beckmann_pdf(m, alpha)];
+        = |F| let alpha = alpha_arg(alpha)?; #[inline(always)] move |m| [warp::square_to_beckmann_pdf(m, alpha)];
 
     /// Inverse of ``square_to_beckmann``.
     fn beckmann_to_square(
         v: [3; Finite] "unit vectors with z >= 0",
         alpha: f64 = "float > 0, the roughness"
     ) -> [2] "in [0, 1]^2"
-        = |F| let alpha = alpha_arg(alpha)?; move |m| warp::beckmann_to_square(m, alpha);
+        = |F| let alpha = alpha_arg(alpha)?; #[inline(always)] move |m| warp::beckmann_to_square(m, alpha);
 
     /// Directions of the von Mises-Fisher lobe around +z: phi = 2 pi
     /// sample[..., 0], 1 - cos theta = -ln(1 - sample[..., 1] (1 -
@@ -53,7 +53,7 @@ warps! {
         sample: [2; Unit] "values in [0, 1]",
         kappa: f64 = "float >= 0, the concentration"
     ) -> [3] "unit vectors; density kappa exp(kappa (cos theta - 1)) / (2 pi (1 - exp(-2 kappa))) per sr"
-        = |F| let lobe = lobe_arg(kappa)?; move |u| warp::square_to_von_mises_fisher(u, &lobe);
+        = |F| let lobe = lobe_arg(kappa)?; #[inline(always)] move |u| warp::square_to_von_mises_fisher(u, &lobe);
 
     /// Density of ``square_to_von_mises_fisher``: kappa exp(kappa (cos
     /// theta - 1)) / (2 pi (1 - exp(-2 kappa))) per steradian (1 / (4 pi)
@@ -63,7 +63,7 @@ warps! {
         kappa: f64 = "float >= 0, the concentration"
     ) -> [1] "per steradian"
         = |F| let lobe = lobe_arg(kappa)?;
-            move |d| [warp::square_to_von_mises_fisher_pdf(d, &lobe)];
+            #[inline(always)] move |d| [warp::square_to_von_mises_fisher_pdf(d, &lobe)];
 
     /// Inverse of ``square_to_von_mises_fisher``: (phi / 2 pi, (1 -
     /// exp(kappa (cos theta - 1))) / (1 - exp(-2 kappa))).
@@ -71,7 +71,7 @@ warps! {
         v: [3; Finite] "unit vectors",
         kappa: f64 = "float >= 0, the concentration"
     ) -> [2] "in [0, 1]^2"
-        = |F| let lobe = lobe_arg(kappa)?; move |d| warp::von_mises_fisher_to_square(d, &lobe);
+        = |F| let lobe = lobe_arg(kappa)?; #[inline(always)] move |d| warp::von_mises_fisher_to_square(d, &lobe);
 
     /// Directions of the rough-fibre lobe: sample[..., 0] picks a direction
     /// on the fibre's specular cone of wi, sample[..., 1:] perturbs it by the
@@ -84,7 +84,7 @@ warps! {
     ) -> [3] "unit vectors"
         = |F| let (wi, t) = (unit_arg("wi", wi)?, unit_arg("tangent", tangent)?);
             let lobe = lobe_arg(kappa)?;
-            move |u| warp::square_to_rough_fiber(u, wi, t, &lobe);
+            #[inline(always)] move |u| warp::square_to_rough_fiber(u, wi, t, &lobe);
 
     /// Density of ``square_to_rough_fiber`` per steradian: exp(-s) I0(c)
     /// kappa exp(-kappa) / (2 pi (1 - exp(-2 kappa))) with s = kappa (wi.t)
@@ -98,7 +98,7 @@ warps! {
     ) -> [1] "per steradian"
         = |F| let (wi, t) = (unit_arg("wi", wi)?, unit_arg("tangent", tangent)?);
             let lobe = lobe_arg(kappa)?;
-            move |d| [warp::square_to_rough_fiber_pdf(d, wi, t, &lobe)];
+            #[inline(always)] move |d| [warp::square_to_rough_fiber_pdf(d, wi, t, &lobe)];
 
     /// Uniform directions in the two spherical lunes between the faces of
     /// normals n1 and n2: azimuth within theta = acos(n1.n2) / 2 of either
@@ -109,7 +109,7 @@ warps! {
         n2: [f64; 3] = "3 floats, the second normal, not parallel to n1"
     ) -> [3] "unit vectors; density 1 / (8 theta) per sr"
         = |F| let lunes = lunes_arg(n1, n2)?;
-            move |u| warp::square_to_uniform_spherical_lune(u, &lunes);
+            #[inline(always)] move |u| warp::square_to_uniform_spherical_lune(u, &lunes);
 
     /// Density of ``square_to_uniform_spherical_lune``: 1 / (8 theta) per
     /// steradian in the lunes, else 0 (Mitsuba: 1 / (8 theta) everywhere).
@@ -119,7 +119,7 @@ warps! {
         n2: [f64; 3] = "3 floats, the second normal, not parallel to n1"
     ) -> [1] "per steradian"
         = |F| let lunes = lunes_arg(n1, n2)?;
-            move |d| [warp::square_to_uniform_spherical_lune_pdf(d, &lunes)];
+            #[inline(always)] move |d| [warp::square_to_uniform_spherical_lune_pdf(d, &lunes)];
 
     /// Inverse of ``square_to_uniform_spherical_lune``.
     fn uniform_spherical_lune_to_square(
@@ -128,7 +128,7 @@ warps! {
         n2: [f64; 3] = "3 floats, the second normal, not parallel to n1"
     ) -> [2] "in [0, 1]^2"
         = |F| let lunes = lunes_arg(n1, n2)?;
-            move |d| warp::uniform_spherical_lune_to_square(d, &lunes);
+            #[inline(always)] move |d| warp::uniform_spherical_lune_to_square(d, &lunes);
 
     /// Directions in the plane orthogonal to n: cos(2 pi u) s + sin(2 pi
     /// u) t, with (s, t, n) Mitsuba's frame of n.
@@ -137,7 +137,7 @@ warps! {
         sample: [1; Unit] "values in [0, 1]"
     ) -> [3] "unit vectors orthogonal to n; uniform in angle"
         = |F| let n = unit_arg("n", n)?;
-            move |u: [F; 1]| warp::interval_to_tangent_direction(n, u[0]);
+            #[inline(always)] move |u: [F; 1]| warp::interval_to_tangent_direction(n, u[0]);
 
     /// Inverse of ``interval_to_tangent_direction``: the angle of the
     /// direction in n's frame as a fraction of a turn.
@@ -145,7 +145,7 @@ warps! {
         { n: [f64; 3] = "3 floats, the normal (normalised)" }
         dir: [3; Finite] "directions orthogonal to n"
     ) -> [1] "in [0, 1)"
-        = |F| let n = unit_arg("n", n)?; move |d| [warp::tangent_direction_to_interval(n, d)];
+        = |F| let n = unit_arg("n", n)?; #[inline(always)] move |d| [warp::tangent_direction_to_interval(n, d)];
 
     /// Density of ``square_to_bilinear``: the bilinear interpolant of the
     /// corners divided by their mean, on [0, 1]^2, else 0 (Mitsuba returns
@@ -157,7 +157,7 @@ warps! {
         sample: [2; Finite] "points of the plane"
     ) -> [1] "per unit area"
         = |F| let v = corners_arg(v00, v10, v01, v11)?;
-            move |p| [warp::square_to_bilinear_pdf(v, p)];
+            #[inline(always)] move |p| [warp::square_to_bilinear_pdf(v, p)];
 }
 
 /// Points of the bilinear density with corner values v00 at (0, 0), v10 at

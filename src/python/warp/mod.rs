@@ -18,7 +18,11 @@
 /// Parameters in braces before the points come first in the signature (as
 /// Mitsuba orders `interval_to_linear(v0, v1, sample)`). Every function
 /// also takes a keyword `out`: an array to write into, as numpy's ufuncs
-/// do.
+/// do. Kernels given as closures are marked `#[inline(always)]`: one left
+/// out of line is compiled for the baseline instruction set, outside the
+/// vector loop of [`crate::simd::map_rows`] (the cosine-power warp's took
+/// 122 ms for 10^7 float32 points, calling the C library's `floor` per
+/// point; inlined, 11.5 ms).
 macro_rules! warps {
     ($(
         $(#[doc = $summary:literal])*

@@ -19,7 +19,7 @@ warps! {
     /// Density of ``square_to_uniform_disk``: 1/pi on the unit disk, else 0.
     fn square_to_uniform_disk_pdf(x: [2; Finite] "points of the plane")
         -> [1] "per unit area"
-        = |F| |p| [warp::square_to_uniform_disk_pdf::<F>(p)];
+        = |F| #[inline(always)] |p| [warp::square_to_uniform_disk_pdf::<F>(p)];
 
     /// Inverse of ``square_to_uniform_disk``: (phi / 2 pi, r^2).
     fn uniform_disk_to_square(x: [2; Finite] "points of the unit disk")
@@ -35,7 +35,7 @@ warps! {
     /// disk, else 0.
     fn square_to_uniform_disk_concentric_pdf(x: [2; Finite] "points of the plane")
         -> [1] "per unit area"
-        = |F| |p| [warp::square_to_uniform_disk_concentric_pdf::<F>(p)];
+        = |F| #[inline(always)] |p| [warp::square_to_uniform_disk_concentric_pdf::<F>(p)];
 
     /// Inverse of ``square_to_uniform_disk_concentric``.
     fn uniform_disk_to_square_concentric(x: [2; Finite] "points of the unit disk")
@@ -51,7 +51,7 @@ warps! {
     /// Density of ``square_to_uniform_sphere``: 1/(4 pi) per steradian.
     fn square_to_uniform_sphere_pdf(x: [3; Finite] "unit vectors")
         -> [1] "per steradian"
-        = |F| |d| [warp::square_to_uniform_sphere_pdf::<F>(d)];
+        = |F| #[inline(always)] |d| [warp::square_to_uniform_sphere_pdf::<F>(d)];
 
     /// Inverse of ``square_to_uniform_sphere``: (phi / 2 pi, (1 - z) / 2).
     fn uniform_sphere_to_square(x: [3; Finite] "unit vectors")
@@ -68,7 +68,7 @@ warps! {
     /// for z >= 0, else 0.
     fn square_to_uniform_hemisphere_pdf(x: [3; Finite] "unit vectors")
         -> [1] "per steradian"
-        = |F| |d| [warp::square_to_uniform_hemisphere_pdf::<F>(d)];
+        = |F| #[inline(always)] |d| [warp::square_to_uniform_hemisphere_pdf::<F>(d)];
 
     /// Inverse of ``square_to_uniform_hemisphere``.
     fn uniform_hemisphere_to_square(x: [3; Finite] "unit vectors with z >= 0")
@@ -79,7 +79,7 @@ warps! {
     /// max(cos theta, 0) / pi per steradian.
     fn square_to_cosine_hemisphere_pdf(x: [3; Finite] "unit vectors")
         -> [1] "per steradian"
-        = |F| |d| [warp::square_to_cosine_hemisphere_pdf::<F>(d)];
+        = |F| #[inline(always)] |d| [warp::square_to_cosine_hemisphere_pdf::<F>(d)];
 
     /// Directions of the cos^n lobe around +z (the Phong lobe):
     /// cos theta = u1^(1/(n+1)), phi = 2 pi u0.
@@ -88,7 +88,7 @@ warps! {
         exponent: f64 = "float >= 0, the lobe's n"
     ) -> [3] "unit vectors; density (n + 1)/(2 pi) cos^n theta per sr"
         = |F| let n = exponent_arg(exponent)?;
-            move |u| warp::square_to_cosine_power_hemisphere(u, n);
+            #[inline(always)] move |u| warp::square_to_cosine_power_hemisphere(u, n);
 
     /// Density of ``square_to_cosine_power_hemisphere``:
     /// (n + 1)/(2 pi) cos^n theta per steradian for cos theta > 0, else 0.
@@ -97,7 +97,7 @@ warps! {
         exponent: f64 = "float >= 0, the lobe's n"
     ) -> [1] "per steradian"
         = |F| let n = exponent_arg(exponent)?;
-            move |d| [warp::square_to_cosine_power_hemisphere_pdf(d, n)];
+            #[inline(always)] move |d| [warp::square_to_cosine_power_hemisphere_pdf(d, n)];
 
     /// Inverse of ``square_to_cosine_power_hemisphere``:
     /// (phi / 2 pi, cos^(n+1) theta).
@@ -106,14 +106,14 @@ warps! {
         exponent: f64 = "float >= 0, the lobe's n"
     ) -> [2] "in [0, 1]^2"
         = |F| let n = exponent_arg(exponent)?;
-            move |d| warp::cosine_power_hemisphere_to_square(d, n);
+            #[inline(always)] move |d| warp::cosine_power_hemisphere_to_square(d, n);
 
     /// Uniform directions in the cone cos theta >= cos_cutoff around +z.
     fn square_to_uniform_cone(
         u: [2; Unit] "values in [0, 1]",
         cos_cutoff: f64 = "float in [-1, 1)"
     ) -> [3] "unit vectors; density 1 / (2 pi (1 - cos_cutoff)) per sr"
-        = |F| let c = cos_cutoff_arg(cos_cutoff)?; move |u| warp::square_to_uniform_cone(u, c);
+        = |F| let c = cos_cutoff_arg(cos_cutoff)?; #[inline(always)] move |u| warp::square_to_uniform_cone(u, c);
 
     /// Density of ``square_to_uniform_cone``: 1 / (2 pi (1 - cos_cutoff))
     /// per steradian inside the cone, else 0.
@@ -122,14 +122,14 @@ warps! {
         cos_cutoff: f64 = "float in [-1, 1)"
     ) -> [1] "per steradian"
         = |F| let c = cos_cutoff_arg(cos_cutoff)?;
-            move |d| [warp::square_to_uniform_cone_pdf(d, c)];
+            #[inline(always)] move |d| [warp::square_to_uniform_cone_pdf(d, c)];
 
     /// Inverse of ``square_to_uniform_cone``.
     fn uniform_cone_to_square(
         x: [3; Finite] "unit vectors inside the cone",
         cos_cutoff: f64 = "float in [-1, 1)"
     ) -> [2] "in [0, 1]^2"
-        = |F| let c = cos_cutoff_arg(cos_cutoff)?; move |d| warp::uniform_cone_to_square(d, c);
+        = |F| let c = cos_cutoff_arg(cos_cutoff)?; #[inline(always)] move |d| warp::uniform_cone_to_square(d, c);
 
     /// Uniform points on the triangle (0, 0), (1, 0), (0, 1):
     /// t = sqrt(1 - u0), point (1 - t, t u1).
@@ -141,7 +141,7 @@ warps! {
     /// else 0.
     fn square_to_uniform_triangle_pdf(x: [2; Finite] "points of the plane")
         -> [1] "per unit area"
-        = |F| |p| [warp::square_to_uniform_triangle_pdf::<F>(p)];
+        = |F| #[inline(always)] |p| [warp::square_to_uniform_triangle_pdf::<F>(p)];
 
     /// Inverse of ``square_to_uniform_triangle``.
     fn uniform_triangle_to_square(x: [2; Finite] "points of the triangle")
@@ -152,29 +152,29 @@ warps! {
     /// x = u^(1/(n+1)).
     fn interval_to_power(u: [1; Unit] "values in [0, 1]", exponent: f64 = "float >= 0")
         -> [1] "in [0, 1]"
-        = |F| let n = exponent_arg(exponent)?; move |u: [F; 1]| [warp::interval_to_power(u[0], n)];
+        = |F| let n = exponent_arg(exponent)?; #[inline(always)] move |u: [F; 1]| [warp::interval_to_power(u[0], n)];
 
     /// Density of ``interval_to_power``: (n + 1) x^n on [0, 1], else 0.
     fn interval_to_power_pdf(x: [1; Finite] "finite", exponent: f64 = "float >= 0")
         -> [1] "per unit length"
         = |F| let n = exponent_arg(exponent)?;
-            move |x: [F; 1]| [warp::interval_to_power_pdf(x[0], n)];
+            #[inline(always)] move |x: [F; 1]| [warp::interval_to_power_pdf(x[0], n)];
 
     /// Inverse of ``interval_to_power``: u = x^(n+1).
     fn power_to_interval(x: [1; Finite] "values in [0, 1]", exponent: f64 = "float >= 0")
         -> [1] "in [0, 1]"
-        = |F| let n = exponent_arg(exponent)?; move |x: [F; 1]| [warp::power_to_interval(x[0], n)];
+        = |F| let n = exponent_arg(exponent)?; #[inline(always)] move |x: [F; 1]| [warp::power_to_interval(x[0], n)];
 
     /// The tent 1 - |x| on [-1, 1] by inversion (Mitsuba's
     /// ``interval_to_tent``): s = u - 1/2, x = sign(s) (1 - sqrt(1 - 2|s|)).
     fn interval_to_tent(sample: [1; Unit] "values in [0, 1]")
         -> [1] "in [-1, 1]; density 1 - |x| per unit length"
-        = |F| |u: [F; 1]| [warp::interval_to_tent(u[0])];
+        = |F| #[inline(always)] |u: [F; 1]| [warp::interval_to_tent(u[0])];
 
     /// Inverse of ``interval_to_tent``: u = (x (2 - |x|) + 1) / 2.
     fn tent_to_interval(value: [1; Finite] "values in [-1, 1]")
         -> [1] "in [0, 1]"
-        = |F| |x: [F; 1]| [warp::tent_to_interval(x[0])];
+        = |F| #[inline(always)] |x: [F; 1]| [warp::tent_to_interval(x[0])];
 
     /// ``interval_to_tent`` in each coordinate: the tent
     /// (1 - |x|)(1 - |y|) on [-1, 1]^2.
@@ -191,7 +191,7 @@ warps! {
     /// else 0.
     fn square_to_tent_pdf(v: [2; Finite] "points of the plane")
         -> [1] "per unit area"
-        = |F| |p| [warp::square_to_tent_pdf::<F>(p)];
+        = |F| #[inline(always)] |p| [warp::square_to_tent_pdf::<F>(p)];
 
     /// The tent on [a, c] with its peak at b (Mitsuba's
     /// ``interval_to_nonuniform_tent``; the falling side runs from c down
@@ -203,7 +203,7 @@ warps! {
         d: [1; Unit] "values in [0, 1] (the sample)"
     ) -> [1] "in [a, c]"
         = |F| let (a, b, c) = tent_args(a, b, c)?;
-            move |u: [F; 1]| [warp::interval_to_nonuniform_tent(a, b, c, u[0])];
+            #[inline(always)] move |u: [F; 1]| [warp::interval_to_nonuniform_tent(a, b, c, u[0])];
 
     /// The linear density on [0, 1] from v0 at 0 to v1 at 1 by inversion:
     /// x = (v0 - sqrt((1 - u) v0^2 + u v1^2)) / (v0 - v1) (x = u when the
@@ -214,7 +214,7 @@ warps! {
         sample: [1; Unit] "values in [0, 1]"
     ) -> [1] "in [0, 1]; density 2((1 - x) v0 + x v1)/(v0 + v1) per unit length"
         = |F| let (v0, v1) = linear_args(v0, v1)?;
-            move |u: [F; 1]| [warp::interval_to_linear(v0, v1, u[0])];
+            #[inline(always)] move |u: [F; 1]| [warp::interval_to_linear(v0, v1, u[0])];
 
     /// Inverse of ``interval_to_linear``: u = x (x v1 + (2 - x) v0)/(v0 + v1).
     fn linear_to_interval(
@@ -222,7 +222,7 @@ warps! {
         sample: [1; Finite] "values in [0, 1]"
     ) -> [1] "in [0, 1]"
         = |F| let (v0, v1) = linear_args(v0, v1)?;
-            move |x: [F; 1]| [warp::linear_to_interval(v0, v1, x[0])];
+            #[inline(always)] move |x: [F; 1]| [warp::linear_to_interval(v0, v1, x[0])];
 
     /// The concentric map's polar coordinates as a point of the square
     /// (Mitsuba's ``square_to_uniform_square_concentric``): (phi / 2 pi,
