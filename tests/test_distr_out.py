@@ -102,3 +102,26 @@ def test_bad_out_is_refused():
     # The inputs are still checked when writing into out.
     with pytest.raises(ValueError, match="u"):
         d1.sample(np.full(N, 1.5), out=np.empty(N, np.int64))
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_batches_equal_single_draws(dtype):
+    # The batch methods draw in groups (the tables' prefetching samplers):
+    # each point gets what a call with that point alone returns.
+    d1, d2 = mcs.Discrete1D(W1), mcs.Discrete2D(W2)
+    p1 = mcs.PiecewiseConstant1D(W1, a=-1.0, b=2.0)
+    p2 = mcs.PiecewiseConstant2D(W2, domain=((0.0, 3.0), (-1.0, 1.0)))
+    u1 = np.concatenate([_u(1, dtype)[:197], np.array([0.0, 1.0], dtype)])
+    u2 = np.concatenate([_u(2, dtype)[:197], np.array([[0.0, 1.0], [1.0, 0.0]], dtype)])
+    for call, u in [(d1.sample_reuse, u1), (d2.sample_reuse, u2), (d2.sample, u2),
+                    (p1.sample, u1), (p2.sample, u2)]:
+        batch = call(u)
+        parts = batch if isinstance(batch, np.ndarray) else tuple(batch)
+        for k in range(len(u)):
+            one = call(u[k])
+            ones = one if isinstance(one, np.ndarray) else tuple(one)
+            if isinstance(parts, tuple):
+                for whole, single in zip(parts, ones):
+                    assert np.array_equal(whole[k], single), (call, k)
+            else:
+                assert np.array_equal(parts[k], ones), (call, k)

@@ -6,6 +6,7 @@ use crate::buffer::Buffer;
 use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::parallel;
+use crate::simd;
 use rayon::prelude::*;
 
 /// Entries per block of the running sums of a long table: each block is
@@ -165,6 +166,36 @@ impl Discrete1D {
         self.search().sample_reuse(u)
     }
 
+    /// `out[i] = sample_reuse(us[i])` for a batch, in the groups of
+    /// [`Discrete1D::sample_into`] (the weight each rescaling reads is
+    /// prefetched with the search's window), compiled for the widest vector
+    /// unit.
+    pub fn sample_reuse_into<F: Real>(&self, us: &[F], out: &mut [(usize, F)]) {
+        simd::dispatch(
+            #[inline(always)]
+            |_| self.sample_reuse_groups(us, out),
+        )
+    }
+
+    /// [`Discrete1D::sample_reuse_into`] without the dispatch, for the batch
+    /// loops of samplers built on this table (which dispatch themselves).
+    #[inline(always)]
+    pub(crate) fn sample_reuse_groups<F: Real>(&self, us: &[F], out: &mut [(usize, F)]) {
+        let search = self.search();
+        for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
+            let mut cells = [0; GROUP];
+            for (k, &u) in cells.iter_mut().zip(us) {
+                *k = search.locate(u.f64());
+            }
+            for &k in &cells[..us.len()] {
+                search.prefetch_window(k);
+            }
+            for ((o, &u), &k) in out.iter_mut().zip(us).zip(&cells) {
+                *o = search.index_reuse(u, k);
+            }
+        }
+    }
+
     /// The tables as slices, for the steps of a draw.
     #[inline(always)]
     pub(crate) fn search(&self) -> Search<'_> {
@@ -266,8 +297,11 @@ mod tests {
             let us: Vec<f64> = (0..=1000).map(|k| k as f64 / 1000.0).collect();
             let mut out = vec![0u64; us.len()];
             d.sample_into(&us, &mut out);
-            for (&u, &i) in us.iter().zip(&out) {
+            let mut reused = vec![(0, 0.0); us.len()];
+            d.sample_reuse_into(&us, &mut reused);
+            for ((&u, &i), &r) in us.iter().zip(&out).zip(&reused) {
                 assert_eq!(i as usize, d.sample(u), "n = {n}, u = {u}");
+                assert_eq!(r, d.sample_reuse(u), "n = {n}, u = {u}");
             }
         }
     }

@@ -8,7 +8,7 @@ use super::arrays::{Check, Indices, Points, PyFloat, broadcast, finish, output, 
 use super::arrays::{fresh, tuple_outputs, writable};
 use super::parallel::run_batch;
 use crate::python::{Obj, Out};
-use crate::simd::{STREAM_MIN_BYTES, map_rows};
+use crate::simd::{STREAM_MIN_BYTES, dispatch, map_rows};
 use numpy::{Element, PyArrayMethods};
 use pyo3::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -47,25 +47,26 @@ where
 }
 
 /// [`map_into`] for kernels that take a whole chunk of points at once and
-/// write one value per point (for work shared across points, such as
+/// write `M` values per point (for work shared across points, such as
 /// prefetching table cells), into `out` when it is given: every input
 /// value is checked first, and the kernel runs only on chunks that pass.
-pub fn map_chunks<'py, F, T, const K: usize>(
+pub fn map_chunks<'py, F, T, const K: usize, const M: usize>(
     py: Python<'py>,
     x: &Points<'py, F, K>,
     check: Check,
     out: Out<'_, 'py>,
-    kernel: impl Fn(&[[F; K]], &mut [T]) + Sync + Send,
+    kernel: impl Fn(&[[F; K]], &mut [[T; M]]) + Sync + Send,
 ) -> PyResult<Obj<'py>>
 where
     F: PyFloat,
     T: Element + bytemuck::Pod + Default + Send,
 {
-    let out = output::<T>(py, &x.out_shape(1), out, "out")?;
+    let out = output::<T>(py, &x.out_shape(M), out, "out")?;
     {
         let mut guard = writable(&out)?;
+        let out_rows = guard.as_slice_mut()?.as_chunks_mut::<M>().0;
         let in_rows = x.rows();
-        let valid = run_batch(py, x.n, guard.as_slice_mut()?, |range, chunk: &mut [T]| {
+        let valid = run_batch(py, x.n, out_rows, |range, chunk: &mut [[T; M]]| {
             let inputs = &in_rows[range];
             let ok = inputs.iter().fold(true, |ok, p| ok & check.holds_all(p));
             if ok {
@@ -78,6 +79,44 @@ where
         }
     }
     finish(out)
+}
+
+/// [`map_chunks`] for kernels of two results per point (`M` and `L`
+/// values), returned as two arrays or written into those of `out` (see
+/// [`map2`]).
+pub fn map_chunks2<'py, F, T, S, const K: usize, const M: usize, const L: usize>(
+    py: Python<'py>,
+    x: &Points<'py, F, K>,
+    check: Check,
+    (out, names): (Out<'_, 'py>, &str),
+    kernel: impl Fn(&[[F; K]], &mut [[T; M]], &mut [[S; L]]) + Sync + Send,
+) -> PyResult<(Obj<'py>, Obj<'py>)>
+where
+    F: PyFloat,
+    T: Element + bytemuck::Pod + Default + Send,
+    S: Element + bytemuck::Pod + Default + Send,
+{
+    let [o1, o2] = tuple_outputs::<2>(out, names)?;
+    let first = output::<T>(py, &x.out_shape(M), o1.as_ref(), "out[0]")?;
+    let second = output::<S>(py, &x.out_shape(L), o2.as_ref(), "out[1]")?;
+    {
+        let (mut g1, mut g2) = (writable(&first)?, writable(&second)?);
+        let rows1 = g1.as_slice_mut()?.as_chunks_mut::<M>().0;
+        let rows2 = g2.as_slice_mut()?.as_chunks_mut::<L>().0;
+        let in_rows = x.rows();
+        let valid = run_batch(py, x.n, (rows1, rows2), |range, (c1, c2)| {
+            let inputs = &in_rows[range];
+            let ok = inputs.iter().fold(true, |ok, p| ok & check.holds_all(p));
+            if ok {
+                kernel(inputs, c1, c2);
+            }
+            ok
+        })?;
+        if !valid {
+            return Err(x.invalid(check));
+        }
+    }
+    Ok((finish(first)?, finish(second)?))
 }
 
 /// Maps every point through `kernel` (`K` values in, `M` out, of any
@@ -172,14 +211,21 @@ where
         let (rows_a, rows_b) = (a.rows(), b.rows());
         let (step_a, step_b) = (usize::from(a.n != 1), usize::from(b.n != 1));
         let (valid_a, valid_b) = run_batch_pair(py, n, out_rows, |range, chunk: &mut [[T; M]]| {
-            let (mut ok_a, mut ok_b) = (true, true);
-            for (o, i) in chunk.iter_mut().zip(range) {
-                let (x, y) = (rows_a[i * step_a], rows_b[i * step_b]);
-                ok_a &= check_a.holds_all(&x);
-                ok_b &= check_b.holds_all(&y);
-                *o = kernel(x, y);
-            }
-            (ok_a, ok_b)
+            // Inside the dispatch, so that the kernel (inlined) is built
+            // for the CPU's vector unit, not the baseline instruction set.
+            dispatch(
+                #[inline(always)]
+                |_| {
+                    let (mut ok_a, mut ok_b) = (true, true);
+                    for (o, i) in chunk.iter_mut().zip(range) {
+                        let (x, y) = (rows_a[i * step_a], rows_b[i * step_b]);
+                        ok_a &= check_a.holds_all(&x);
+                        ok_b &= check_b.holds_all(&y);
+                        *o = kernel(x, y);
+                    }
+                    (ok_a, ok_b)
+                },
+            )
         })?;
         if !valid_a {
             return Err(a.invalid(check_a));
@@ -242,12 +288,18 @@ where
         let rows2 = g2.as_slice_mut()?.as_chunks_mut::<L>().0;
         let in_rows = x.rows();
         let valid = run_batch(py, x.n, (rows1, rows2), |range, (c1, c2)| {
-            let mut ok = true;
-            for ((o1, o2), u) in c1.iter_mut().zip(c2.iter_mut()).zip(&in_rows[range]) {
-                ok &= check.holds_all(u);
-                (*o1, *o2) = kernel(*u);
-            }
-            ok
+            // In the dispatch, as [`map_pair`]'s loop.
+            dispatch(
+                #[inline(always)]
+                |_| {
+                    let mut ok = true;
+                    for ((o1, o2), u) in c1.iter_mut().zip(c2.iter_mut()).zip(&in_rows[range]) {
+                        ok &= check.holds_all(u);
+                        (*o1, *o2) = kernel(*u);
+                    }
+                    ok
+                },
+            )
         })?;
         if !valid {
             return Err(x.invalid(check));

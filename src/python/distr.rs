@@ -4,11 +4,11 @@
 //! in the sampling pass.
 
 use super::arrays::{Check, Indices, Points, Table, output, with_precision, writable};
-use super::batch::{map_chunks, map_indices, map_into, map2};
+use super::batch::{map_chunks, map_chunks2, map_indices, map_into};
 use super::parallel::detached;
 use super::pickle::reduce;
 use super::records::record;
-use crate::distr;
+use crate::distr::{self, GROUP};
 use crate::python::{Obj, Out};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
@@ -41,6 +41,24 @@ fn per_index<'py>(
         }
     }
     Ok(array.into_any())
+}
+
+/// The batch draw `draw` of `inputs` (a table's own results, [`GROUP`]
+/// at a time in a buffer on the stack), each result `r` of input `k`
+/// handed to `write(k, r)`.
+fn in_groups<U: Copy, R: Copy + Default>(
+    inputs: &[U],
+    draw: impl Fn(&[U], &mut [R]),
+    mut write: impl FnMut(usize, R),
+) {
+    let mut buffer = [R::default(); GROUP];
+    for (g, group) in inputs.chunks(GROUP).enumerate() {
+        let drawn = &mut buffer[..group.len()];
+        draw(group, drawn);
+        for (k, &r) in drawn.iter().enumerate() {
+            write(g * GROUP + k, r);
+        }
+    }
 }
 
 /// The Python methods of a 1D index table (`Discrete1D`, `AliasTable`):
@@ -77,8 +95,8 @@ macro_rules! index_table_methods {
             ) -> PyResult<Obj<'py>> {
                 with_precision!(u, F => {
                     let u = Points::<F, 1>::extract(u, "u")?;
-                    map_chunks(py, &u, Check::Unit, out, |u, out: &mut [i64]| {
-                        self.0.sample_into(u.as_flattened(), out)
+                    map_chunks(py, &u, Check::Unit, out, |u, out: &mut [[i64; 1]]| {
+                        self.0.sample_into(u.as_flattened(), out.as_flattened_mut())
                     })
                 })
             }
@@ -199,10 +217,13 @@ index_table_methods!(PyDiscrete1D, distr::Discrete1D, "Discrete1D", {
     ) -> PyResult<PyReusedSample> {
         with_precision!(u, F => {
             let u = Points::<F, 1>::extract(u, "u")?;
-            let (index, u) = map2(py, &u, Check::Unit, (out, "index, u"), |u| {
-                let (i, r) = self.0.sample_reuse(u[0]);
-                ([i as i64], [r])
-            })?;
+            let kernel = |u: &[[F; 1]], index: &mut [[i64; 1]], rescaled: &mut [[F; 1]]| {
+                let draw = |u: &[F], out: &mut [(usize, F)]| self.0.sample_reuse_into(u, out);
+                in_groups(u.as_flattened(), draw, |k, (i, r)| {
+                    (index[k], rescaled[k]) = ([i as i64], [r]);
+                });
+            };
+            let (index, u) = map_chunks2(py, &u, Check::Unit, (out, "index, u"), kernel)?;
             Ok(PyReusedSample::new(index, u))
         })
     }
@@ -282,9 +303,9 @@ impl PyDiscrete2D {
     fn sample<'py>(&self, py: Python<'py>, u: &Obj<'py>, out: Out<'_, 'py>) -> PyResult<Obj<'py>> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
-            map_into(py, &u, Check::Unit, out, |u| {
-                let (r, c) = self.table.sample(u);
-                [r as i64, c as i64]
+            map_chunks(py, &u, Check::Unit, out, |u, cells: &mut [[i64; 2]]| {
+                let draw = |u: &[[F; 2]], out: &mut [_]| self.table.sample_reuse_into(u, out);
+                in_groups(u, draw, |k, ((r, c), _)| cells[k] = [r as i64, c as i64]);
             })
         })
     }
@@ -311,10 +332,13 @@ impl PyDiscrete2D {
     ) -> PyResult<PyReusedSample> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
-            let (index, u) = map2(py, &u, Check::Unit, (out, "index, u"), |u| {
-                let ((r, c), v) = self.table.sample_reuse(u);
-                ([r as i64, c as i64], v)
-            })?;
+            let kernel = |u: &[[F; 2]], index: &mut [[i64; 2]], rescaled: &mut [[F; 2]]| {
+                let draw = |u: &[[F; 2]], out: &mut [_]| self.table.sample_reuse_into(u, out);
+                in_groups(u, draw, |k, ((r, c), v)| {
+                    (index[k], rescaled[k]) = ([r as i64, c as i64], v);
+                });
+            };
+            let (index, u) = map_chunks2(py, &u, Check::Unit, (out, "index, u"), kernel)?;
             Ok(PyReusedSample::new(index, u))
         })
     }
@@ -411,10 +435,11 @@ impl PyPiecewiseConstant1D {
     ) -> PyResult<PyPiecewiseSample> {
         with_precision!(u, F => {
             let u = Points::<F, 1>::extract(u, "u")?;
-            let (x, pdf) = map2(py, &u, Check::Unit, (out, "x, pdf"), |u| {
-                let (x, pdf) = self.0.sample(u[0]);
-                ([x], [pdf])
-            })?;
+            let kernel = |u: &[[F; 1]], x: &mut [[F; 1]], pdf: &mut [[F; 1]]| {
+                let draw = |u: &[F], out: &mut [(F, F)]| self.0.sample_into(u, out);
+                in_groups(u.as_flattened(), draw, |k, (p, d)| (x[k], pdf[k]) = ([p], [d]));
+            };
+            let (x, pdf) = map_chunks2(py, &u, Check::Unit, (out, "x, pdf"), kernel)?;
             Ok(PyPiecewiseSample::new(x, pdf))
         })
     }
@@ -563,10 +588,11 @@ impl PyPiecewiseConstant2D {
     ) -> PyResult<PyPiecewiseSample> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
-            let (x, pdf) = map2(py, &u, Check::Unit, (out, "x, pdf"), |u| {
-                let (p, pdf) = self.0.sample(u);
-                (p, [pdf])
-            })?;
+            let kernel = |u: &[[F; 2]], x: &mut [[F; 2]], pdf: &mut [[F; 1]]| {
+                let draw = |u: &[[F; 2]], out: &mut [([F; 2], F)]| self.0.sample_into(u, out);
+                in_groups(u, draw, |k, (p, d)| (x[k], pdf[k]) = (p, [d]));
+            };
+            let (x, pdf) = map_chunks2(py, &u, Check::Unit, (out, "x, pdf"), kernel)?;
             Ok(PyPiecewiseSample::new(x, pdf))
         })
     }

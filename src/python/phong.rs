@@ -63,9 +63,13 @@ impl PyPhong {
         let wi = Points::<F, 3>::extract(wi, "wi")?;
         let wo = Points::<F, 3>::extract(wo, "wo")?;
         let phong = &self.0;
-        map_pair(py, (&wi, Check::Finite), (&wo, Check::Finite), |a, b| {
-            kernel(phong, a, b)
-        })
+        map_pair(
+            py,
+            (&wi, Check::Finite),
+            (&wo, Check::Finite),
+            #[inline(always)]
+            |a, b| kernel(phong, a, b),
+        )
     }
 }
 
@@ -105,7 +109,7 @@ impl PyPhong {
     /// -------
     /// ndarray, shape (N, 3) or (3,), per steradian.
     fn eval<'py>(&self, py: Python<'py>, wi: &Obj<'py>, wo: &Obj<'py>) -> PyResult<Obj<'py>> {
-        with_precision!(wo, F => self.pair::<F, 3>(py, wi, wo, |p, a, b| p.eval(a, b)))
+        with_precision!(wo, F => self.pair::<F, 3>(py, wi, wo, #[inline(always)] |p, a, b| p.eval(a, b)))
     }
 
     /// The density of ``sample`` at wo for wi, per steradian.
@@ -118,7 +122,7 @@ impl PyPhong {
     /// -------
     /// ndarray, shape (N,) (a scalar for single directions).
     fn pdf<'py>(&self, py: Python<'py>, wi: &Obj<'py>, wo: &Obj<'py>) -> PyResult<Obj<'py>> {
-        with_precision!(wo, F => self.pair::<F, 1>(py, wi, wo, |p, a, b| [p.pdf(a, b)]))
+        with_precision!(wo, F => self.pair::<F, 1>(py, wi, wo, #[inline(always)] |p, a, b| [p.pdf(a, b)]))
     }
 
     /// Directions drawn for wi.

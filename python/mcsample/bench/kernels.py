@@ -207,6 +207,7 @@ def suite_distr(n: int, repeat: int, mi) -> list[Timing]:
         seconds = measure_alternating([f for _, _, f in runs], repeat)
         out += [Timing(case, impl, dtype, count, t)
                 for (impl, dtype, _), t in zip(runs, seconds)]
+    out += _distr_methods(n, repeat, mi)
     cdf = np.cumsum(weights)
     out.append(Timing("sample 10^6 table", "numpy searchsorted", "float64", n,
                       measure(lambda: np.searchsorted(cdf, u * cdf[-1]), repeat)))
@@ -225,6 +226,56 @@ def suite_distr(n: int, repeat: int, mi) -> list[Timing]:
                           measure(lambda: urn.rvs(n), repeat)))
     except ImportError:
         pass
+    return out
+
+
+def _distr_methods(n: int, repeat: int, mi) -> list[Timing]:
+    """The distributions' other batch methods on float32 u, the plain call,
+    into reused arrays (out=) and Mitsuba's equivalent, alternating:
+    ``sample_reuse`` of 1000 weights, a 128 x 256 ``Discrete2D`` and
+    ``PiecewiseConstant1D.sample`` (Mitsuba's ``ContinuousDistribution``
+    over 1000 values; its ``sample_pdf``)."""
+    rng = np.random.default_rng(7)
+    w1, w2 = rng.random(1000), rng.random((128, 256))
+    u1 = mcs.uniform(n, 1, seed=8)[:, 0].astype(np.float32)
+    u2 = mcs.uniform(n, 2, seed=9).astype(np.float32)
+    d1, d2, p1 = mcs.Discrete1D(w1), mcs.Discrete2D(w2), mcs.PiecewiseConstant1D(w1)
+    i1, i2 = np.empty(n, np.int64), np.empty((n, 2), np.int64)
+    f1, f1b = np.empty(n, np.float32), np.empty(n, np.float32)
+    cases: dict[str, list[tuple[str, Callable[[], object]]]] = {
+        "Discrete1D.sample_reuse 1000": [
+            ("mcsample", lambda: d1.sample_reuse(u1)),
+            ("mcsample out=", lambda: d1.sample_reuse(u1, out=(i1, f1)))],
+        "Discrete2D.sample 128x256": [
+            ("mcsample", lambda: d2.sample(u2)),
+            ("mcsample out=", lambda: d2.sample(u2, out=i2))],
+        "PiecewiseConstant1D.sample 1000": [
+            ("mcsample", lambda: p1.sample(u1)),
+            ("mcsample out=", lambda: p1.sample(u1, out=(f1, f1b)))],
+    }
+    if mi is not None:
+        import drjit as dr
+
+        def run(f):
+            def go():
+                dr.eval(f())
+                dr.sync_thread()
+            return go
+
+        uf, u2f = mi.Float(u1), mi.Point2f(u2[:, 0], u2[:, 1])
+        m1 = mi.DiscreteDistribution(w1.astype(np.float32))
+        m2 = mi.DiscreteDistribution2D(w2.astype(np.float32))
+        c1 = mi.ContinuousDistribution([0.0, 1.0], w1.astype(np.float32))
+        cases["Discrete1D.sample_reuse 1000"].append(
+            ("Mitsuba 3 llvm", run(lambda: m1.sample_reuse(uf))))
+        cases["Discrete2D.sample 128x256"].append(
+            ("Mitsuba 3 llvm", run(lambda: m2.sample(u2f))))
+        cases["PiecewiseConstant1D.sample 1000"].append(
+            ("Mitsuba 3 llvm", run(lambda: c1.sample_pdf(uf))))
+    out = []
+    for case, runs in cases.items():
+        seconds = measure_alternating([f for _, f in runs], repeat)
+        out += [Timing(case, impl, "float32", n, t) for (impl, _), t in zip(runs, seconds)]
     return out
 
 
