@@ -143,6 +143,20 @@ impl Discrete1D {
     /// sums each search reads, then search; so the cache misses of a group
     /// overlap rather than queue.
     pub fn sample_into<F: Real, I: From<u32>>(&self, us: &[F], out: &mut [I]) {
+        self.searched_in_groups(us, out, |search, u, k| {
+            I::from(search.index(u.f64(), k) as u32)
+        });
+    }
+
+    /// The sweeps of [`Discrete1D::sample_into`], each group's last one
+    /// writing `out[i] = finish(search, us[i], guide cell of us[i])`.
+    #[inline(always)]
+    fn searched_in_groups<F: Real, O>(
+        &self,
+        us: &[F],
+        out: &mut [O],
+        finish: impl Fn(&Search<'_>, F, usize) -> O,
+    ) {
         let search = self.search();
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
             let mut cells = [0; GROUP];
@@ -153,7 +167,7 @@ impl Discrete1D {
                 search.prefetch_window(k);
             }
             for ((o, &u), &k) in out.iter_mut().zip(us).zip(&cells) {
-                *o = I::from(search.index(u.f64(), k) as u32);
+                *o = finish(&search, u, k);
             }
         }
     }
@@ -181,19 +195,7 @@ impl Discrete1D {
     /// loops of samplers built on this table (which dispatch themselves).
     #[inline(always)]
     pub(crate) fn sample_reuse_groups<F: Real>(&self, us: &[F], out: &mut [(usize, F)]) {
-        let search = self.search();
-        for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
-            let mut cells = [0; GROUP];
-            for (k, &u) in cells.iter_mut().zip(us) {
-                *k = search.locate(u.f64());
-            }
-            for &k in &cells[..us.len()] {
-                search.prefetch_window(k);
-            }
-            for ((o, &u), &k) in out.iter_mut().zip(us).zip(&cells) {
-                *o = search.index_reuse(u, k);
-            }
-        }
+        self.searched_in_groups(us, out, |search, u, k| search.index_reuse(u, k));
     }
 
     /// The tables as slices, for the steps of a draw.

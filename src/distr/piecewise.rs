@@ -148,7 +148,14 @@ impl PiecewiseConstant1D {
     #[inline]
     pub fn sample<F: Real>(&self, u: F) -> (F, F) {
         let (i, r) = self.table.sample_reuse(u);
-        let pdf = self.table.weight(i) / self.integral();
+        self.sample_in_cell(i, r, self.integral())
+    }
+
+    /// The point at fraction `r` (in `[0, 1)`) of cell `i`, and the density
+    /// there (`integral`: [`PiecewiseConstant1D::integral`]).
+    #[inline(always)]
+    fn sample_in_cell<F: Real>(&self, i: usize, r: F, integral: f64) -> (F, F) {
+        let pdf = self.table.weight(i) / integral;
         (self.axis.point(i, r.f64()), F::c(pdf))
     }
 
@@ -165,8 +172,7 @@ impl PiecewiseConstant1D {
                     let cells = &mut cells[..us.len()];
                     self.table.sample_reuse_groups(us, cells);
                     for (o, &(i, r)) in out.iter_mut().zip(cells.iter()) {
-                        let pdf = self.table.weight(i) / integral;
-                        *o = (self.axis.point(i, r.f64()), F::c(pdf));
+                        *o = self.sample_in_cell(i, r, integral);
                     }
                 }
             },

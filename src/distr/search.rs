@@ -291,7 +291,8 @@ impl<'a> Search<'a> {
     #[inline(always)]
     pub(crate) fn rescale<F: Real>(&self, u: F, i: usize) -> F {
         let rescaled = (u.f64() * self.sum - self.sum_before(i)) / self.weights[self.start + i];
-        F::c(rescaled.clamp(0.0, f64::ONE_MINUS_EPSILON))
+        // Clamped in `F`: `1 − 2⁻⁵³` would round to `1.0` in `f32`.
+        F::c(rescaled.max(0.0)).min(F::ONE_MINUS_EPSILON)
     }
 
     /// `C_{i−1}` (0 for i = 0, Σw past the end).

@@ -403,7 +403,11 @@ pub fn tuple_outputs<'py, const N: usize>(
             "out must be a tuple of {count} arrays: ({names})"
         )));
     };
-    Ok(std::array::from_fn(|k| items.get_item(k).ok()))
+    let mut arrays: [Option<Obj<'py>>; N] = std::array::from_fn(|_| None);
+    for (k, slot) in arrays.iter_mut().enumerate() {
+        *slot = Some(items.get_item(k)?);
+    }
+    Ok(arrays)
 }
 
 /// Write access to an output array, which fails (rather than panics) when

@@ -82,8 +82,9 @@ where
 }
 
 /// [`map_chunks`] for kernels of two results per point (`M` and `L`
-/// values), returned as two arrays or written into those of `out` (see
-/// [`map2`]).
+/// values), returned as two arrays, or written into the two arrays of
+/// `out` when it is given (a tuple, see [`tuple_outputs`]; `names` names
+/// the results in its message).
 pub fn map_chunks2<'py, F, T, S, const K: usize, const M: usize, const L: usize>(
     py: Python<'py>,
     x: &Points<'py, F, K>,
@@ -266,12 +267,13 @@ where
 /// As [`map_into`] for kernels with two results (`M` and `L` values per point),
 /// returned as two arrays, or written into the two arrays of `out` when it
 /// is given (a tuple, see [`tuple_outputs`]; `names` names the results in
-/// its message).
+/// its message). The loop runs inside the SIMD dispatch, as
+/// [`map_pair`]'s.
 pub fn map2<'py, F, T, S, const K: usize, const M: usize, const L: usize>(
     py: Python<'py>,
     x: &Points<'py, F, K>,
     check: Check,
-    (out, names): (Out<'_, 'py>, &str),
+    out: (Out<'_, 'py>, &str),
     kernel: impl Fn([F; K]) -> ([T; M], [S; L]) + Sync + Send,
 ) -> PyResult<(Obj<'py>, Obj<'py>)>
 where
@@ -279,33 +281,16 @@ where
     T: Element + bytemuck::Pod + Default + Send,
     S: Element + bytemuck::Pod + Default + Send,
 {
-    let [o1, o2] = tuple_outputs::<2>(out, names)?;
-    let first = output::<T>(py, &x.out_shape(M), o1.as_ref(), "out[0]")?;
-    let second = output::<S>(py, &x.out_shape(L), o2.as_ref(), "out[1]")?;
-    {
-        let (mut g1, mut g2) = (writable(&first)?, writable(&second)?);
-        let rows1 = g1.as_slice_mut()?.as_chunks_mut::<M>().0;
-        let rows2 = g2.as_slice_mut()?.as_chunks_mut::<L>().0;
-        let in_rows = x.rows();
-        let valid = run_batch(py, x.n, (rows1, rows2), |range, (c1, c2)| {
-            // In the dispatch, as [`map_pair`]'s loop.
-            dispatch(
-                #[inline(always)]
-                |_| {
-                    let mut ok = true;
-                    for ((o1, o2), u) in c1.iter_mut().zip(c2.iter_mut()).zip(&in_rows[range]) {
-                        ok &= check.holds_all(u);
-                        (*o1, *o2) = kernel(*u);
-                    }
-                    ok
-                },
-            )
-        })?;
-        if !valid {
-            return Err(x.invalid(check));
-        }
-    }
-    Ok((finish(first)?, finish(second)?))
+    map_chunks2(py, x, check, out, |inputs, c1, c2| {
+        dispatch(
+            #[inline(always)]
+            |_| {
+                for ((o1, o2), u) in c1.iter_mut().zip(c2.iter_mut()).zip(inputs) {
+                    (*o1, *o2) = kernel(*u);
+                }
+            },
+        )
+    })
 }
 
 /// Maps every index row to one float64 value: the batch's shape, or a

@@ -55,7 +55,14 @@ impl PyFrame {
         let frames = alloc::collect(self.frames.iter().map(cast), "the frames")?;
         if self.batch.is_empty() {
             let f = frames[0];
-            return map_into(py, &v, Check::Finite, None, move |x| op(&f, x));
+            return map_into(
+                py,
+                &v,
+                Check::Finite,
+                None,
+                #[inline(always)]
+                move |x| op(&f, x),
+            );
         }
         let batch =
             broadcast(("normal", &self.batch), ("v", &v.batch)).map_err(|_| Error::Shape {

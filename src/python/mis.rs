@@ -71,7 +71,7 @@ fn heuristic<'py>(
         let a = Points::<F, 1>::extract(pdf_a, "pdf_a")?;
         let b = Points::<F, 1>::extract(pdf_b, "pdf_b")?;
         let beta = F::c(beta);
-        map_pair(py, (&a, Check::Density), (&b, Check::Density), move |a, b| {
+        map_pair(py, (&a, Check::Density), (&b, Check::Density), #[inline(always)] move |a, b| {
             [mis::power_heuristic(a[0], b[0], beta)]
         })
     })

@@ -15,6 +15,7 @@ mod mis;
 mod parallel;
 mod phong;
 mod pickle;
+mod piecewise;
 mod qmc;
 mod records;
 mod recycle;
@@ -59,6 +60,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(parallel::get_num_threads, m)?)?;
     m.add_function(wrap_pyfunction!(parallel::_trigger_panic, m)?)?;
     distr::register(m)?;
+    piecewise::register(m)?;
     m.add_class::<frame::PyFrame>()?;
     m.add_class::<phong::PyPhong>()?;
     m.add_class::<phong::PyPhongSample>()?;

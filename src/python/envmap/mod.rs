@@ -188,9 +188,14 @@ impl PyEnvMap {
         let uv = Points::<F, 2>::extract(uv, "uv")?;
         let env = &self.0;
         let bounds = [[0.0, 1.0], [0.0, env.options().mapping.t_max()]];
-        map_into(py, &uv, Check::Within(bounds), None, |p: [F; 2]| {
-            env.uv_to_dir(p.map(F::f64)).map(F::c)
-        })
+        map_into(
+            py,
+            &uv,
+            Check::Within(bounds),
+            None,
+            #[inline(always)]
+            |p: [F; 2]| env.uv_to_dir(p.map(F::f64)).map(F::c),
+        )
     }
 }
 

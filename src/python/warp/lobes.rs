@@ -243,10 +243,17 @@ where
 {
     let corners = corners_arg(v00, v10, v01, v11)?;
     let points = Points::<F, 2>::extract(sample, "sample")?;
-    map2(py, &points, check, out, |p| {
-        let (q, pdf) = kernel(corners, p);
-        (q, [pdf])
-    })
+    map2(
+        py,
+        &points,
+        check,
+        out,
+        #[inline(always)]
+        |p| {
+            let (q, pdf) = kernel(corners, p);
+            (q, [pdf])
+        },
+    )
 }
 
 /// Registers the lobes, lunes, tangent and bilinear warps in module `m`.
