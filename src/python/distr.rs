@@ -293,8 +293,8 @@ impl PyDiscrete2D {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
             map_chunks(py, &u, Check::Unit, out, |u, cells: &mut [[i64; 2]]| {
-                let draw = |u: &[[F; 2]], out: &mut [_]| self.table.sample_reuse_into(u, out);
-                in_groups(u, draw, |k, ((r, c), _)| cells[k] = [r as i64, c as i64]);
+                let draw = |u: &[[F; 2]], out: &mut [_]| self.table.sample_into(u, out);
+                in_groups(u, draw, |k, (r, c)| cells[k] = [r as i64, c as i64]);
             })
         })
     }
