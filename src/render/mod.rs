@@ -71,12 +71,12 @@ use crate::alloc;
 use crate::error::Result;
 use crate::parallel;
 use crate::rng::Rng;
-use crate::sampler::batch::{Drawn, Request};
+use crate::sampler::batch::Drawn;
 use crate::sampler::zorder::ZOrder;
 use crate::sampler::{Sampler, Stream};
 use accel::Hit;
 use film::{Block, Sums};
-use numbers::{Numbers, camera_requests};
+use numbers::{Numbers, camera_dims};
 use shape::Ray;
 use wavefront::{CameraSample, Wavefront};
 
@@ -188,9 +188,7 @@ struct Batch {
     stream: embree::Stream,
     /// The camera's numbers drawn beforehand, `BATCH` samples at a time
     /// (the samplers other than the independent one): the `j`-th sample's
-    /// requests and values are those from `(j mod BATCH)·(1 + lens + time)`
-    /// on.
-    requests: Vec<Request>,
+    /// are the `(j mod BATCH)`-th of the batch.
     drawn: Drawn,
     /// One pixel's sums per block at a time.
     block_sums: Vec<Sums>,
@@ -245,11 +243,12 @@ impl Batch {
         // time (likewise).
         let independent = settings.sampler == Sampler::Independent;
         let lens_drawn = scene.camera().has_lens() || independent;
-        let per_sample = 1 + usize::from(lens_drawn) + usize::from(moves);
-        if !independent {
-            self.requests.clear();
-            alloc::reserve(&mut self.requests, BATCH.min(n) * per_sample, WHAT)?;
-        }
+        let camera = if independent {
+            Vec::new()
+        } else {
+            camera_dims((lens_drawn, moves))
+        };
+        self.drawn.values.clear();
         let spp = spp.max(1) as usize;
         let index = |i: usize| samples.first + i as u64;
         // The other samplers' camera numbers drawn together, BATCH
@@ -262,20 +261,18 @@ impl Batch {
             let key = mix(seed, pixel);
             for i in 0..spp {
                 if !independent && j % BATCH == 0 {
-                    self.requests.clear();
-                    let (mut q, mut k) = (p, i);
-                    for _ in j..(j + BATCH).min(n) {
-                        let index = index(k) as u32;
-                        camera_requests(q as u32, index, (lens_drawn, moves), &mut self.requests);
-                        (q, k) = if k + 1 == spp { (q + 1, 0) } else { (q, k + 1) };
-                    }
-                    self.drawn.draw(&mut streams, &self.requests)?;
+                    // Sample `j + m` is sample `(i + m) mod spp` of pixel
+                    // `p + (i + m) / spp`.
+                    let samples = (0..(j + BATCH).min(n) - j).map(|m| {
+                        let (q, k) = (p + (i + m) / spp, (i + m) % spp);
+                        (q as u32, index(k) as u32)
+                    });
+                    self.drawn.draw(&mut streams, samples, &camera)?;
                 }
                 let stream = &mut streams[p];
                 start_sample(stream, key, pixel, index(i));
-                let first = j % BATCH * per_sample;
-                let drawn = (&self.requests[..], &self.drawn.values[..]);
-                let mut numbers = Numbers::new(stream, drawn, first..first + per_sample);
+                let drawn = (&camera[..], &self.drawn.values[..]);
+                let mut numbers = Numbers::new(stream, drawn, j % BATCH);
                 let film = numbers.get2(dims::FILM);
                 let lens = if lens_drawn {
                     numbers.get2(dims::LENS)

@@ -7,30 +7,32 @@
 
 use super::integrator::{Integrator, Settings, Strategy, dims};
 use crate::rng::Rng;
-use crate::sampler::batch::Request;
+use crate::sampler::batch::Dim;
 use crate::sampler::{Sampler, Stream};
 
 /// The numbers of one camera sample, or of one path's bounce.
 pub struct Numbers<'a> {
     /// The pixel's stream, at the sample.
     pub stream: &'a mut Stream,
-    /// The requests drawn for the sample beforehand, and their values.
-    drawn: (&'a [Request], &'a [[f32; 2]]),
+    /// The dimensions drawn for every sample of the step beforehand, and
+    /// this sample's values of them.
+    drawn: (&'a [Dim], &'a [[f32; 2]]),
 }
 
 impl<'a> Numbers<'a> {
-    /// The numbers of a sample of `stream` whose requests, among the
-    /// batch's `drawn` (requests and their values), are those of `range`
-    /// (none when out of bounds: then all are asked of the stream).
+    /// The numbers of sample `k` of a step whose samples were each drawn
+    /// `dims` beforehand (`values`, sample after sample); none when out of
+    /// bounds: then all are asked of the stream.
     pub fn new(
         stream: &'a mut Stream,
-        (requests, values): (&'a [Request], &'a [[f32; 2]]),
-        range: std::ops::Range<usize>,
+        (dims, values): (&'a [Dim], &'a [[f32; 2]]),
+        k: usize,
     ) -> Self {
-        let mine = requests.get(range.clone()).zip(values.get(range));
+        let d = dims.len();
+        let mine = values.get(k * d..(k + 1) * d);
         Numbers {
             stream,
-            drawn: mine.unwrap_or((&[], &[])),
+            drawn: mine.map_or((&[], &[]), |v| (dims, v)),
         }
     }
 
@@ -55,41 +57,43 @@ impl<'a> Numbers<'a> {
     }
 
     /// The value drawn beforehand for the 1D or 2D (`two`) request of
-    /// `dim`, if it was. A request that [`camera_requests`] or
-    /// [`bounce_requests`] did not foresee is asked of the stream: the same
-    /// bits, only slower; debug builds check that none is missed.
+    /// `dim`, if it was. A request that [`camera_dims`] or [`bounce_dims`]
+    /// did not foresee is asked of the stream: the same bits, only slower;
+    /// debug builds check that none is missed.
     #[inline]
     fn find(&self, dim: u32, two: bool) -> Option<[f32; 2]> {
-        let (requests, values) = self.drawn;
-        let found = requests.iter().position(|r| r.dim == dim && r.two == two);
+        let (dims, values) = self.drawn;
+        let found = dims.iter().position(|&d| d == Dim { dim, two });
         debug_assert!(
-            requests.is_empty() || found.is_some(),
+            dims.is_empty() || found.is_some(),
             "dimension {dim} not drawn"
         );
         values.get(found?).copied()
     }
 }
 
-/// Pushes the requests the camera makes for sample `index` of the
-/// batch's pixel `pixel` (`Batch::run`, in its order) for a sampler other
-/// than the independent one: the film position, the lens position when
-/// the camera has a lens, the time when something moves.
-pub fn camera_requests(pixel: u32, index: u32, (lens, time): (bool, bool), out: &mut Vec<Request>) {
-    let mut push = |dim: u32, two: bool| {
-        out.push(Request {
-            stream: pixel,
-            index,
-            dim,
-            two,
-        });
-    };
-    push(dims::FILM, true);
+/// The dimensions the camera asks each sample for (`Batch::run`, in its
+/// order) under a sampler other than the independent one: the film
+/// position, the lens position when the camera has a lens, the time when
+/// something moves.
+pub fn camera_dims((lens, time): (bool, bool)) -> Vec<Dim> {
+    let mut out = vec![Dim {
+        dim: dims::FILM,
+        two: true,
+    }];
     if lens {
-        push(dims::LENS, true);
+        out.push(Dim {
+            dim: dims::LENS,
+            two: true,
+        });
     }
     if time {
-        push(dims::TIME, false);
+        out.push(Dim {
+            dim: dims::TIME,
+            two: false,
+        });
     }
+    out
 }
 
 /// Whether the shading draws the light's choice: when the scene has more
@@ -101,28 +105,21 @@ pub fn draws_light_choice(many_lights: bool, sampler: Sampler) -> bool {
     many_lights || sampler == Sampler::Independent
 }
 
-/// Pushes the requests the shading of the vertex at `depth` of a path of
-/// sample `index` of the batch's pixel `pixel` makes (`Bounce::shade` of
-/// [`super::wavefront`], in its order) for a sampler other than the
-/// independent one: none at the last vertex; the light's choice (when
-/// `many_lights`, [`draws_light_choice`]) and position unless only the
-/// BSDF is sampled; the BSDF's direction and component unless emitter
-/// sampling stops there; Russian roulette from `rr_depth` on (path
-/// integrator).
-pub fn bounce_requests(
-    settings: &Settings,
-    many_lights: bool,
-    (pixel, index, depth): (u32, u32, u32),
-    out: &mut Vec<Request>,
-) {
+/// The dimensions the shading of each path's vertex at `depth` asks for
+/// (`Bounce::shade` of [`super::wavefront`], in its order) under a sampler
+/// other than the independent one, into `out`: none at the last vertex;
+/// the light's choice (when `many_lights`, [`draws_light_choice`]) and
+/// position unless only the BSDF is sampled; the BSDF's direction and
+/// component unless emitter sampling stops there; Russian roulette from
+/// `rr_depth` on (path integrator).
+pub fn bounce_dims(settings: &Settings, many_lights: bool, depth: u32, out: &mut Vec<Dim>) {
+    out.clear();
     let max_depth = settings.max_depth();
     if depth + 1 >= max_depth {
         return;
     }
     let mut push = |offset: u32, two: bool| {
-        out.push(Request {
-            stream: pixel,
-            index,
+        out.push(Dim {
             dim: dims::bounce(depth, offset),
             two,
         });

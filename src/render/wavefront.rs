@@ -35,7 +35,7 @@ use super::integrator::{
     Escaped, Integrator, Settings, Strategy, add_scaled, dims, emission_weight, mul, offset,
     shading, shadow_ray,
 };
-use super::numbers::{Numbers, bounce_requests, draws_light_choice};
+use super::numbers::{Numbers, bounce_dims, draws_light_choice};
 use super::scene::{InvertedSamples, LightSample, Scene};
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
@@ -44,7 +44,7 @@ use crate::error::Result;
 use crate::frame::Frame;
 use crate::phong::PhongView;
 use crate::rng::Rng;
-use crate::sampler::batch::{Drawn, Request};
+use crate::sampler::batch::{Dim, Drawn};
 use crate::sampler::{Sampler, Stream};
 
 /// A path between two bounces.
@@ -141,10 +141,9 @@ pub struct Wavefront {
     inverted: InvertedSamples,
     light_samples: Vec<Option<LightSample>>,
     /// The numbers of the bounce drawn beforehand (the samplers other than
-    /// the independent one): the requests of path `k` are
-    /// `requests[first[k] .. first[k + 1]]`.
-    requests: Vec<Request>,
-    first: Vec<u32>,
+    /// the independent one): the dimensions every path's vertex asks for,
+    /// and their values, path after path.
+    dims: Vec<Dim>,
     drawn: Drawn,
     stream: embree::Stream,
     /// The rays of the batch that left the scene.
@@ -182,12 +181,6 @@ impl Wavefront {
             self.env_samples,
             self.light_samples
         )?;
-        // The numbers of a bounce: at most the 5 requests of a vertex
-        // (`numbers::bounce_requests`) per path.
-        self.requests.clear();
-        alloc::reserve(&mut self.requests, 5 * n, WHAT)?;
-        self.first.clear();
-        alloc::reserve(&mut self.first, n + 1, WHAT)?;
         self.escaped.clear();
         self.escaped.reserve(n)
     }
@@ -249,24 +242,20 @@ impl Wavefront {
                     .zip(&self.hits)
                     .map(|(path, hit)| scene.surface(&path.ray, hit, path.time)),
             );
-            // The numbers the shading will ask for, drawn together.
-            self.requests.clear();
-            self.first.clear();
-            if streams
-                .first()
-                .is_some_and(|s| s.sampler() != Sampler::Independent)
+            // The numbers the shading will ask for, drawn together: the
+            // paths in flight have all made as many bounces.
+            self.dims.clear();
+            self.drawn.values.clear();
+            if let Some(depth) = self.paths.first().map(|p| p.depth)
+                && streams
+                    .first()
+                    .is_some_and(|s| s.sampler() != Sampler::Independent)
             {
-                for path in &self.paths {
-                    self.first.push(self.requests.len() as u32);
-                    bounce_requests(
-                        settings,
-                        scene.chooses_among_lights(),
-                        (path.pixel, path.index, path.depth),
-                        &mut self.requests,
-                    );
-                }
-                self.first.push(self.requests.len() as u32);
-                self.drawn.draw(streams, &self.requests)?;
+                debug_assert!(self.paths.iter().all(|p| p.depth == depth));
+                let many = scene.chooses_among_lights();
+                bounce_dims(settings, many, depth, &mut self.dims);
+                let samples = self.paths.iter().map(|p| (p.pixel, p.index));
+                self.drawn.draw(streams, samples, &self.dims)?;
             }
             let shading_points = self.hits.iter().zip(&self.surfaces);
             for (k, (mut path, (hit, surface))) in
@@ -275,12 +264,8 @@ impl Wavefront {
                 let stream = &mut streams[path.pixel as usize];
                 stream.start(path.index);
                 swap_generators(stream, &mut path);
-                let mine = match (self.first.get(k), self.first.get(k + 1)) {
-                    (Some(&a), Some(&b)) => a as usize..b as usize,
-                    _ => 0..0,
-                };
-                let drawn = (&self.requests[..], &self.drawn.values[..]);
-                let mut numbers = Numbers::new(stream, drawn, mine);
+                let drawn = (&self.dims[..], &self.drawn.values[..]);
+                let mut numbers = Numbers::new(stream, drawn, k);
                 let bounce = Bounce {
                     scene,
                     settings,

@@ -24,27 +24,25 @@ use crate::math::Real;
 use crate::qmc::patterns::{kensler_step, rotate, walk};
 use crate::simd::dispatch;
 
-/// One request: coordinate `dim` (and `dim + 1` when `two`) of sample
-/// `index` of the stream `stream` of a batch.
+/// A coordinate every sample of a step asks for: `dim` (and `dim + 1`
+/// when `two`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Request {
-    /// Which of the batch's streams.
-    pub stream: u32,
-    /// The sample's index in its stream.
-    pub index: u32,
+pub struct Dim {
     /// The (first) dimension.
     pub dim: u32,
     /// A 2D request ([`Stream::get2`]) rather than 1D ([`Stream::get1`]).
     pub two: bool,
 }
 
-/// The values of a batch's requests, and the scratch they are drawn in
+/// The values of a batch's requests (each of its samples asking for the
+/// same dimensions), and the scratch they are drawn in
 /// (kept between batches, so drawing allocates only while the batches
 /// grow).
 #[derive(Clone, Debug, Default)]
 pub struct Drawn {
-    /// `values[k]`: request `k`'s coordinates (a 1D request's in `[0]`,
-    /// `[1]` then meaningless).
+    /// `values[s · d + k]`: coordinates `dims[k]` of sample `s`, when each
+    /// asks for `d` dimensions (a 1D request's in `[0]`, `[1]` then
+    /// meaningless).
     pub values: Vec<[f32; 2]>,
     /// The Sobol' index of each request: the sample's index until the
     /// permutation of [`Sampler::Sobol`] or [`Sampler::LowDiscrepancy`] replaces it.
@@ -57,22 +55,27 @@ pub struct Drawn {
 }
 
 impl Drawn {
-    /// Draws `requests` from `streams`: `values[k]` is what
-    /// `streams[s].start(index)` followed by `get1::<f32>(dim)` or
-    /// `get2::<f32>(dim)` gives. Nothing is drawn for
+    /// Draws `dims` for each of `samples` (a stream of `streams` and a
+    /// sample's index in it): `values[s · dims.len() + k]` is what
+    /// `streams[stream].start(index)` followed by `get1::<f32>` or
+    /// `get2::<f32>` of `dims[k]` gives. Nothing is drawn for
     /// [`Sampler::Independent`], whose numbers depend on the order they
-    /// are asked in. The streams of the samplers other than Sobol's are left at the last
-    /// request's sample ([`Stream::start`] them again before asking).
+    /// are asked in. The streams of the samplers other than Sobol's are
+    /// left at the last sample ([`Stream::start`] them again before
+    /// asking).
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the memory for the values cannot be
     /// had.
     ///
     /// # Panics
-    /// When a request names a stream out of `streams`.
-    pub fn draw(&mut self, streams: &mut [Stream], requests: &[Request]) -> Result<()> {
+    /// When a sample names a stream out of `streams`.
+    pub fn draw<I>(&mut self, streams: &mut [Stream], samples: I, dims: &[Dim]) -> Result<()>
+    where
+        I: ExactSizeIterator<Item = (u32, u32)>,
+    {
         const WHAT: &str = "a batch of sample numbers";
-        let n = requests.len();
+        let n = samples.len() * dims.len();
         self.values.clear();
         alloc::reserve(&mut self.values, n, WHAT)?;
         let Some(sampler) = streams.first().map(Stream::sampler) else {
@@ -85,15 +88,17 @@ impl Drawn {
             sampler,
             Sampler::Sobol | Sampler::LowDiscrepancy | Sampler::ZSobol
         ) {
-            self.values.extend(requests.iter().map(|r| {
-                let stream = &mut streams[r.stream as usize];
-                stream.start(r.index);
-                if r.two {
-                    stream.get2(r.dim)
-                } else {
-                    [stream.get1(r.dim), 0.0]
-                }
-            }));
+            for (stream, index) in samples {
+                let stream = &mut streams[stream as usize];
+                stream.start(index);
+                self.values.extend(dims.iter().map(|d| {
+                    if d.two {
+                        stream.get2(d.dim)
+                    } else {
+                        [stream.get1(d.dim), 0.0]
+                    }
+                }));
+            }
             return Ok(());
         }
         let Drawn {
@@ -115,21 +120,29 @@ impl Drawn {
             permutation.resize(n, [0; 3]);
         }
         values.resize(n, [0.0; 2]);
-        let keyed = requests.iter().zip(index.iter_mut()).zip(seed.iter_mut());
+        let per_sample = dims.len().max(1);
+        let keyed = index
+            .chunks_exact_mut(per_sample)
+            .zip(seed.chunks_exact_mut(per_sample));
         if sampler == Sampler::ZSobol {
-            for ((r, i), s) in keyed {
-                let stream = &mut streams[r.stream as usize];
-                stream.start(r.index);
-                let (index, key) = stream.sobol_index(r.dim);
-                (*i, *s) = (index, key.seed);
+            for ((stream, at), (i, s)) in samples.zip(keyed) {
+                let stream = &mut streams[stream as usize];
+                stream.start(at);
+                for ((d, i), s) in dims.iter().zip(i).zip(s) {
+                    let (index, key) = stream.sobol_index(d.dim);
+                    (*i, *s) = (index, key.seed);
+                }
             }
         } else {
-            for (((r, i), s), p) in keyed.zip(permutation.iter_mut()) {
-                let stream = &mut streams[r.stream as usize];
-                let key = stream.key(r.dim);
-                (*i, *s) = (u64::from(r.index), key.seed);
-                let (seed, rotation) = key.permutation();
-                *p = [seed, rotation, stream.count];
+            let keyed = keyed.zip(permutation.chunks_exact_mut(per_sample));
+            for ((stream, at), ((i, s), p)) in samples.zip(keyed) {
+                let stream = &mut streams[stream as usize];
+                for (((d, i), s), p) in dims.iter().zip(i).zip(s).zip(p) {
+                    let key = stream.key(d.dim);
+                    (*i, *s) = (u64::from(at), key.seed);
+                    let (seed, rotation) = key.permutation();
+                    *p = [seed, rotation, stream.count];
+                }
             }
         }
         dispatch(

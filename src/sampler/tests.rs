@@ -212,32 +212,32 @@ fn a_batch_of_requests_is_the_requests_one_by_one() {
                     })
                     .collect()
             };
-            let requests: Vec<batch::Request> = (0..90u32)
-                .map(|k| batch::Request {
-                    stream: k % 3,
-                    index: (k * 7 + k / 3) % count as u32,
-                    dim: [0, 1, 5, 12, 31, 40][(k % 6) as usize],
-                    two: k % 4 != 1,
-                })
+            let samples = || (0..30u32).map(|k| (k % 3, (k * 7 + k / 3) % count as u32));
+            let dims: Vec<batch::Dim> = [0, 1, 5, 12, 31, 40, 5]
+                .iter()
+                .zip([true, false, true, false, true, true, false])
+                .map(|(&dim, two)| batch::Dim { dim, two })
                 .collect();
             let mut drawn = batch::Drawn::default();
             let mut streams = fresh();
             // Twice: the second time with every key cached.
             for _ in 0..2 {
-                drawn.draw(&mut streams, &requests).unwrap();
+                drawn.draw(&mut streams, samples(), &dims).unwrap();
+                assert_eq!(drawn.values.len(), 30 * dims.len());
                 let mut alone = fresh();
-                for (r, v) in requests.iter().zip(&drawn.values) {
-                    let s = &mut alone[r.stream as usize];
-                    s.start(r.index);
-                    let want = if r.two {
-                        s.get2(r.dim)
+                let requests = samples().flat_map(|s| dims.iter().map(move |d| (s, d)));
+                for (((stream, index), d), v) in requests.zip(&drawn.values) {
+                    let s = &mut alone[stream as usize];
+                    s.start(index);
+                    let want = if d.two {
+                        s.get2(d.dim)
                     } else {
-                        [s.get1(r.dim), v[1]]
+                        [s.get1(d.dim), v[1]]
                     };
                     assert_eq!(
                         v.map(f32::to_bits),
                         want.map(f32::to_bits),
-                        "{sampler:?} {count} {r:?}"
+                        "{sampler:?} {count} {stream} {index} {d:?}"
                     );
                 }
             }
