@@ -1,11 +1,12 @@
-//! Triangle meshes from PLY (ASCII or binary, via `ply-rs-bw`) and Wavefront
+//! Triangle meshes from PLY (ASCII or binary, via `serde-ply`) and Wavefront
 //! OBJ files (via `tobj`): positions, faces (polygons split into fans) and,
 //! when the file has them, vertex normals.
 
 use std::path::Path;
 
-use ply_rs_bw::parser::{Parser, Reader};
-use ply_rs_bw::ply::{Property, PropertyAccess, PropertyAccessResult};
+use serde::Deserialize;
+use serde::de::{DeserializeSeed, Deserializer, IgnoredAny, MapAccess, SeqAccess, Visitor};
+use serde_ply::{PlyReader, PropertyType};
 
 use crate::alloc;
 use crate::error::{Error, Result};
@@ -50,169 +51,219 @@ pub fn read_mesh(path: &Path) -> Result<MeshData> {
     Ok(mesh)
 }
 
-/// A PLY vertex as read: its position and normal, and which of the six
-/// (`x y z nx ny nz`) the file gave.
-#[derive(Default)]
-struct PlyVertex {
-    values: [f64; 6],
-    given: u8,
+/// A PLY vertex's position (other properties skipped).
+#[derive(Deserialize)]
+struct Position {
+    x: f64,
+    y: f64,
+    z: f64,
 }
 
-impl PropertyAccess for PlyVertex {
-    fn new() -> Self {
-        Self::default()
+/// A PLY vertex's position and normal.
+#[derive(Deserialize)]
+struct Oriented {
+    x: f64,
+    y: f64,
+    z: f64,
+    nx: f64,
+    ny: f64,
+    nz: f64,
+}
+
+/// An element of another kind, read and dropped.
+#[derive(Deserialize)]
+struct Skipped {}
+
+/// The faces of a PLY `face` element, each polygon's list `name` split
+/// into the fan `(p0, p_k, p_k+1)` straight into `faces` (no list kept per
+/// face).
+struct Faces<'a> {
+    faces: &'a mut Vec<[i64; 3]>,
+    name: &'a str,
+}
+
+impl<'de> DeserializeSeed<'de> for Faces<'_> {
+    type Value = ();
+
+    fn deserialize<D: Deserializer<'de>>(self, rows: D) -> std::result::Result<(), D::Error> {
+        rows.deserialize_seq(self)
+    }
+}
+
+impl<'de> Visitor<'de> for Faces<'_> {
+    type Value = ();
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("the rows of a PLY face element")
     }
 
-    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
-        let Some(slot) = ["x", "y", "z", "nx", "ny", "nz"]
-            .iter()
-            .position(|&k| k == name)
+    fn visit_seq<A: SeqAccess<'de>>(self, mut rows: A) -> std::result::Result<(), A::Error> {
+        while rows
+            .next_element_seed(Face(&mut *self.faces, self.name))?
+            .is_some()
+        {}
+        Ok(())
+    }
+}
+
+/// One row of the face element: its list `.1` fanned into `.0`, the other
+/// properties skipped.
+struct Face<'a>(&'a mut Vec<[i64; 3]>, &'a str);
+
+impl<'de> DeserializeSeed<'de> for Face<'_> {
+    type Value = ();
+
+    fn deserialize<D: Deserializer<'de>>(self, row: D) -> std::result::Result<(), D::Error> {
+        row.deserialize_map(self)
+    }
+}
+
+impl<'de> Visitor<'de> for Face<'_> {
+    type Value = ();
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a PLY face")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut row: A) -> std::result::Result<(), A::Error> {
+        let Face(faces, name) = self;
+        while let Some(ours) = row.next_key_seed(IsName(name))? {
+            if ours {
+                row.next_value_seed(Fan(&mut *faces))?;
+            } else {
+                row.next_value::<IgnoredAny>()?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A polygon's list of vertex indices, pushed as its fan of triangles.
+struct Fan<'a>(&'a mut Vec<[i64; 3]>);
+
+impl<'de> DeserializeSeed<'de> for Fan<'_> {
+    type Value = ();
+
+    fn deserialize<D: Deserializer<'de>>(self, list: D) -> std::result::Result<(), D::Error> {
+        list.deserialize_seq(self)
+    }
+}
+
+impl<'de> Visitor<'de> for Fan<'_> {
+    type Value = ();
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a list of vertex indices")
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut list: A) -> std::result::Result<(), A::Error> {
+        let (Some(first), Some(mut last)) = (list.next_element::<i64>()?, list.next_element()?)
         else {
-            return PropertyAccessResult::Ignored;
+            return Ok(());
         };
-        let value = match property {
-            Property::Double(v) => v,
-            p => match p.to_f32_lossy() {
-                Some(v) => f64::from(v),
-                // A list: no coordinate (the normals are then left out).
-                None if slot >= 3 => return PropertyAccessResult::Ignored,
-                None => return PropertyAccessResult::UnsupportedType,
-            },
-        };
-        self.values[slot] = value;
-        self.given |= 1 << slot;
-        PropertyAccessResult::Set
+        while let Some(next) = list.next_element()? {
+            self.0.push([first, last, next]);
+            last = next;
+        }
+        Ok(())
     }
 }
 
-/// A PLY face as read: its polygon's vertex indices, from
-/// `vertex_indices`, or `vertex_index` when it has no `vertex_indices`.
-#[derive(Default)]
-struct PlyFace {
-    indices: Option<Vec<i64>>,
-    index: Option<Vec<i64>>,
-}
+/// Whether a property's name (as the reader gives it, in bytes) is `.0`.
+struct IsName<'a>(&'a str);
 
-impl PropertyAccess for PlyFace {
-    fn new() -> Self {
-        Self::default()
-    }
+impl<'de> DeserializeSeed<'de> for IsName<'_> {
+    type Value = bool;
 
-    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
-        let slot = match name {
-            "vertex_indices" => &mut self.indices,
-            "vertex_index" => &mut self.index,
-            _ => return PropertyAccessResult::Ignored,
-        };
-        *slot = Some(match property {
-            Property::ListChar(v) => v.into_iter().map(i64::from).collect(),
-            Property::ListUChar(v) => v.into_iter().map(i64::from).collect(),
-            Property::ListShort(v) => v.into_iter().map(i64::from).collect(),
-            Property::ListUShort(v) => v.into_iter().map(i64::from).collect(),
-            Property::ListInt(v) => v.into_iter().map(i64::from).collect(),
-            Property::ListUInt(v) => v.into_iter().map(i64::from).collect(),
-            _ => return PropertyAccessResult::UnsupportedType,
-        });
-        PropertyAccessResult::Set
+    fn deserialize<D: Deserializer<'de>>(self, name: D) -> std::result::Result<bool, D::Error> {
+        name.deserialize_bytes(self)
     }
 }
 
-/// An element of another kind, skipped.
-struct Skipped;
+impl Visitor<'_> for IsName<'_> {
+    type Value = bool;
 
-impl PropertyAccess for Skipped {
-    fn new() -> Self {
-        Skipped
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a property name")
     }
-}
 
-/// Splits the polygon `poly` into the fan `(p0, p_k, p_k+1)`.
-fn fan(poly: &[i64], faces: &mut Vec<[i64; 3]>) {
-    for k in 1..poly.len().saturating_sub(1) {
-        faces.push([poly[0], poly[k], poly[k + 1]]);
+    fn visit_bytes<E>(self, name: &[u8]) -> std::result::Result<bool, E> {
+        Ok(name == self.0.as_bytes())
+    }
+
+    fn visit_str<E>(self, name: &str) -> std::result::Result<bool, E> {
+        Ok(name == self.0)
     }
 }
 
 /// Memory the PLY reader takes per vertex or face it reads, checked before
-/// it starts: a vertex as read (56 bytes, twice while its list grows) and
-/// as kept (48), a face as read (56, twice, and its list of indices) and
-/// as kept (24).
+/// it starts: a vertex as read (48 bytes, twice while its list grows) and
+/// as kept (24, and 24 for its normal), a face as kept (24, twice for a
+/// quad's fan).
 const PLY_BYTES_PER_ELEMENT: usize = 192;
 
 fn read_ply(path: &Path) -> Result<MeshData> {
     let file = std::fs::File::open(path).map_err(|e| io_error(path, e.to_string()))?;
-    let mut reader = Reader::new(std::io::BufReader::new(file));
     let unreadable =
-        |e: ply_rs_bw::parser::ParseError| io_error(path, format!("not a readable PLY file: {e}"));
-    let header = Parser::<Skipped>::new()
-        .read_header(&mut reader)
-        .map_err(unreadable)?;
+        |e: serde_ply::DeserializeError| io_error(path, format!("not a readable PLY file: {e}"));
+    let mut reader = PlyReader::from_reader(std::io::BufReader::new(file)).map_err(unreadable)?;
     // The header's counts, checked before the payload is read (other
     // elements are skipped, kept nowhere).
     let mut elements = 0usize;
-    for (name, element) in &header.elements {
-        if name == "vertex" || name == "face" {
-            check_primitives(
-                if name == "vertex" {
-                    "vertices"
-                } else {
-                    "faces"
-                },
-                element.count,
-            )?;
-            elements = elements.saturating_add(element.count);
-        }
+    for element in &reader.header().elem_defs {
+        let what = match element.name.as_str() {
+            "vertex" => "vertices",
+            "face" => "faces",
+            _ => continue,
+        };
+        check_primitives(what, element.count)?;
+        elements = elements.saturating_add(element.count);
     }
     alloc::probe::<u8>(
         elements.saturating_mul(PLY_BYTES_PER_ELEMENT),
         "the PLY file's elements",
     )?;
-    // The elements in the header's order, each read by its own type.
-    let (mut verts, mut polys) = (None, Vec::new());
-    for (name, element) in &header.elements {
-        match name.as_str() {
-            "vertex" => {
-                verts = Some(
-                    Parser::<PlyVertex>::new()
-                        .read_payload_for_element(&mut reader, element, &header)
-                        .map_err(unreadable)?,
-                );
+    // The elements in the header's order.
+    let (mut vertices, mut normals, mut faces) = (None, None, Vec::new());
+    while let Some(element) = reader.current_element() {
+        let scalar = |name: &str| {
+            element
+                .get_property(name)
+                .is_some_and(|p| matches!(p.property_type, PropertyType::Scalar(_)))
+        };
+        match element.name.as_str() {
+            "vertex" if ["x", "y", "z"].iter().all(|&k| scalar(k)) => {
+                // Normals when all three are numbers (not lists).
+                if ["nx", "ny", "nz"].iter().all(|&k| scalar(k)) {
+                    let read: Vec<Oriented> = reader.next_element().map_err(unreadable)?;
+                    vertices = Some(read.iter().map(|v| [v.x, v.y, v.z]).collect());
+                    normals = Some(read.iter().map(|v| [v.nx, v.ny, v.nz]).collect());
+                } else {
+                    let read: Vec<Position> = reader.next_element().map_err(unreadable)?;
+                    vertices = Some(read.iter().map(|v| [v.x, v.y, v.z]).collect());
+                }
             }
+            "vertex" => return Err(io_error(path, "PLY vertices need x, y and z")),
             "face" => {
-                polys = Parser::<PlyFace>::new()
-                    .read_payload_for_element(&mut reader, element, &header)
-                    .map_err(unreadable)?;
+                let name = ["vertex_indices", "vertex_index"]
+                    .into_iter()
+                    .find(|&k| element.get_property(k).is_some())
+                    .ok_or_else(|| io_error(path, "PLY faces need a 'vertex_indices' list"))?;
+                faces = alloc::with_capacity(element.count, "the faces")?;
+                let seed = Faces {
+                    faces: &mut faces,
+                    name,
+                };
+                // The element read through the reader's map of elements
+                // (its `next_element` takes no seed).
+                (&mut reader).next_value_seed(seed).map_err(unreadable)?;
             }
             _ => {
-                Parser::<Skipped>::new()
-                    .read_payload_for_element(&mut reader, element, &header)
-                    .map_err(unreadable)?;
+                let _: Vec<Skipped> = reader.next_element().map_err(unreadable)?;
             }
         }
     }
-    let verts = verts.ok_or_else(|| io_error(path, "PLY file without a 'vertex' element"))?;
-    let mut vertices = alloc::with_capacity(verts.len(), "the vertices")?;
-    let mut normals = alloc::with_capacity(verts.len(), "the normals")?;
-    for v in &verts {
-        if v.given & 0b111 != 0b111 {
-            return Err(io_error(path, "PLY vertices need x, y and z"));
-        }
-        let [x, y, z, a, b, c] = v.values;
-        vertices.push([x, y, z]);
-        if v.given == 0b11_1111 {
-            normals.push([a, b, c]);
-        }
-    }
-    let mut faces = alloc::with_capacity(polys.len(), "the faces")?;
-    for f in &polys {
-        let poly = f
-            .indices
-            .as_deref()
-            .or(f.index.as_deref())
-            .ok_or_else(|| io_error(path, "PLY faces need a 'vertex_indices' list"))?;
-        fan(poly, &mut faces);
-    }
-    let normals = (normals.len() == vertices.len()).then_some(normals);
+    let vertices = vertices.ok_or_else(|| io_error(path, "PLY file without a 'vertex' element"))?;
     Ok(MeshData {
         vertices,
         faces,
@@ -350,6 +401,41 @@ mod tests {
         )
         .unwrap();
         assert!(matches!(read_mesh(&path), Err(Error::Io { .. })));
+    }
+
+    /// Doubles, a colour among the vertex's properties, a pentagon, and a
+    /// property after the face's list: all skipped or read in place.
+    #[test]
+    fn binary_ply_with_other_properties_around_the_ones_read() {
+        let mut bytes = "ply\nformat binary_little_endian 1.0\nelement vertex 5\n\
+                         property uchar red\nproperty double x\nproperty double y\n\
+                         property double z\nproperty int nx\nelement face 2\n\
+                         property list uchar int vertex_indices\nproperty float quality\n\
+                         end_header\n"
+            .as_bytes()
+            .to_vec();
+        for k in 0..5u8 {
+            bytes.push(200 + k);
+            for c in [f64::from(k), 0.5 * f64::from(k), -1.0] {
+                bytes.extend(c.to_le_bytes());
+            }
+            bytes.extend(7i32.to_le_bytes());
+        }
+        for poly in [&[4i32, 3, 2, 1, 0][..], &[0, 2, 4]] {
+            bytes.push(poly.len() as u8);
+            for &i in poly {
+                bytes.extend(i.to_le_bytes());
+            }
+            bytes.extend(0.25f32.to_le_bytes());
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("pentagon.ply");
+        std::fs::write(&path, &bytes).unwrap();
+        let m = read_mesh(&path).unwrap();
+        assert_eq!(m.vertices[3], [3.0, 1.5, -1.0]);
+        assert_eq!(m.faces, vec![[4, 3, 2], [4, 2, 1], [4, 1, 0], [0, 2, 4]]);
+        // Only `nx` of a normal: none.
+        assert!(m.normals.is_none());
     }
 
     #[test]
