@@ -1,7 +1,7 @@
 //! Orthonormal frames: the local shading frame (normal = +z) around a
 //! world-space normal.
 
-use crate::math::{Real, V3, dot};
+use crate::math::{Real, V3, cross, dot};
 
 /// An orthonormal basis `(s, t, n)`: `to_local` gives a vector's
 /// coordinates along `s`, `t`, `n`; `to_world` maps them back.
@@ -40,6 +40,26 @@ impl<F: Real> Frame<F> {
         }
     }
 
+    /// The frame around the unit vector `n` whose first axis follows the
+    /// tangent `dpdu` (Mitsuba's `SurfaceInteraction::initialize_sh_frame`):
+    /// `s = normalize(dpdu − n (n·dpdu))`, `t = n × s`; or
+    /// [`Frame::from_normal`]'s when `dpdu` is zero or (nearly) along `n`.
+    #[inline]
+    pub fn from_normal_and_tangent(n: V3<F>, dpdu: V3<F>) -> Self {
+        let along = dot(n, dpdu);
+        let s: V3<F> = std::array::from_fn(|k| dpdu[k] - n[k] * along);
+        let len2 = dot(s, s);
+        if !(len2 > F::c(1e-12) && len2 > F::c(1e-6) * dot(dpdu, dpdu)) {
+            return Self::from_normal(n);
+        }
+        let s = s.map(|c| c / len2.sqrt());
+        Frame {
+            s,
+            t: cross(n, s),
+            n,
+        }
+    }
+
     /// Coordinates of `v` in this frame: `(v·s, v·t, v·n)`.
     #[inline(always)]
     pub fn to_local(&self, v: V3<F>) -> V3<F> {
@@ -56,11 +76,14 @@ impl<F: Real> Frame<F> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::cross;
     use proptest::prelude::*;
 
     fn check(n: V3<f64>) {
-        let f = Frame::from_normal(n);
+        check_frame(Frame::from_normal(n), n);
+    }
+
+    /// `f` is orthonormal, right-handed, about `n`.
+    fn check_frame(f: Frame<f64>, n: V3<f64>) {
         for (name, v) in [("s", f.s), ("t", f.t)] {
             assert!(
                 (dot(v, v) - 1.0).abs() < 1e-12,
@@ -103,11 +126,37 @@ mod tests {
         }
     }
 
+    /// A tangent frame's first axis is the tangent made orthogonal to
+    /// `n`; no tangent, or one along `n`, gives Duff's frame.
+    #[test]
+    fn a_tangent_turns_the_frame_about_the_normal() {
+        let n = [0.6, 0.0, 0.8];
+        let f = Frame::from_normal_and_tangent(n, [0.0, 2.0, 1.0]);
+        check_frame(f, n);
+        // [0, 2, 1] − n (n·[0, 2, 1]) = [−0.48, 2, 0.36], of length 2.088.
+        let want = [-0.48, 2.0, 0.36].map(|c| c / (0.48f64 * 0.48 + 4.0 + 0.36 * 0.36).sqrt());
+        assert!(
+            (0..3).all(|k| (f.s[k] - want[k]).abs() < 1e-12),
+            "{:?}",
+            f.s
+        );
+        for none in [[0.0; 3], [1.2, 0.0, 1.6], [1e-9, 0.0, 0.0]] {
+            assert_eq!(
+                Frame::from_normal_and_tangent(n, none),
+                Frame::from_normal(n)
+            );
+        }
+    }
+
     proptest! {
         #[test]
         fn orthonormal_everywhere(phi in 0.0..std::f64::consts::TAU, z in -1.0..=1.0f64) {
             let r = (1.0 - z * z).sqrt();
-            check([r * phi.cos(), r * phi.sin(), z]);
+            let n = [r * phi.cos(), r * phi.sin(), z];
+            check(n);
+            // A sphere's azimuth tangent, as `SurfacePoint::dpdu`.
+            let f = Frame::from_normal_and_tangent(n, [-n[1], n[0], 0.0]);
+            check_frame(f, n);
         }
     }
 }

@@ -4,7 +4,7 @@
 
 use glam::Vec3A;
 
-use super::super::integrator::{offset, shading};
+use super::super::integrator::{frame_tangent, offset, shading};
 use super::super::scene::{Emission, Scene};
 use super::super::shape::Ray;
 use super::{Ctx, dims};
@@ -180,7 +180,8 @@ pub(super) fn walk(
             return;
         }
         let from = -ray.d;
-        let (frame, view) = shading(scene, shape, v.ns, from);
+        let tangent = frame_tangent(&sp, stream.sampler());
+        let (frame, view) = shading(scene, shape, (v.ns, tangent), from);
         let (bsdf_u, rr_u) = if light {
             (dims::LIGHT_BSDF, dims::LIGHT_ROULETTE)
         } else {
@@ -197,7 +198,7 @@ pub(super) fn walk(
         };
         beta = std::array::from_fn(|c| beta[c] * s.weight[c] * fix);
         // The density of sampling `from` had the walk come the other way.
-        let (back, view_back) = shading(scene, shape, v.ns, d);
+        let (back, view_back) = shading(scene, shape, (v.ns, tangent), d);
         let rev = view_back.eval_pdf_one(frame_local(&back, from)).1;
         let n = path.len();
         path[n - 2].pdf_rev = convert(rev, &v, &path[n - 2]);
@@ -273,7 +274,8 @@ pub(super) fn pdf(ctx: &Ctx, v: &Vertex, prev: Option<&Vertex>, next: &Vertex) -
                 return pdf_light(ctx, v, next);
             };
             let from = direction(v, prev);
-            let (frame, view) = shading(ctx.scene, shape, v.ns, from);
+            // Only evaluated: any turn of the frame.
+            let (frame, view) = shading(ctx.scene, shape, (v.ns, Vec3A::ZERO), from);
             view.eval_pdf_one(frame_local(&frame, to)).1
         }
         Kind::Light { .. } | Kind::Environment => return pdf_light(ctx, v, next),
@@ -340,7 +342,8 @@ pub(super) fn scatter(
     let Some(fix) = side_factor(v, from, to, light) else {
         return [0.0; 3];
     };
-    let (frame, view) = shading(ctx.scene, shape, v.ns, from);
+    // Only evaluated: any turn of the frame.
+    let (frame, view) = shading(ctx.scene, shape, (v.ns, Vec3A::ZERO), from);
     let wo = frame_local(&frame, to);
     let f = view.eval_pdf_one(wo).0;
     let s = wo[2].abs() * fix;

@@ -62,6 +62,7 @@ impl Disk {
             p,
             ng: self.normal,
             ns: self.normal,
+            dpdu: Vec3A::ZERO,
         }
     }
 

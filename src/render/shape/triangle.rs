@@ -53,7 +53,12 @@ impl Triangle {
             }
             None => ng,
         };
-        SurfacePoint { p, ng, ns }
+        SurfacePoint {
+            p,
+            ng,
+            ns,
+            dpdu: Vec3A::ZERO,
+        }
     }
 
     /// A point drawn uniformly by area (density `1/area`), `u ∈ [0, 1]²`
