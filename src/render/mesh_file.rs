@@ -74,6 +74,29 @@ struct Oriented {
 #[derive(Deserialize)]
 struct Skipped {}
 
+/// The rows of an element of no properties, not visited.
+struct IgnoredRows;
+
+impl<'de> DeserializeSeed<'de> for IgnoredRows {
+    type Value = ();
+
+    fn deserialize<D: Deserializer<'de>>(self, rows: D) -> std::result::Result<(), D::Error> {
+        rows.deserialize_seq(self)
+    }
+}
+
+impl<'de> Visitor<'de> for IgnoredRows {
+    type Value = ();
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("the rows of a PLY element")
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, _: A) -> std::result::Result<(), A::Error> {
+        Ok(())
+    }
+}
+
 /// The faces of a PLY `face` element, each polygon's list `name` split
 /// into the fan `(p0, p_k, p_k+1)` straight into `faces` (no list kept per
 /// face).
@@ -224,7 +247,8 @@ fn read_ply(path: &Path) -> Result<MeshData> {
         "the PLY file's elements",
     )?;
     // The elements in the header's order.
-    let (mut vertices, mut normals, mut faces) = (None, None, Vec::new());
+    let (mut vertices, mut normals, mut faces) = (Vec::new(), None, Vec::new());
+    let mut has_vertices = false;
     while let Some(element) = reader.current_element() {
         let scalar = |name: &str| {
             element
@@ -233,15 +257,19 @@ fn read_ply(path: &Path) -> Result<MeshData> {
         };
         match element.name.as_str() {
             "vertex" if ["x", "y", "z"].iter().all(|&k| scalar(k)) => {
+                has_vertices = true;
                 // Normals when all three are numbers (not lists).
-                if ["nx", "ny", "nz"].iter().all(|&k| scalar(k)) {
+                (vertices, normals) = if ["nx", "ny", "nz"].iter().all(|&k| scalar(k)) {
                     let read: Vec<Oriented> = reader.next_element().map_err(unreadable)?;
-                    vertices = Some(read.iter().map(|v| [v.x, v.y, v.z]).collect());
-                    normals = Some(read.iter().map(|v| [v.nx, v.ny, v.nz]).collect());
+                    let normals = read.iter().map(|v| [v.nx, v.ny, v.nz]).collect();
+                    (
+                        read.into_iter().map(|v| [v.x, v.y, v.z]).collect(),
+                        Some(normals),
+                    )
                 } else {
                     let read: Vec<Position> = reader.next_element().map_err(unreadable)?;
-                    vertices = Some(read.iter().map(|v| [v.x, v.y, v.z]).collect());
-                }
+                    (read.into_iter().map(|v| [v.x, v.y, v.z]).collect(), None)
+                };
             }
             "vertex" => return Err(io_error(path, "PLY vertices need x, y and z")),
             "face" => {
@@ -258,12 +286,19 @@ fn read_ply(path: &Path) -> Result<MeshData> {
                 // (its `next_element` takes no seed).
                 (&mut reader).next_value_seed(seed).map_err(unreadable)?;
             }
+            // An element of no properties has no bytes to read: passed
+            // over at once (row by row, a huge count would take forever).
+            _ if element.properties.is_empty() => (&mut reader)
+                .next_value_seed(IgnoredRows)
+                .map_err(unreadable)?,
             _ => {
                 let _: Vec<Skipped> = reader.next_element().map_err(unreadable)?;
             }
         }
     }
-    let vertices = vertices.ok_or_else(|| io_error(path, "PLY file without a 'vertex' element"))?;
+    if !has_vertices {
+        return Err(io_error(path, "PLY file without a 'vertex' element"));
+    }
     Ok(MeshData {
         vertices,
         faces,
@@ -396,11 +431,16 @@ mod tests {
         let path = dir.path().join("no_z.ply");
         std::fs::write(
             &path,
-            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
-             end_header\n0 0\n",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+             element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+             0 0\n1 0\n0 1\n3 0 1 2\n",
         )
         .unwrap();
-        assert!(matches!(read_mesh(&path), Err(Error::Io { .. })));
+        let refused = read_mesh(&path).unwrap_err().to_string();
+        assert!(
+            refused.contains("PLY vertices need x, y and z"),
+            "{refused}"
+        );
     }
 
     /// Doubles, a colour among the vertex's properties, a pentagon, and a
@@ -436,6 +476,36 @@ mod tests {
         assert_eq!(m.faces, vec![[4, 3, 2], [4, 2, 1], [4, 1, 0], [0, 2, 4]]);
         // Only `nx` of a normal: none.
         assert!(m.normals.is_none());
+    }
+
+    /// Binary normals (read by the typed rows' offsets), and an element of
+    /// no properties with a count no file could hold, passed over at once.
+    #[test]
+    fn binary_normals_and_an_element_of_nothing() {
+        let mut bytes = "ply\nformat binary_little_endian 1.0\nelement vertex 3\n\
+                         property float x\nproperty float y\nproperty float z\n\
+                         property float nx\nproperty float ny\nproperty float nz\n\
+                         element nothing 18446744073709551615\nelement face 1\n\
+                         property list uchar int vertex_indices\nend_header\n"
+            .as_bytes()
+            .to_vec();
+        for k in 0..3 {
+            let p = [k == 1, k == 2, false].map(|b| f32::from(u8::from(b)));
+            for c in p.into_iter().chain([0.0, 0.6, 0.8]) {
+                bytes.extend(c.to_le_bytes());
+            }
+        }
+        bytes.push(3);
+        for i in [0i32, 1, 2] {
+            bytes.extend(i.to_le_bytes());
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("normals.ply");
+        std::fs::write(&path, &bytes).unwrap();
+        let m = read_mesh(&path).unwrap();
+        assert_eq!(m.vertices, vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+        assert_eq!(m.normals.unwrap()[2], [0.0, 0.6f32 as f64, 0.8f32 as f64]);
+        assert_eq!(m.faces, vec![[0, 1, 2]]);
     }
 
     #[test]

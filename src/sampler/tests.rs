@@ -220,6 +220,9 @@ fn a_batch_of_requests_is_the_requests_one_by_one() {
                 .collect();
             let mut drawn = batch::Drawn::default();
             let mut streams = fresh();
+            // No dimensions (a path's last vertex): nothing drawn.
+            drawn.draw(&mut streams, samples(), &[]).unwrap();
+            assert!(drawn.values.is_empty());
             // Twice: the second time with every key cached.
             for _ in 0..2 {
                 drawn.draw(&mut streams, samples(), &dims).unwrap();
