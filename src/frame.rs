@@ -40,19 +40,20 @@ impl<F: Real> Frame<F> {
         }
     }
 
-    /// The frame around the unit vector `n` whose first axis follows the
-    /// tangent `dpdu` (Mitsuba's `SurfaceInteraction::initialize_sh_frame`):
-    /// `s = normalize(dpdu − n (n·dpdu))`, `t = n × s`; or
-    /// [`Frame::from_normal`]'s when `dpdu` is zero or (nearly) along `n`.
+    /// The frame around the unit vector `n` whose first axis runs along
+    /// the azimuth about the z axis, as a sphere's `∂p/∂u` (Mitsuba's
+    /// sphere): `s = (−n_y, n_x, 0)/√(n_x² + n_y²)`, `t = n × s`. It turns
+    /// smoothly everywhere but at the poles `n = ±z`, where
+    /// [`Frame::from_normal`]'s (which jumps across `n_z = 0`) takes over
+    /// (`n_x² + n_y² ≤ 10⁻¹²`).
     #[inline]
-    pub fn from_normal_and_tangent(n: V3<F>, dpdu: V3<F>) -> Self {
-        let along = dot(n, dpdu);
-        let s: V3<F> = std::array::from_fn(|k| dpdu[k] - n[k] * along);
-        let len2 = dot(s, s);
-        if !(len2 > F::c(1e-12) && len2 > F::c(1e-6) * dot(dpdu, dpdu)) {
+    pub fn azimuthal(n: V3<F>) -> Self {
+        let r2 = n[0] * n[0] + n[1] * n[1];
+        if !(r2 > F::c(1e-12)) {
             return Self::from_normal(n);
         }
-        let s = s.map(|c| c / len2.sqrt());
+        let inv = F::one() / r2.sqrt();
+        let s = [-n[1] * inv, n[0] * inv, F::zero()];
         Frame {
             s,
             t: cross(n, s),
@@ -126,25 +127,24 @@ mod tests {
         }
     }
 
-    /// A tangent frame's first axis is the tangent made orthogonal to
-    /// `n`; no tangent, or one along `n`, gives Duff's frame.
+    /// The azimuthal frame's first axis is horizontal and turns smoothly
+    /// across the equator, where Duff's jumps; at the poles it is Duff's.
     #[test]
-    fn a_tangent_turns_the_frame_about_the_normal() {
-        let n = [0.6, 0.0, 0.8];
-        let f = Frame::from_normal_and_tangent(n, [0.0, 2.0, 1.0]);
+    fn the_azimuthal_frame_turns_smoothly_across_the_equator() {
+        let n = [0.6, 0.8, 0.0];
+        let f = Frame::azimuthal(n);
         check_frame(f, n);
-        // [0, 2, 1] − n (n·[0, 2, 1]) = [−0.48, 2, 0.36], of length 2.088.
-        let want = [-0.48, 2.0, 0.36].map(|c| c / (0.48f64 * 0.48 + 4.0 + 0.36 * 0.36).sqrt());
-        assert!(
-            (0..3).all(|k| (f.s[k] - want[k]).abs() < 1e-12),
-            "{:?}",
-            f.s
-        );
-        for none in [[0.0; 3], [1.2, 0.0, 1.6], [1e-9, 0.0, 0.0]] {
-            assert_eq!(
-                Frame::from_normal_and_tangent(n, none),
-                Frame::from_normal(n)
-            );
+        assert!((0..3).all(|k| (f.s[k] - [-0.8, 0.6, 0.0][k]).abs() < 1e-12), "{:?}", f.s);
+        let near = |z: f64| {
+            let r = (1.0 - z * z).sqrt();
+            [0.6 * r, 0.8 * r, z]
+        };
+        let gap = |a: Frame<f64>, b: Frame<f64>| (0..3).map(|k| (a.s[k] - b.s[k]).abs()).sum::<f64>();
+        let (above, below) = (near(1e-6), near(-1e-6));
+        assert!(gap(Frame::azimuthal(above), Frame::azimuthal(below)) < 1e-5);
+        assert!(gap(Frame::from_normal(above), Frame::from_normal(below)) > 0.5);
+        for pole in [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1e-9, 0.0, 1.0]] {
+            assert_eq!(Frame::azimuthal(pole), Frame::from_normal(pole));
         }
     }
 
@@ -154,9 +154,7 @@ mod tests {
             let r = (1.0 - z * z).sqrt();
             let n = [r * phi.cos(), r * phi.sin(), z];
             check(n);
-            // A sphere's azimuth tangent, as `SurfacePoint::dpdu`.
-            let f = Frame::from_normal_and_tangent(n, [-n[1], n[0], 0.0]);
-            check_frame(f, n);
+            check_frame(Frame::azimuthal(n), n);
         }
     }
 }

@@ -25,7 +25,7 @@ use glam::Vec3A;
 
 use super::accel::Hit;
 use super::scene::{LightSample, Scene};
-use super::shape::{Ray, SurfacePoint};
+use super::shape::Ray;
 use crate::alloc;
 use crate::frame::Frame;
 use crate::phong::PhongView;
@@ -181,19 +181,30 @@ pub(crate) fn shadow_ray(p: Vec3A, n: Vec3A, ls: &LightSample) -> Ray {
     }
 }
 
-/// The shading frame at a point of shape `shape` with shading normal `ns`,
-/// turned about it by the tangent `dpdu` ([`frame_tangent`]), seen from the
-/// unit direction `from` (a two-sided material turns its front toward it;
-/// seen from the back, a one-sided material is black), and the BSDF's view
-/// of `from` in that frame. The BSDF is isotropic: its values and densities
-/// do not depend on the turn, so a caller that only evaluates may pass a
-/// zero tangent.
+/// The shading frame at a point of shape `shape` with shading normal `ns`
+/// seen from the unit direction `from` (a two-sided material turns its
+/// front toward it; seen from the back, a one-sided material is black),
+/// and the BSDF's view of `from` in that frame, for a BSDF sampled under
+/// `sampler`.
+///
+/// A stratified pattern is laid over the frame, so a frame that jumps
+/// within a pixel mixes two layouts of it: the frame of the normal alone
+/// ([`Frame::from_normal`], Duff's) jumps across `n_z = 0`, which crosses
+/// every sphere. So under the samplers other than the independent one a
+/// sphere shades in the frame of its azimuth ([`Frame::azimuthal`], as
+/// Mitsuba's sphere), which turns smoothly but at its poles: the demo's
+/// multijitter relMSE at 64 spp went from 1.016 to 0.998 × Mitsuba's
+/// (benches/README.md). The independent sampler's directions are alike in
+/// any turn of the frame: it keeps the frame of the normal, and its renders
+/// their bits. The BSDF is isotropic, so a caller that only evaluates it
+/// may pass any sampler.
 #[inline]
 pub(super) fn shading(
     scene: &Scene,
     shape: u32,
-    (ns, dpdu): (Vec3A, Vec3A),
+    ns: Vec3A,
     from: Vec3A,
+    sampler: Sampler,
 ) -> (Frame<f32>, PhongView<f32>) {
     let material = scene.material(shape);
     let ns = if material.two_sided && ns.dot(from) < 0.0 {
@@ -201,28 +212,13 @@ pub(super) fn shading(
     } else {
         ns
     };
-    let frame = Frame::from_normal_and_tangent(ns.to_array(), dpdu.to_array());
+    let frame = if sampler != Sampler::Independent && scene.is_sphere(shape) {
+        Frame::azimuthal(ns.to_array())
+    } else {
+        Frame::from_normal(ns.to_array())
+    };
     let view = material.bsdf.view(frame.to_local(from.to_array()));
     (frame, view)
-}
-
-/// The tangent that turns the shading frame at `sp` about its normal when
-/// its BSDF is sampled under `sampler`: the shape's `∂p/∂u`
-/// ([`SurfacePoint::dpdu`]) for the stratified and quasi-Monte Carlo
-/// samplers, none for the independent one (its directions are alike in any
-/// turn of the frame, and its renders keep their bits). A stratified
-/// pattern is laid over the frame, so a frame that jumps within a pixel
-/// (Duff's at `n_z = 0`, at a sphere's silhouette) mixes two layouts of
-/// it: with the sphere's own tangent (Mitsuba's), the demo's glossy
-/// spheres render with 3 % less relMSE under `multijitter` at 64 spp
-/// (benches/README.md).
-#[inline]
-pub(super) fn frame_tangent(sp: &SurfacePoint, sampler: Sampler) -> Vec3A {
-    if sampler == Sampler::Independent {
-        Vec3A::ZERO
-    } else {
-        sp.dpdu
-    }
 }
 
 /// Whether nothing blocks the segment from `o` to `end` at time `tau`

@@ -242,7 +242,6 @@ impl Mover {
                 p: forward.transform_point3a(sp.p),
                 ng: normal(sp.ng),
                 ns: normal(sp.ns),
-                dpdu: forward.transform_vector3a(sp.dpdu),
             },
         )
     }

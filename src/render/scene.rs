@@ -72,6 +72,9 @@ fn bounding_sphere(accel: &Accel, movers: &[Mover]) -> (Vec3A, f32) {
 pub struct Scene {
     accel: Accel,
     materials: Vec<Material>,
+    /// Whether each shape is a sphere (its shading frame:
+    /// [`super::integrator::shading`]).
+    spheres: Vec<bool>,
     emission: Vec<Option<[f32; 3]>>,
     light_of_shape: Vec<Option<u32>>,
     environment: Option<Environment>,
@@ -114,6 +117,12 @@ impl Scene {
         let mut shape_of = alloc::with_capacity(count, "the scene's primitives")?;
         let mut normals = Vec::new();
         let mut materials = Vec::with_capacity(shapes.len());
+        let spheres = alloc::collect(
+            shapes
+                .iter()
+                .map(|s| matches!(s.geometry, Geometry::Sphere(_))),
+            "the scene's shapes",
+        )?;
         let mut emission = Vec::with_capacity(shapes.len());
         let mut light_of_shape = Vec::with_capacity(shapes.len());
         let mut lights = Vec::new();
@@ -201,6 +210,7 @@ impl Scene {
         Ok(Scene {
             accel,
             materials,
+            spheres,
             emission,
             light_of_shape,
             environment,
@@ -324,6 +334,12 @@ impl Scene {
     #[inline]
     pub fn material(&self, shape: u32) -> &Material {
         &self.materials[shape as usize]
+    }
+
+    /// Whether shape `shape` is a sphere.
+    #[inline]
+    pub fn is_sphere(&self, shape: u32) -> bool {
+        self.spheres[shape as usize]
     }
 
     /// The environment, if any.

@@ -688,3 +688,34 @@ fn camera_samples_draw_their_own_numbers() {
         }
     }
 }
+
+/// Spheres shade in their azimuthal frame under the stratified samplers,
+/// in the frame of the normal alone under the independent one; other
+/// shapes always in the latter ([`integrator::shading`]).
+#[test]
+fn spheres_shade_in_their_azimuthal_frame_under_stratified_samplers() {
+    use crate::frame::Frame;
+    use crate::render::shape::Sphere;
+    let ball = Shape {
+        geometry: Geometry::Sphere(Sphere {
+            center: DVec3::new(0.0, 0.0, 3.0),
+            radius: 1.0,
+            flip: false,
+        }),
+        material: diffuse(0.5),
+        emission: None,
+        motion: None,
+    };
+    let scene = floor_scene(0.5, vec![ball]);
+    let ns = Vec3A::new(0.6, 0.0, 0.8);
+    let from = Vec3A::new(0.0, 0.6, 0.8);
+    for (shape, sampler, want) in [
+        (1, Sampler::Sobol, Frame::azimuthal(ns.to_array())),
+        (1, Sampler::MultiJitter, Frame::azimuthal(ns.to_array())),
+        (1, Sampler::Independent, Frame::from_normal(ns.to_array())),
+        (0, Sampler::Sobol, Frame::from_normal(ns.to_array())),
+    ] {
+        let (frame, _) = integrator::shading(&scene, shape, ns, from, sampler);
+        assert_eq!(frame, want, "shape {shape}, {sampler:?}");
+    }
+}

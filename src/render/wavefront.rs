@@ -32,8 +32,8 @@ use glam::Vec3A;
 use super::accel::Hit;
 use super::embree;
 use super::integrator::{
-    Escaped, Integrator, Settings, Strategy, add_scaled, dims, emission_weight, frame_tangent, mul,
-    offset, shading, shadow_ray,
+    Escaped, Integrator, Settings, Strategy, add_scaled, dims, emission_weight, mul, offset,
+    shading, shadow_ray,
 };
 use super::numbers::{Numbers, bounce_dims, draws_light_choice};
 use super::scene::{InvertedSamples, LightSample, Scene};
@@ -450,8 +450,7 @@ impl Bounce<'_> {
         if depth + 1 >= max_depth {
             return false;
         }
-        let tangent = frame_tangent(&sp, numbers.stream.sampler());
-        let (frame, view) = shading(scene, shape, (sp.ns, tangent), wi);
+        let (frame, view) = shading(scene, shape, sp.ns, wi, numbers.stream.sampler());
 
         if settings.strategy != Strategy::Bsdf {
             let many = scene.chooses_among_lights();

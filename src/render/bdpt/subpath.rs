@@ -4,12 +4,12 @@
 
 use glam::Vec3A;
 
-use super::super::integrator::{frame_tangent, offset, shading};
+use super::super::integrator::{offset, shading};
 use super::super::scene::{Emission, Scene};
 use super::super::shape::Ray;
 use super::{Ctx, dims};
 use crate::frame::Frame;
-use crate::sampler::Stream;
+use crate::sampler::{Sampler, Stream};
 use crate::warp;
 
 /// What a vertex is.
@@ -180,8 +180,7 @@ pub(super) fn walk(
             return;
         }
         let from = -ray.d;
-        let tangent = frame_tangent(&sp, stream.sampler());
-        let (frame, view) = shading(scene, shape, (v.ns, tangent), from);
+        let (frame, view) = shading(scene, shape, v.ns, from, stream.sampler());
         let (bsdf_u, rr_u) = if light {
             (dims::LIGHT_BSDF, dims::LIGHT_ROULETTE)
         } else {
@@ -198,7 +197,7 @@ pub(super) fn walk(
         };
         beta = std::array::from_fn(|c| beta[c] * s.weight[c] * fix);
         // The density of sampling `from` had the walk come the other way.
-        let (back, view_back) = shading(scene, shape, (v.ns, tangent), d);
+        let (back, view_back) = shading(scene, shape, v.ns, d, stream.sampler());
         let rev = view_back.eval_pdf_one(frame_local(&back, from)).1;
         let n = path.len();
         path[n - 2].pdf_rev = convert(rev, &v, &path[n - 2]);
@@ -274,8 +273,8 @@ pub(super) fn pdf(ctx: &Ctx, v: &Vertex, prev: Option<&Vertex>, next: &Vertex) -
                 return pdf_light(ctx, v, next);
             };
             let from = direction(v, prev);
-            // Only evaluated: any turn of the frame.
-            let (frame, view) = shading(ctx.scene, shape, (v.ns, Vec3A::ZERO), from);
+            // Only evaluated: any frame serves.
+            let (frame, view) = shading(ctx.scene, shape, v.ns, from, Sampler::Independent);
             view.eval_pdf_one(frame_local(&frame, to)).1
         }
         Kind::Light { .. } | Kind::Environment => return pdf_light(ctx, v, next),
@@ -342,8 +341,8 @@ pub(super) fn scatter(
     let Some(fix) = side_factor(v, from, to, light) else {
         return [0.0; 3];
     };
-    // Only evaluated: any turn of the frame.
-    let (frame, view) = shading(ctx.scene, shape, (v.ns, Vec3A::ZERO), from);
+    // Only evaluated: any frame serves.
+    let (frame, view) = shading(ctx.scene, shape, v.ns, from, Sampler::Independent);
     let wo = frame_local(&frame, to);
     let f = view.eval_pdf_one(wo).0;
     let s = wo[2].abs() * fix;

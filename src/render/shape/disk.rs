@@ -62,7 +62,6 @@ impl Disk {
             p,
             ng: self.normal,
             ns: self.normal,
-            dpdu: Vec3A::ZERO,
         }
     }
 

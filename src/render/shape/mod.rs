@@ -46,12 +46,6 @@ pub struct SurfacePoint {
     pub ng: Vec3A,
     /// Shading normal (interpolated vertex normal, else `ng`).
     pub ns: Vec3A,
-    /// The tangent `∂p/∂u` of a shape whose parametrisation turns the
-    /// shading frame about `ns` (not unit): a sphere's azimuth direction
-    /// about the z axis, `(−n_y, n_x, 0)` for its outward normal `n`, as
-    /// Mitsuba's sphere (zero at its poles). Zero for the other shapes,
-    /// whose frame is then [`crate::frame::Frame::from_normal`]'s.
-    pub dpdu: Vec3A,
 }
 
 #[cfg(test)]

@@ -72,14 +72,12 @@ impl Sphere {
     pub fn point(&self, p: Vec3A) -> SurfacePoint {
         let n = (p.as_dvec3() - self.center).normalize();
         let snapped = self.center + self.radius * n;
-        let dpdu = Vec3A::new(-n.y as f32, n.x as f32, 0.0);
         let n = if self.flip { -n } else { n };
         let n = Vec3A::from(n.as_vec3());
         SurfacePoint {
             p: Vec3A::from(snapped.as_vec3()),
             ng: n,
             ns: n,
-            dpdu,
         }
     }
 
@@ -155,13 +153,11 @@ impl Sphere {
         let (s, t) = axis.any_orthonormal_pair();
         let n = -cos_alpha * axis + sin_alpha * (phi.cos() * s + phi.sin() * t);
         let p = self.center + self.radius * n;
-        let dpdu = Vec3A::new(-n.y as f32, n.x as f32, 0.0);
         let n = Vec3A::from((if self.flip { -n } else { n }).as_vec3());
         let point = SurfacePoint {
             p: Vec3A::from(p.as_vec3()),
             ng: n,
             ns: n,
-            dpdu,
         };
         Some((point, uniform_cone_density(one_minus_cos_max)))
     }

@@ -118,38 +118,6 @@ fn sphere_hit_from_outside_and_inside() {
     assert!((sp.ng - Vec3A::Z).length() < 1e-6);
 }
 
-/// A sphere's shading frame ([`crate::frame::Frame::from_normal_and_tangent`]
-/// of its `dpdu`) turns smoothly across its equator `n_z = 0`, where the
-/// frame of the normal alone (Duff's) jumps; `dpdu` is tangent, and the
-/// same for an inside-out sphere.
-#[test]
-fn sphere_frames_turn_smoothly_across_the_equator() {
-    use crate::frame::Frame;
-    for flip in [false, true] {
-        let s = Sphere {
-            center: DVec3::new(0.5, 1.0, -2.0),
-            radius: 2.0,
-            flip,
-        };
-        let at = |z: f32| {
-            let n = Vec3A::new(0.6, 0.8 * (1.0 - z * z).sqrt(), z).normalize();
-            let sp = s.point(Vec3A::from(s.center.as_vec3()) + 2.0 * n);
-            assert!(sp.dpdu.dot(sp.ng).abs() < 1e-6, "dpdu not tangent");
-            (
-                Frame::from_normal_and_tangent(sp.ns.to_array(), sp.dpdu.to_array()),
-                Frame::from_normal(sp.ns.to_array()),
-            )
-        };
-        let ((above, duff_above), (below, duff_below)) = (at(1e-4), at(-1e-4));
-        let gap = |a: Frame<f32>, b: Frame<f32>| Vec3A::from(a.s).distance(Vec3A::from(b.s));
-        assert!(gap(above, below) < 1e-3, "{flip}: {above:?} {below:?}");
-        assert!(
-            gap(duff_above, duff_below) > 0.5,
-            "{flip}: Duff's frame did not jump"
-        );
-    }
-}
-
 #[test]
 fn sphere_occlusion_agrees_with_the_nearest_hit() {
     let s = Sphere {

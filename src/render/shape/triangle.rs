@@ -53,12 +53,7 @@ impl Triangle {
             }
             None => ng,
         };
-        SurfacePoint {
-            p,
-            ng,
-            ns,
-            dpdu: Vec3A::ZERO,
-        }
+        SurfacePoint { p, ng, ns }
     }
 
     /// A point drawn uniformly by area (density `1/area`), `u ∈ [0, 1]²`
