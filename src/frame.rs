@@ -134,12 +134,17 @@ mod tests {
         let n = [0.6, 0.8, 0.0];
         let f = Frame::azimuthal(n);
         check_frame(f, n);
-        assert!((0..3).all(|k| (f.s[k] - [-0.8, 0.6, 0.0][k]).abs() < 1e-12), "{:?}", f.s);
+        assert!(
+            (0..3).all(|k| (f.s[k] - [-0.8, 0.6, 0.0][k]).abs() < 1e-12),
+            "{:?}",
+            f.s
+        );
         let near = |z: f64| {
             let r = (1.0 - z * z).sqrt();
             [0.6 * r, 0.8 * r, z]
         };
-        let gap = |a: Frame<f64>, b: Frame<f64>| (0..3).map(|k| (a.s[k] - b.s[k]).abs()).sum::<f64>();
+        let gap =
+            |a: Frame<f64>, b: Frame<f64>| (0..3).map(|k| (a.s[k] - b.s[k]).abs()).sum::<f64>();
         let (above, below) = (near(1e-6), near(-1e-6));
         assert!(gap(Frame::azimuthal(above), Frame::azimuthal(below)) < 1e-5);
         assert!(gap(Frame::from_normal(above), Frame::from_normal(below)) > 0.5);
