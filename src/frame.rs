@@ -49,7 +49,7 @@ impl<F: Real> Frame<F> {
     #[inline]
     pub fn azimuthal(n: V3<F>) -> Self {
         let r2 = n[0] * n[0] + n[1] * n[1];
-        if !(r2 > F::c(1e-12)) {
+        if r2.partial_cmp(&F::c(1e-12)) != Some(std::cmp::Ordering::Greater) {
             return Self::from_normal(n);
         }
         let inv = F::one() / r2.sqrt();
