@@ -201,6 +201,24 @@ def test_out_receives_the_result_as_numpy_ufuncs_do():
     assert warp.square_to_uniform_sphere_pdf(out, out=pdf) is pdf
 
 
+def test_an_unbatched_result_into_out_is_out_itself():
+    """As numpy's ufuncs (``np.sqrt(2.0, out=np.empty(()))`` is the 0-d
+    ``out``): one point's scalar result written into a 0-d ``out`` comes
+    back as that array; without ``out`` it is a numpy scalar."""
+    assert isinstance(np.sqrt(2.0, out=np.empty(())), np.ndarray)
+    d = np.array([0.0, 0.0, 1.0])
+    pdf = np.empty(())
+    got = warp.square_to_uniform_sphere_pdf(d, out=pdf)
+    assert got is pdf and pdf[()] == pytest.approx(1 / (4 * np.pi))
+    assert isinstance(warp.square_to_uniform_sphere_pdf(d), np.float64)
+    table = mcs.Discrete1D([1.0, 2.0, 3.0])
+    index = np.full((), -7, np.int64)
+    assert table.sample(0.5, out=index) is index and index[()] == table.sample(0.5)
+    env = mcs.EnvMap()
+    value = np.empty(())
+    assert env.pdf(d, out=value) is value and value[()] == env.pdf(d)
+
+
 @pytest.mark.parametrize("out,exc,fragment", [
     (np.empty((1000, 3), np.float32), TypeError, "dtype float64"),
     (np.empty((999, 3)), ValueError, "out must have shape (1000, 3) (a writeable C-ordered array), got (999, 3)"),

@@ -331,6 +331,39 @@ pub fn finish<'py, F: Element>(array: Bound<'py, PyArrayDyn<F>>) -> PyResult<Obj
     }
 }
 
+/// An array results are written to ([`output`]): the caller's `out`, or
+/// a fresh one.
+pub struct Output<'py, T> {
+    array: Bound<'py, PyArrayDyn<T>>,
+    given: bool,
+}
+
+impl<'py, T> std::ops::Deref for Output<'py, T> {
+    type Target = Bound<'py, PyArrayDyn<T>>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.array
+    }
+}
+
+impl<'py, T: Element> Output<'py, T> {
+    /// The result as returned to Python: the caller's `out` itself, 0-d
+    /// included (as numpy's ufuncs return theirs), else the fresh array
+    /// through [`finish`] (a numpy scalar when 0-d).
+    pub fn finish(self) -> PyResult<Obj<'py>> {
+        if self.given {
+            Ok(self.array.into_any())
+        } else {
+            finish(self.array)
+        }
+    }
+
+    /// The array, whichever it is.
+    pub fn into_array(self) -> Bound<'py, PyArrayDyn<T>> {
+        self.array
+    }
+}
+
 /// The array results go to: `out` (argument `arg`) when given, checked as
 /// numpy's ufuncs check theirs (a numpy array of dtype `T` and of `shape`,
 /// C-ordered and writeable; each failure says which), else a fresh one.
@@ -339,9 +372,12 @@ pub fn output<'py, T: Element + bytemuck::Pod>(
     shape: &[usize],
     out: Out<'_, 'py>,
     arg: &'static str,
-) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
+) -> PyResult<Output<'py, T>> {
     let Some(out) = out.filter(|o| !o.is_none()) else {
-        return fresh::<T>(py, shape);
+        return Ok(Output {
+            array: fresh::<T>(py, shape)?,
+            given: false,
+        });
     };
     let array = out.cast::<PyUntypedArray>().map_err(|_| {
         PyTypeError::new_err(format!(
@@ -380,7 +416,10 @@ pub fn output<'py, T: Element + bytemuck::Pod>(
     if let Some(message) = problem {
         return Err(Error::Argument { arg, message }.into());
     }
-    Ok(array.cast::<PyArrayDyn<T>>()?.clone())
+    Ok(Output {
+        array: array.cast::<PyArrayDyn<T>>()?.clone(),
+        given: true,
+    })
 }
 
 /// The arrays of an `out` that holds one array per result, as numpy's

@@ -78,7 +78,7 @@ where
             return Err(x.invalid(check));
         }
     }
-    finish(out)
+    out.finish()
 }
 
 /// [`map_chunks`] for kernels of two results per point (`M` and `L`
@@ -117,7 +117,7 @@ where
             return Err(x.invalid(check));
         }
     }
-    Ok((finish(first)?, finish(second)?))
+    Ok((first.finish()?, second.finish()?))
 }
 
 /// Maps every point through `kernel` (`K` values in, `M` out, of any
@@ -158,7 +158,7 @@ where
             return Err(x.invalid(check));
         }
     }
-    finish(out)
+    out.finish()
 }
 
 /// `out[i] = kernel(inputs[i])` on all cores with the GIL released (see
@@ -313,5 +313,5 @@ pub fn map_indices<'py, const K: usize>(
             true
         })?;
     }
-    finish(out)
+    out.finish()
 }

@@ -40,7 +40,7 @@ fn per_index<'py>(
             *v = f(k);
         }
     }
-    Ok(array.into_any())
+    Ok(array.into_array().into_any())
 }
 
 /// The batch draw `draw` of `inputs` (a table's own results, [`GROUP`]

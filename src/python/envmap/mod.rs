@@ -4,7 +4,7 @@
 mod input;
 
 use super::args::index_arg;
-use super::arrays::{Check, Points, PyFloat, finish, output, tuple_outputs, with_precision};
+use super::arrays::{Check, Points, PyFloat, output, tuple_outputs, with_precision};
 use super::arrays::{writable, zeros};
 use super::batch::{map_each, map_into};
 use super::parallel::{detached, run_batch};
@@ -135,7 +135,7 @@ impl PyEnvMap {
                 return Err(d.invalid(Check::Finite));
             }
         }
-        finish(out)
+        out.finish()
     }
 
     /// Samples for `u`, into the arrays of `out` (direction, pdf, weight)
@@ -181,7 +181,11 @@ impl PyEnvMap {
                 return Err(u.invalid(Check::Unit));
             }
         }
-        PyEnvSample::finished(direction, pdf, weight)
+        PyEnvSample::finished(
+            direction.into_array(),
+            pdf.into_array(),
+            weight.into_array(),
+        )
     }
 
     fn uv_to_dir_as<'py, F: EnvFloat>(&self, py: Python<'py>, uv: &Obj<'py>) -> PyResult<Obj<'py>> {
