@@ -217,6 +217,13 @@ def test_an_unbatched_result_into_out_is_out_itself():
     env = mcs.EnvMap()
     value = np.empty(())
     assert env.pdf(d, out=value) is value and value[()] == env.pdf(d)
+    # The arrays of a tuple out= are the record's fields, 0-d too.
+    outs = (np.empty(3), np.empty(()), np.empty(3))
+    s = env.sample([0.3, 0.6], out=outs)
+    assert s.direction is outs[0] and s.pdf is outs[1] and s.weight is outs[2]
+    outs = (np.empty((), np.int64), np.empty(()))
+    r = table.sample_reuse(0.5, out=outs)
+    assert r.index is outs[0] and r.u is outs[1]
 
 
 @pytest.mark.parametrize("out,exc,fragment", [

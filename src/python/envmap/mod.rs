@@ -181,11 +181,11 @@ impl PyEnvMap {
                 return Err(u.invalid(Check::Unit));
             }
         }
-        PyEnvSample::finished(
-            direction.into_array(),
-            pdf.into_array(),
-            weight.into_array(),
-        )
+        Ok(PyEnvSample::new(
+            direction.finish()?,
+            pdf.finish()?,
+            weight.finish()?,
+        ))
     }
 
     fn uv_to_dir_as<'py, F: EnvFloat>(&self, py: Python<'py>, uv: &Obj<'py>) -> PyResult<Obj<'py>> {
