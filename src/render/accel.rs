@@ -8,8 +8,7 @@
 //! its other primitives one after the other. Through the
 //! BVH, the leaves' primitives are read from a copy in the BVH's order
 //! (`Packed`: a triangle's vertex and edges in 40 bytes), so that a leaf
-//! is a run of memory rather than a scatter over the scene's list of
-//! primitives (64 bytes each).
+//! is a run of memory rather than a scatter over the meshes' vertices.
 
 use std::time::Duration;
 
@@ -20,6 +19,7 @@ use crate::alloc;
 use crate::error::Result;
 
 use super::embree::{self, Stream as EmbreeStream, Triangles as Embree};
+use super::mesh::Mesh;
 use super::shape::{
     Candidate, Disk, Ray, Sphere, SurfacePoint, Triangle, Triangles4, triangle_hit,
 };
@@ -30,25 +30,42 @@ use super::shape::{
 /// ([`Packed`]) was added.
 const BUILD_BYTES_PER_PRIMITIVE: usize = 300;
 
-/// A primitive of a scene, in 64 bytes (a triangle's: its vertex, edges
-/// and the indices of its vertex normals). A disk, with its two affine
-/// maps, is kept out of line.
+/// A primitive of a scene, in 16 bytes: a triangle as the face of a
+/// mesh (its vertices and normals stay in the mesh), a sphere or a disk
+/// out of line.
 #[derive(Clone, Debug)]
 pub enum Primitive {
-    /// One triangle of a mesh.
-    Triangle(Triangle),
+    /// Face `face` of mesh `mesh` ([`Accel::meshes`]).
+    Triangle {
+        /// The mesh.
+        mesh: u32,
+        /// The face.
+        face: u32,
+    },
     /// A sphere.
-    Sphere(Sphere),
+    Sphere(Box<Sphere>),
     /// A disk.
     Disk(Box<Disk>),
 }
 
 impl Primitive {
-    /// The hit of `ray` in `(0, ray.tmax)`, if any.
+    /// Its triangle, if it is a face of one of `meshes`.
+    #[inline]
+    pub fn triangle(&self, meshes: &[Mesh]) -> Option<Triangle> {
+        match *self {
+            Primitive::Triangle { mesh, face } => Some(meshes[mesh as usize].triangle(face)),
+            _ => None,
+        }
+    }
+
+    /// The hit of `ray` in `(0, ray.tmax)`, if any (`meshes` those of its
+    /// scene, as for every method here).
     #[inline(always)]
-    pub fn intersect(&self, ray: &Ray) -> Option<Candidate> {
+    pub fn intersect(&self, ray: &Ray, meshes: &[Mesh]) -> Option<Candidate> {
         match self {
-            Primitive::Triangle(t) => t.intersect(ray),
+            Primitive::Triangle { mesh, face } => {
+                meshes[*mesh as usize].triangle(*face).intersect(ray)
+            }
             Primitive::Sphere(s) => s.intersect(ray),
             Primitive::Disk(d) => d.intersect(ray),
         }
@@ -56,36 +73,41 @@ impl Primitive {
 
     /// Whether the primitive lies on the ray in `(0, ray.tmax)`.
     #[inline]
-    fn occludes(&self, ray: &Ray) -> bool {
+    fn occludes(&self, ray: &Ray, meshes: &[Mesh]) -> bool {
         match self {
             Primitive::Sphere(s) => s.occludes(ray),
-            _ => self.intersect(ray).is_some(),
+            _ => self.intersect(ray, meshes).is_some(),
         }
     }
 
     /// Its area.
-    pub fn area(&self) -> f64 {
+    pub fn area(&self, meshes: &[Mesh]) -> f64 {
         match self {
-            Primitive::Triangle(t) => f64::from(t.area()),
+            Primitive::Triangle { mesh, face } => {
+                f64::from(meshes[*mesh as usize].triangle(*face).area())
+            }
             Primitive::Sphere(s) => s.area(),
             Primitive::Disk(d) => f64::from(d.area),
         }
     }
 
-    /// A point drawn uniformly by area (density `1 / area`); `normals` is
-    /// the table of a triangle's vertex normals ([`Accel::normals`]).
+    /// A point drawn uniformly by area (density `1 / area`).
     #[inline]
-    pub fn sample(&self, u: [f32; 2], normals: &[Vec3A]) -> SurfacePoint {
+    pub fn sample(&self, u: [f32; 2], meshes: &[Mesh]) -> SurfacePoint {
         match self {
-            Primitive::Triangle(t) => t.sample(u, normals),
+            Primitive::Triangle { mesh, face } => {
+                let m = &meshes[*mesh as usize];
+                m.triangle(*face).sample(u, &m.normals)
+            }
             Primitive::Sphere(s) => s.sample(u),
             Primitive::Disk(d) => d.sample(u),
         }
     }
 
-    fn bounds(&self) -> Aabb {
+    fn bounds(&self, meshes: &[Mesh]) -> Aabb {
         let (lo, hi) = match self {
-            Primitive::Triangle(t) => {
+            Primitive::Triangle { mesh, face } => {
+                let t = meshes[*mesh as usize].triangle(*face);
                 let (p1, p2) = (t.p0 + t.e1, t.p0 + t.e2);
                 (t.p0.min(p1).min(p2), t.p0.max(p1).max(p2))
             }
@@ -96,12 +118,14 @@ impl Primitive {
     }
 
     /// The surface point of a hit on this primitive at `p` (position along
-    /// the ray) with barycentrics `bary` (triangles; `normals` is the table
-    /// of their vertex normals, [`Accel::normals`]).
-    #[inline]
-    pub fn point(&self, p: Vec3A, bary: [f32; 2], normals: &[Vec3A]) -> SurfacePoint {
+    /// the ray) with barycentrics `bary` (triangles).
+    #[inline(always)]
+    pub fn point(&self, p: Vec3A, bary: [f32; 2], meshes: &[Mesh]) -> SurfacePoint {
         match self {
-            Primitive::Triangle(t) => t.point(bary, normals),
+            Primitive::Triangle { mesh, face } => {
+                let m = &meshes[*mesh as usize];
+                m.triangle(*face).point(bary, &m.normals)
+            }
             Primitive::Sphere(s) => s.point(p),
             Primitive::Disk(d) => d.point(p),
         }
@@ -143,9 +167,9 @@ impl Packed {
     /// triangle.
     const OTHER: u32 = 1 << 31;
 
-    fn new(primitive: &Primitive, index: u32) -> Self {
-        match primitive {
-            Primitive::Triangle(t) => Packed {
+    fn new(primitive: &Primitive, index: u32, meshes: &[Mesh]) -> Self {
+        match primitive.triangle(meshes) {
+            Some(t) => Packed {
                 p0: t.p0.to_array(),
                 primitive: index,
                 e1: t.e1.to_array(),
@@ -161,16 +185,17 @@ impl Packed {
     }
 }
 
-/// Primitives, the shape each belongs to, their Embree scene (the
-/// triangles, when Embree traces them) and the BVH of the others (none for
-/// at most [`LEAF_MAX`] primitives).
+/// Primitives, the shape each belongs to, the meshes whose faces the
+/// triangles are, their Embree scene (the meshes, when Embree traces them)
+/// and the BVH of the others (none for at most [`LEAF_MAX`] primitives).
 pub struct Accel {
+    /// Before the meshes, so that it is released before the buffers it
+    /// shares with them.
+    embree: Option<Embree>,
     primitives: Vec<Primitive>,
     shape_of: Vec<u32>,
-    /// The triangles' vertex normals ([`Triangle::normals`] index it).
-    normals: Vec<Vec3A>,
+    meshes: Vec<Mesh>,
     bounds: Option<Aabb>,
-    embree: Option<Embree>,
     bvh: Option<CwBvh>,
     /// The primitives in the order of the BVH's leaves.
     packed: Vec<Packed>,
@@ -183,6 +208,9 @@ pub struct Accel {
 struct Leaf {
     /// The triangles, four to a pack, with their primitive indices.
     packs: Vec<(Triangles4, [u32; 4])>,
+    /// The spheres, copied in (a test reads no further), with their
+    /// primitive indices.
+    spheres: Vec<(Sphere, u32)>,
     /// The indices of the other primitives.
     others: Vec<u32>,
 }
@@ -190,12 +218,15 @@ struct Leaf {
 impl Leaf {
     /// Sorts the primitives `ids` of `primitives` into packs of triangles
     /// and the others.
-    fn new(primitives: &[Primitive], ids: &[u32]) -> Self {
-        let (mut triangles, mut others) = (Vec::new(), Vec::new());
+    fn new(primitives: &[Primitive], ids: &[u32], meshes: &[Mesh]) -> Self {
+        let (mut triangles, mut spheres, mut others) = (Vec::new(), Vec::new(), Vec::new());
         for &i in ids {
             match &primitives[i as usize] {
-                Primitive::Triangle(t) => triangles.push((*t, i)),
-                _ => others.push(i),
+                p @ Primitive::Triangle { .. } => {
+                    triangles.extend(p.triangle(meshes).map(|t| (t, i)))
+                }
+                Primitive::Sphere(s) => spheres.push((**s, i)),
+                Primitive::Disk(_) => others.push(i),
             }
         }
         let packs = triangles
@@ -208,56 +239,65 @@ impl Leaf {
                 )
             })
             .collect();
-        Leaf { packs, others }
+        Leaf {
+            packs,
+            spheres,
+            others,
+        }
     }
 }
 
 impl Accel {
     /// Builds the BVH over `primitives`, primitive `i` of shape
     /// `shape_of[i]` (the two as separate lists, so that the build holds
-    /// no second copy of the primitives), whose triangles' vertex normals
-    /// index `normals`.
+    /// no second copy of the primitives), whose triangles are faces of
+    /// `meshes` (each mesh's faces one after the other, in their order, as
+    /// [`crate::render::geometry::Geometry::into_primitives`] lists them).
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the BVH's memory cannot be had.
     ///
     /// # Panics
     /// If the two lists differ in length.
-    pub fn new(
-        primitives: Vec<Primitive>,
-        shape_of: Vec<u32>,
-        normals: Vec<Vec3A>,
-    ) -> Result<Self> {
-        let mut accel = Self::build(primitives, shape_of, true)?;
-        accel.normals = normals;
-        Ok(accel)
+    pub fn new(primitives: Vec<Primitive>, shape_of: Vec<u32>, meshes: Vec<Mesh>) -> Result<Self> {
+        Self::build(primitives, shape_of, meshes, true)
     }
 
     /// [`Accel::new`], with Embree only if `embree` (and as
     /// `MCSAMPLE_RAY_TRACER` says): `false` lets the tests compare the two.
-    fn build(primitives: Vec<Primitive>, shape_of: Vec<u32>, embree: bool) -> Result<Self> {
+    fn build(
+        primitives: Vec<Primitive>,
+        shape_of: Vec<u32>,
+        meshes: Vec<Mesh>,
+        embree: bool,
+    ) -> Result<Self> {
         const WHAT: &str = "the BVH";
         let n = primitives.len();
         assert_eq!(shape_of.len(), n, "a shape for every primitive");
         let bounds = primitives
             .iter()
-            .map(Primitive::bounds)
+            .map(|p| p.bounds(&meshes))
             .reduce(|a, b| a.union(&b));
         let library = if embree { embree::wanted()? } else { None };
-        let triangles = primitives
-            .iter()
-            .filter(|p| matches!(p, Primitive::Triangle(_)))
-            .count();
+        let is_triangle = |p: &Primitive| matches!(p, Primitive::Triangle { .. });
+        let triangles = primitives.iter().filter(|p| is_triangle(p)).count();
         let embree = match library {
-            Some(library) if triangles > LEAF_MAX => Embree::new(library, &primitives)?,
+            Some(library) if triangles > LEAF_MAX => Some(Embree::new(
+                library,
+                &meshes,
+                &first_faces(&primitives, &meshes)?,
+            )?),
             _ => None,
         };
         // What obvhs traces: all, or what Embree does not.
         let mut ids = alloc::with_capacity(n, WHAT)?;
-        ids.extend((0..n as u32).filter(|&i| {
-            embree.is_none() || !matches!(primitives[i as usize], Primitive::Triangle(_))
-        }));
-        let aabbs = alloc::collect(ids.iter().map(|&i| primitives[i as usize].bounds()), WHAT)?;
+        ids.extend(
+            (0..n as u32).filter(|&i| embree.is_none() || !is_triangle(&primitives[i as usize])),
+        );
+        let aabbs = alloc::collect(
+            ids.iter().map(|&i| primitives[i as usize].bounds(&meshes)),
+            WHAT,
+        )?;
         // The builder allocates as it goes, infallibly: check first that
         // its working memory is there.
         if ids.len() > LEAF_MAX {
@@ -276,19 +316,19 @@ impl Accel {
                 alloc::collect(
                     bvh.primitive_indices.iter().map(|&j| {
                         let i = ids[j as usize];
-                        Packed::new(&primitives[i as usize], i)
+                        Packed::new(&primitives[i as usize], i, &meshes)
                     }),
                     WHAT,
                 )?,
             ),
-            None => (Leaf::new(&primitives, &ids), Vec::new()),
+            None => (Leaf::new(&primitives, &ids, &meshes), Vec::new()),
         };
         Ok(Accel {
+            embree,
             primitives,
             shape_of,
-            normals: Vec::new(),
+            meshes,
             bounds,
-            embree,
             bvh,
             packed,
             leaf,
@@ -308,10 +348,10 @@ impl Accel {
         &self.primitives
     }
 
-    /// The table of the triangles' vertex normals.
+    /// The meshes whose faces the triangles are.
     #[inline]
-    pub fn normals(&self) -> &[Vec3A] {
-        &self.normals
+    pub fn meshes(&self) -> &[Mesh] {
+        &self.meshes
     }
 
     /// The shape a primitive belongs to.
@@ -386,25 +426,24 @@ impl Accel {
     fn intersect_leaf(&self, ray: &Ray) -> Option<Hit> {
         let mut best: Option<Hit> = None;
         let mut shrunk = *ray;
-        let Leaf { packs, others } = &self.leaf;
+        let Leaf {
+            packs,
+            spheres,
+            others,
+        } = &self.leaf;
         for (pack, index) in packs {
             if let Some((lane, c)) = pack.intersect(&shrunk) {
-                best = Some(Hit {
-                    t: c.t,
-                    primitive: index[lane],
-                    bary: c.bary,
-                });
-                shrunk.tmax = c.t;
+                nearer(&mut best, &mut shrunk, index[lane], c);
+            }
+        }
+        for (sphere, primitive) in spheres {
+            if let Some(c) = sphere.intersect(&shrunk) {
+                nearer(&mut best, &mut shrunk, *primitive, c);
             }
         }
         for &primitive in others {
-            if let Some(c) = self.primitives[primitive as usize].intersect(&shrunk) {
-                best = Some(Hit {
-                    t: c.t,
-                    primitive,
-                    bary: c.bary,
-                });
-                shrunk.tmax = c.t;
+            if let Some(c) = self.primitives[primitive as usize].intersect(&shrunk, &self.meshes) {
+                nearer(&mut best, &mut shrunk, primitive, c);
             }
         }
         best
@@ -447,7 +486,7 @@ impl Accel {
         let p = &self.packed[id];
         if p.primitive & Packed::OTHER != 0 {
             let primitive = p.primitive & !Packed::OTHER;
-            let c = self.primitives[primitive as usize].intersect(ray)?;
+            let c = self.primitives[primitive as usize].intersect(ray, &self.meshes)?;
             return Some((primitive, c));
         }
         triangle_hit(ray, p.p0, p.e1, p.e2).map(|c| (p.primitive, c))
@@ -489,11 +528,16 @@ impl Accel {
     #[inline]
     fn others_occlude(&self, ray: &Ray) -> bool {
         let Some(bvh) = self.bvh.as_ref() else {
-            let Leaf { packs, others } = &self.leaf;
+            let Leaf {
+                packs,
+                spheres,
+                others,
+            } = &self.leaf;
             return packs.iter().any(|(pack, _)| pack.occludes(ray))
+                || spheres.iter().any(|(s, _)| s.occludes(ray))
                 || others
                     .iter()
-                    .any(|&p| self.primitives[p as usize].occludes(ray));
+                    .any(|&p| self.primitives[p as usize].occludes(ray, &self.meshes));
         };
         let query = obvhs::ray::Ray::new(ray.o, ray.d, 0.0, ray.tmax);
         !bvh.ray_traverse_miss(query, |_, id| {
@@ -506,6 +550,33 @@ impl Accel {
     pub fn bounds(&self) -> Option<(Vec3A, Vec3A)> {
         self.bounds.map(|b| (b.min, b.max))
     }
+}
+
+/// `c`, the hit of a ray on `primitive`, as the `best` so far, and the
+/// ray `shrunk` to it.
+#[inline(always)]
+fn nearer(best: &mut Option<Hit>, shrunk: &mut Ray, primitive: u32, c: Candidate) {
+    *best = Some(Hit {
+        t: c.t,
+        primitive,
+        bary: c.bary,
+    });
+    shrunk.tmax = c.t;
+}
+
+/// The number among `primitives` of each mesh's first face (0 for a mesh
+/// of no faces, which Embree is not given).
+///
+/// # Errors
+/// [`crate::Error::Memory`] when the list cannot be had.
+fn first_faces(primitives: &[Primitive], meshes: &[Mesh]) -> Result<Vec<u32>> {
+    let mut first = alloc::filled(meshes.len(), 0, "the meshes")?;
+    for (i, p) in primitives.iter().enumerate() {
+        if let Primitive::Triangle { mesh, face: 0 } = *p {
+            first[mesh as usize] = i as u32;
+        }
+    }
+    Ok(first)
 }
 
 #[cfg(test)]

@@ -20,7 +20,8 @@ use std::sync::OnceLock;
 
 use libloading::Library;
 
-use super::accel::{Hit, Primitive};
+use super::accel::Hit;
+use super::mesh::Mesh;
 use super::shape::Ray;
 use crate::error::{Error, Result};
 
@@ -89,7 +90,7 @@ struct Api {
     set_scene_flags: unsafe extern "C" fn(Handle, u32),
     set_build_quality: unsafe extern "C" fn(Handle, u32),
     new_geometry: unsafe extern "C" fn(Handle, u32) -> Handle,
-    new_buffer: unsafe extern "C" fn(Handle, u32, u32, u32, usize, usize) -> *mut c_void,
+    shared_buffer: unsafe extern "C" fn(Handle, u32, u32, u32, *const c_void, usize, usize, usize),
     commit_geometry: unsafe extern "C" fn(Handle),
     attach_geometry: unsafe extern "C" fn(Handle, Handle) -> u32,
     release_geometry: unsafe extern "C" fn(Handle),
@@ -151,7 +152,7 @@ impl Api {
             set_scene_flags: entry!("rtcSetSceneFlags"),
             set_build_quality: entry!("rtcSetSceneBuildQuality"),
             new_geometry: entry!("rtcNewGeometry"),
-            new_buffer: entry!("rtcSetNewGeometryBuffer"),
+            shared_buffer: entry!("rtcSetSharedGeometryBuffer"),
             commit_geometry: entry!("rtcCommitGeometry"),
             attach_geometry: entry!("rtcAttachGeometry"),
             release_geometry: entry!("rtcReleaseGeometry"),
@@ -253,12 +254,13 @@ pub struct Stream {
 /// Rays per call of a stream function (its count is a `u32`).
 const STREAM_CHUNK: usize = 1 << 20;
 
-/// Triangles in an Embree scene (one triangle mesh of unshared vertices),
-/// with the index of each in the scene's list of primitives.
+/// Triangle meshes in an Embree scene (one geometry each, tracing the
+/// meshes' own vertex and index buffers), with the number of each one's
+/// first face in the scene's list of primitives, by geometry ID.
 pub struct Triangles {
     api: &'static Api,
     scene: Handle,
-    primitive: Vec<u32>,
+    first: Vec<u32>,
 }
 
 // SAFETY: a committed Embree scene is read-only and may be traced from
@@ -278,48 +280,47 @@ impl Drop for Triangles {
 }
 
 impl Triangles {
-    /// The triangles among `primitives` in an Embree scene of `library`,
-    /// or `None` when there are more than Embree numbers
-    /// (`u32::MAX / 3`: their vertices are numbered in 32 bits).
+    /// The faces of `meshes` in an Embree scene of `library`; the faces
+    /// of mesh `m` are the scene's primitives from `first[m]` on. Embree
+    /// reads the meshes' vertices and faces where they are: they must
+    /// stay, unchanged, as long as the scene.
     ///
     /// # Errors
     /// [`Error::Memory`] when the memory cannot be had or Embree runs out
     /// of it; [`Error::Argument`] when Embree fails otherwise.
     #[allow(unsafe_code)]
-    pub fn new(library: Library3, primitives: &[Primitive]) -> Result<Option<Self>> {
+    pub fn new(library: Library3, meshes: &[Mesh], first: &[u32]) -> Result<Self> {
         const WHAT: &str = "Embree's BVH";
         let api = library.0;
-        let triangles = || {
-            primitives.iter().enumerate().filter_map(|(i, p)| match p {
-                Primitive::Triangle(t) => Some((t, i as u32)),
-                _ => None,
-            })
+        let n: usize = meshes.iter().map(|m| m.faces.len()).sum();
+        // About what Embree allocates: a BVH of some 100 bytes a triangle,
+        // as it goes, so check first.
+        let bytes = n as u128 * 128;
+        crate::alloc::probe::<u8>(n.saturating_mul(128), WHAT)?;
+        let traced = || {
+            meshes
+                .iter()
+                .zip(first)
+                .filter(|(m, _)| !m.faces.is_empty())
         };
-        let n = triangles().count();
-        if n > (u32::MAX / 3) as usize {
-            return Ok(None);
-        }
-        let mut primitive = crate::alloc::with_capacity(n, WHAT)?;
-        primitive.extend(triangles().map(|t| t.1));
-        // About what Embree allocates: its copy of the vertices (36 bytes
-        // a triangle) and indices (12), and a BVH of some 100 bytes a
-        // triangle; Embree allocates as it goes, so check first.
-        let bytes = n as u128 * 160;
-        crate::alloc::probe::<u8>(n.saturating_mul(160), WHAT)?;
+        let mut firsts = crate::alloc::with_capacity(traced().count(), WHAT)?;
         // SAFETY: calls on a valid device, in the order Embree's API
-        // requires (buffers filled before the geometry is committed,
+        // requires (buffers set before the geometry is committed,
         // attached, released; the scene committed before it is traced).
-        // The buffers Embree returns hold 3n vertices and n triangles.
+        // The buffers shared are the mesh's: `points.len()` vertices 16
+        // bytes apart (each readable as 16 bytes, as Embree reads them)
+        // and `faces.len()` triples of indices below it; the caller keeps
+        // them as long as the scene.
         unsafe {
             let scene = (api.new_scene)(api.device);
             if scene.is_null() {
                 api.check("a scene", bytes)?;
                 return Err(Error::Memory { what: WHAT, bytes });
             }
-            let release_on_error = Triangles {
+            let mut triangles = Triangles {
                 api,
                 scene,
-                primitive,
+                first: Vec::new(),
             };
             api.check("a scene", bytes)?;
             // RTC_SCENE_FLAG_ROBUST: no optimisation that could let a ray
@@ -328,32 +329,48 @@ impl Triangles {
             // RTC_BUILD_QUALITY_HIGH: a scene is built once and traced
             // billions of times.
             (api.set_build_quality)(scene, 2);
-            let geometry = (api.new_geometry)(api.device, 0);
-            api.check("a triangle mesh", bytes)?;
-            // RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3: 3n vertices.
-            let vertices = (api.new_buffer)(geometry, 1, 0, 0x9003, 12, 3 * n).cast::<[f32; 3]>();
-            // RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3: n triangles.
-            let indices = (api.new_buffer)(geometry, 0, 0, 0x5003, 12, n).cast::<[u32; 3]>();
-            if vertices.is_null() || indices.is_null() {
+            for (mesh, &first) in traced() {
+                let geometry = (api.new_geometry)(api.device, 0);
+                api.check("a triangle mesh", bytes)?;
+                // RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3.
+                (api.shared_buffer)(
+                    geometry,
+                    1,
+                    0,
+                    0x9003,
+                    mesh.points.as_ptr().cast(),
+                    0,
+                    size_of::<glam::Vec3A>(),
+                    mesh.points.len(),
+                );
+                // RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3.
+                (api.shared_buffer)(
+                    geometry,
+                    0,
+                    0,
+                    0x5003,
+                    mesh.faces.as_ptr().cast(),
+                    0,
+                    size_of::<[u32; 3]>(),
+                    mesh.faces.len(),
+                );
+                (api.commit_geometry)(geometry);
+                let id = (api.attach_geometry)(scene, geometry);
                 (api.release_geometry)(geometry);
                 api.check("a triangle mesh", bytes)?;
-                return Err(Error::Memory { what: WHAT, bytes });
+                // IDs are handed out from 0 in order of attachment.
+                if id as usize != firsts.len() {
+                    return Err(Error::Argument {
+                        arg: "scene",
+                        message: format!("Embree numbered mesh {} as {id}", firsts.len()),
+                    });
+                }
+                firsts.push(first);
             }
-            let vertices = std::slice::from_raw_parts_mut(vertices, 3 * n);
-            let indices = std::slice::from_raw_parts_mut(indices, n);
-            for (i, (t, _)) in triangles().enumerate() {
-                let v = 3 * i as u32;
-                indices[i] = [v, v + 1, v + 2];
-                vertices[3 * i] = t.p0.to_array();
-                vertices[3 * i + 1] = (t.p0 + t.e1).to_array();
-                vertices[3 * i + 2] = (t.p0 + t.e2).to_array();
-            }
-            (api.commit_geometry)(geometry);
-            (api.attach_geometry)(scene, geometry);
-            (api.release_geometry)(geometry);
             (api.commit_scene)(scene);
             api.check("the BVH", bytes)?;
-            Ok(Some(release_on_error))
+            triangles.first = firsts;
+            Ok(triangles)
         }
     }
 
@@ -408,7 +425,7 @@ impl Triangles {
     fn hit_of(&self, rh: &RayHit) -> Option<Hit> {
         (rh.hit.geom_id != INVALID).then(|| Hit {
             t: rh.ray.tfar,
-            primitive: self.primitive[rh.hit.prim_id as usize],
+            primitive: self.first[rh.hit.geom_id as usize] + rh.hit.prim_id,
             bary: [rh.hit.u, rh.hit.v],
         })
     }

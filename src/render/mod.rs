@@ -48,6 +48,7 @@ pub mod film;
 pub mod filter;
 pub mod geometry;
 pub mod integrator;
+pub mod mesh;
 pub mod mesh_file;
 pub mod motion;
 mod numbers;

@@ -234,7 +234,7 @@ impl Mover {
         let (forward, inverse) = self.relative(tau);
         let local = Self::local(ray, &inverse);
         let primitive = &self.accel.primitives()[own as usize];
-        let sp = primitive.point(local.o + local.d * hit.t, hit.bary, self.accel.normals());
+        let sp = primitive.point(local.o + local.d * hit.t, hit.bary, self.accel.meshes());
         let normal = |n: Vec3A| (inverse.matrix3.transpose() * n).normalize();
         (
             self.accel.shape_of(own),

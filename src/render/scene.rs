@@ -4,8 +4,8 @@
 
 use glam::Vec3A;
 
+use super::accel::Accel;
 use super::accel::Hit;
-use super::accel::{Accel, Primitive};
 use super::camera::Camera;
 pub use super::environment::Environment;
 use super::filter::{FilmFilter, Filter};
@@ -115,7 +115,7 @@ impl Scene {
         check_primitives("shapes", count)?;
         let mut primitives = alloc::with_capacity(count, "the scene's primitives")?;
         let mut shape_of = alloc::with_capacity(count, "the scene's primitives")?;
-        let mut normals = Vec::new();
+        let mut meshes = Vec::new();
         let mut materials = Vec::with_capacity(shapes.len());
         let spheres = alloc::collect(
             shapes
@@ -140,28 +140,32 @@ impl Scene {
                         ),
                     });
                 }
-                let mut own_normals = Vec::new();
+                let mut own_meshes = Vec::new();
                 let own = alloc::collect(
-                    shape.geometry.into_primitives(&mut own_normals)?,
+                    shape.geometry.into_primitives(&mut own_meshes),
                     "a moving shape's primitives",
                 )?;
                 let shapes = alloc::collect(own.iter().map(|_| id), "a moving shape's primitives")?;
-                movers.push(Mover::new(Accel::new(own, shapes, own_normals)?, motion));
+                movers.push(Mover::new(Accel::new(own, shapes, own_meshes)?, motion));
                 materials.push(shape.material);
                 emission.push(None);
                 light_of_shape.push(None);
                 continue;
             }
             let first = primitives.len() as u32;
-            primitives.extend(shape.geometry.into_primitives(&mut normals)?);
+            primitives.extend(shape.geometry.into_primitives(&mut meshes));
             shape_of.resize(primitives.len(), id);
-            let areas = alloc::collect(
-                primitives[first as usize..].iter().map(Primitive::area),
-                "the areas",
-            )?;
             materials.push(shape.material);
             let radiance = shape.emission.map(|l| l.map(|v| v as f32));
             emission.push(radiance);
+            // The areas of an emitter's primitives, to choose among them.
+            let areas = match shape.emission {
+                Some(_) => alloc::collect(
+                    primitives[first as usize..].iter().map(|p| p.area(&meshes)),
+                    "the areas",
+                )?,
+                None => Vec::new(),
+            };
             let total: f64 = areas.iter().sum();
             let power = shape
                 .emission
@@ -183,7 +187,7 @@ impl Scene {
                 light_of_shape.push(None);
             }
         }
-        let accel = Accel::new(primitives, shape_of, normals)?;
+        let accel = Accel::new(primitives, shape_of, meshes)?;
         // At most MAX_PRIMITIVES in all (check_primitives above).
         let mut first = accel.primitives().len() as u32;
         for mover in &mut movers {
@@ -277,7 +281,7 @@ impl Scene {
         let primitive = &self.accel.primitives()[hit.primitive as usize];
         (
             self.accel.shape_of(hit.primitive),
-            primitive.point(ray.o + ray.d * hit.t, hit.bary, self.accel.normals()),
+            primitive.point(ray.o + ray.d * hit.t, hit.bary, self.accel.meshes()),
         )
     }
 

@@ -192,10 +192,10 @@ impl Scene {
                     let own = &self.accel.primitives()[*first as usize..(first + count) as usize];
                     let nearest = own
                         .iter()
-                        .filter_map(|p| p.intersect(&ray).map(|c| (p, c)))
+                        .filter_map(|p| p.intersect(&ray, self.accel.meshes()).map(|c| (p, c)))
                         .min_by(|a, b| a.1.t.total_cmp(&b.1.t));
                     if let Some((p, c)) = nearest {
-                        let y = p.point(x + d * c.t, c.bary, self.accel.normals());
+                        let y = p.point(x + d * c.t, c.bary, self.accel.meshes());
                         if self.emitted(*shape, y.ng, -d).is_some() {
                             pdf += self.light_pdf(*shape, x, y.ng, d, c.t);
                         }
@@ -248,7 +248,7 @@ impl Scene {
                 let (primitive, u2) = self.pick_primitive(area, [u[1], u[2]]);
                 Some(Emission::Surface {
                     shape: area.shape,
-                    point: primitive.sample(u2, self.accel.normals()),
+                    point: primitive.sample(u2, self.accel.meshes()),
                     pdf: pmf / area.total_area,
                     radiance: area.radiance,
                 })
@@ -419,7 +419,7 @@ impl Scene {
                         Some((y, pdf)) => (y, Some(pdf)),
                         None => (s.sample(u2), None),
                     },
-                    _ => (primitive.sample(u2, self.accel.normals()), None),
+                    _ => (primitive.sample(u2, self.accel.meshes()), None),
                 };
                 let to_light = y.p - x;
                 let dist = to_light.length();

@@ -56,7 +56,7 @@ impl Sphere {
     /// Whether a root lies in `(0, tmax)`, without dividing: `q/a` does
     /// when `0 < q < a·tmax`, and `k/q` when `0 < σk < |q|·tmax` with `σ`
     /// the sign of `q` (`a > 0`).
-    #[inline]
+    #[inline(always)]
     pub fn occludes(&self, ray: &Ray) -> bool {
         let Some((q, a, k)) = self.roots(ray) else {
             return false;

@@ -17,9 +17,9 @@ pub struct Triangle {
     pub e1: Vec3A,
     /// `p2 − p0`.
     pub e2: Vec3A,
-    /// The indices of the vertex normals in the scene's table (the
+    /// The indices of the vertex normals in its mesh's table (the
     /// `normals` argument of [`Triangle::point`]), when the mesh has
-    /// them: 12 bytes instead of the normals' 48.
+    /// them.
     pub normals: Option<[u32; 3]>,
 }
 
