@@ -12,6 +12,7 @@ use glam::{Affine3A, Vec3A};
 use mcsample::envmap::{EnvMap, Options};
 use mcsample::phong::{Phong, Selection};
 use mcsample::render::camera::{Camera, FovAxis};
+use mcsample::render::mesh::Mesh;
 use mcsample::render::scene::{Environment, Geometry, Material, Shape};
 use mcsample::render::{
     Heuristic, Integrator, Progress, Samples, Scene, Settings, Strategy, render,
@@ -36,7 +37,8 @@ fn rectangle(m: [[f64; 4]; 4], material: Material, emission: Option<[f64; 3]>) -
         .map(|[x, y]| [0, 1, 2].map(|r| m[r][0] * x + m[r][1] * y + m[r][3]))
         .collect();
     Shape {
-        geometry: Geometry::mesh(&vertices, &[[0, 1, 2], [2, 3, 0]], None, true)
+        geometry: Mesh::new(&vertices, &[[0, 1, 2], [2, 3, 0]], None, true)
+            .map(Geometry::Mesh)
             .expect("valid mesh"),
         material,
         emission,

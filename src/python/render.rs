@@ -22,6 +22,7 @@ use crate::error::Error;
 use crate::render::camera::{Camera, FovAxis};
 use crate::render::film::{self, Block};
 use crate::render::filter::Filter;
+use crate::render::mesh::Mesh;
 use crate::render::motion::Motion;
 use crate::render::scene::daffine;
 use crate::render::scene::{Environment, Geometry, Material, Shape, affine};
@@ -140,7 +141,8 @@ impl PySceneBuilder {
             .as_ref()
             .map(|n| rows::<f64, 3>(n, "normals"))
             .transpose()?;
-        let geometry = py.detach(|| Geometry::mesh(&v, &f, n.as_deref(), face_normals));
+        let geometry =
+            py.detach(|| Mesh::new(&v, &f, n.as_deref(), face_normals).map(Geometry::Mesh));
         self.push(geometry, &bsdf, two_sided, emission)
     }
 

@@ -252,7 +252,7 @@ impl Accel {
     /// `shape_of[i]` (the two as separate lists, so that the build holds
     /// no second copy of the primitives), whose triangles are faces of
     /// `meshes` (each mesh's faces one after the other, in their order, as
-    /// [`crate::render::geometry::Geometry::into_primitives`] lists them).
+    /// the geometry of a shape lists them).
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the BVH's memory cannot be had.

@@ -4,7 +4,7 @@
 use glam::DVec3;
 
 use super::accel::Primitive;
-pub use super::mesh::Mesh;
+use super::mesh::Mesh;
 use super::shape::{Disk, Sphere};
 use crate::error::{Error, Result};
 
@@ -72,19 +72,6 @@ impl Geometry {
             Geometry::Sphere(s) => Box::new(std::iter::once(Primitive::Sphere(Box::new(s)))),
             Geometry::Disk(d) => Box::new(std::iter::once(Primitive::Disk(Box::new(d)))),
         }
-    }
-
-    /// A triangle mesh: [`Mesh::new`].
-    ///
-    /// # Errors
-    /// As [`Mesh::new`].
-    pub fn mesh(
-        vertices: &[[f64; 3]],
-        faces: &[[i64; 3]],
-        normals: Option<&[[f64; 3]]>,
-        face_normals: bool,
-    ) -> Result<Self> {
-        Mesh::new(vertices, faces, normals, face_normals).map(Geometry::Mesh)
     }
 
     /// A sphere of `radius > 0` around `center`; normals inward if `flip`.

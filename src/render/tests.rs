@@ -8,6 +8,7 @@ use glam::{Affine3A, DVec3, Quat, Vec3, Vec3A};
 
 use super::camera::{Camera, FovAxis};
 use super::integrator;
+use super::mesh::Mesh;
 use super::scene::{Environment, Geometry, Material, Shape};
 use super::shape::Ray;
 use super::wavefront::{CameraSample, Wavefront};
@@ -40,7 +41,7 @@ fn mesh(m: Affine3A, vertices: &[[f32; 3]], faces: &[[i64; 3]]) -> Geometry {
         .iter()
         .map(|&p| m.transform_point3(Vec3::from(p)).as_dvec3().to_array())
         .collect();
-    Geometry::mesh(&v, faces, None, true).unwrap()
+    Geometry::Mesh(Mesh::new(&v, faces, None, true).unwrap())
 }
 
 /// Mitsuba's rectangle `[−1, 1]², z = 0`, facing +z, placed by `m`.
@@ -600,9 +601,9 @@ fn pixel_moments_are_the_mean_and_the_variance_of_the_mean() {
 #[test]
 fn mesh_faces_must_index_its_vertices() {
     let v = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-    assert!(Geometry::mesh(&v, &[[0, 1, 2]], None, true).is_ok());
+    assert!(Mesh::new(&v, &[[0, 1, 2]], None, true).is_ok());
     for bad in [[0, 1, 3], [0, -1, 2]] {
-        let result = Geometry::mesh(&v, &[bad], None, true);
+        let result = Mesh::new(&v, &[bad], None, true);
         assert!(
             matches!(result, Err(crate::error::Error::Index { .. })),
             "{bad:?}"

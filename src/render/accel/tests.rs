@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::render::geometry::Geometry;
+use crate::render::mesh::Mesh;
 use glam::DVec3;
 
 /// A row of spheres along −z, fewer than [`LEAF_MAX`] (tested directly)
@@ -61,10 +62,10 @@ fn embree_and_obvhs_agree() {
         let f: Vec<[i64; 3]> = (0..n as i64)
             .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
             .collect();
-        Geometry::mesh(&v, &f, None, true).unwrap()
+        Geometry::Mesh(Mesh::new(&v, &f, None, true).unwrap())
     };
     let sphere = Geometry::sphere([0.3, -0.2, 0.1], 0.5, false).unwrap();
-    let empty = Geometry::mesh(&[], &[], None, true).unwrap();
+    let empty = Geometry::Mesh(Mesh::new(&[], &[], None, true).unwrap());
     let (mut prims, mut shapes, mut meshes) = (Vec::new(), Vec::new(), Vec::new());
     for (id, g) in [cloud(1200), sphere, empty, cloud(800)]
         .into_iter()
