@@ -10,13 +10,14 @@
 //! (`Packed`: a triangle's vertex and edges in 40 bytes), so that a leaf
 //! is a run of memory rather than a scatter over the meshes' vertices.
 
+use std::sync::Arc;
 use std::time::Duration;
 
 use glam::Vec3A;
 use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh, ray::RayHit};
 
 use crate::alloc;
-use crate::error::Result;
+use crate::error::{Error, Result};
 
 use super::embree::{self, Stream as EmbreeStream, Triangles as Embree};
 use super::mesh::Mesh;
@@ -63,9 +64,7 @@ impl Primitive {
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray, meshes: &[Mesh]) -> Option<Candidate> {
         match self {
-            Primitive::Triangle { mesh, face } => {
-                meshes[*mesh as usize].triangle(*face).intersect(ray)
-            }
+            Primitive::Triangle { .. } => self.triangle(meshes)?.intersect(ray),
             Primitive::Sphere(s) => s.intersect(ray),
             Primitive::Disk(d) => d.intersect(ray),
         }
@@ -95,10 +94,7 @@ impl Primitive {
     #[inline]
     pub fn sample(&self, u: [f32; 2], meshes: &[Mesh]) -> SurfacePoint {
         match self {
-            Primitive::Triangle { mesh, face } => {
-                let m = &meshes[*mesh as usize];
-                m.triangle(*face).sample(u, &m.normals)
-            }
+            Primitive::Triangle { mesh, face } => meshes[*mesh as usize].sample(*face, u),
             Primitive::Sphere(s) => s.sample(u),
             Primitive::Disk(d) => d.sample(u),
         }
@@ -122,10 +118,7 @@ impl Primitive {
     #[inline(always)]
     pub fn point(&self, p: Vec3A, bary: [f32; 2], meshes: &[Mesh]) -> SurfacePoint {
         match self {
-            Primitive::Triangle { mesh, face } => {
-                let m = &meshes[*mesh as usize];
-                m.triangle(*face).point(bary, &m.normals)
-            }
+            Primitive::Triangle { mesh, face } => meshes[*mesh as usize].point(*face, bary),
             Primitive::Sphere(s) => s.point(p),
             Primitive::Disk(d) => d.point(p),
         }
@@ -189,12 +182,11 @@ impl Packed {
 /// triangles are, their Embree scene (the meshes, when Embree traces them)
 /// and the BVH of the others (none for at most [`LEAF_MAX`] primitives).
 pub struct Accel {
-    /// Before the meshes, so that it is released before the buffers it
-    /// shares with them.
     embree: Option<Embree>,
     primitives: Vec<Primitive>,
     shape_of: Vec<u32>,
-    meshes: Vec<Mesh>,
+    /// Shared with the Embree scene, which traces their buffers.
+    meshes: Arc<[Mesh]>,
     bounds: Option<Aabb>,
     bvh: Option<CwBvh>,
     /// The primitives in the order of the BVH's leaves.
@@ -211,13 +203,13 @@ struct Leaf {
     /// The spheres, copied in (a test reads no further), with their
     /// primitive indices.
     spheres: Vec<(Sphere, u32)>,
-    /// The indices of the other primitives.
+    /// The indices of the disks.
     others: Vec<u32>,
 }
 
 impl Leaf {
-    /// Sorts the primitives `ids` of `primitives` into packs of triangles
-    /// and the others.
+    /// Sorts the primitives `ids` of `primitives` into packs of triangles,
+    /// the spheres and the others (disks).
     fn new(primitives: &[Primitive], ids: &[u32], meshes: &[Mesh]) -> Self {
         let (mut triangles, mut spheres, mut others) = (Vec::new(), Vec::new(), Vec::new());
         for &i in ids {
@@ -255,7 +247,8 @@ impl Accel {
     /// the geometry of a shape lists them).
     ///
     /// # Errors
-    /// [`crate::Error::Memory`] when the BVH's memory cannot be had.
+    /// [`crate::Error::Memory`] when the BVH's memory cannot be had,
+    /// [`crate::Error::Argument`] when the faces are not listed so.
     ///
     /// # Panics
     /// If the two lists differ in length.
@@ -272,6 +265,8 @@ impl Accel {
         embree: bool,
     ) -> Result<Self> {
         const WHAT: &str = "the BVH";
+        let meshes: Arc<[Mesh]> = meshes.into();
+        let first = first_faces(&primitives, &meshes)?;
         let n = primitives.len();
         assert_eq!(shape_of.len(), n, "a shape for every primitive");
         let bounds = primitives
@@ -282,11 +277,7 @@ impl Accel {
         let is_triangle = |p: &Primitive| matches!(p, Primitive::Triangle { .. });
         let triangles = primitives.iter().filter(|p| is_triangle(p)).count();
         let embree = match library {
-            Some(library) if triangles > LEAF_MAX => Some(Embree::new(
-                library,
-                &meshes,
-                &first_faces(&primitives, &meshes)?,
-            )?),
+            Some(library) if triangles > LEAF_MAX => Some(Embree::new(library, &meshes, &first)?),
             _ => None,
         };
         // What obvhs traces: all, or what Embree does not.
@@ -565,16 +556,44 @@ fn nearer(best: &mut Option<Hit>, shrunk: &mut Ray, primitive: u32, c: Candidate
 }
 
 /// The number among `primitives` of each mesh's first face (0 for a mesh
-/// of no faces, which Embree is not given).
+/// of no faces, which Embree is not given), after checking that every
+/// mesh's faces are listed once each, one after the other, in their order,
+/// as Embree numbers them.
 ///
 /// # Errors
-/// [`crate::Error::Memory`] when the list cannot be had.
+/// [`Error::Argument`] when they are not, [`Error::Memory`] when the list
+/// cannot be had.
 fn first_faces(primitives: &[Primitive], meshes: &[Mesh]) -> Result<Vec<u32>> {
     let mut first = alloc::filled(meshes.len(), 0, "the meshes")?;
+    let mut listed = alloc::filled(meshes.len(), 0_usize, "the meshes")?;
     for (i, p) in primitives.iter().enumerate() {
-        if let Primitive::Triangle { mesh, face: 0 } = *p {
-            first[mesh as usize] = i as u32;
+        if let Primitive::Triangle { mesh, face } = *p {
+            let m = mesh as usize;
+            if face == 0 && m < meshes.len() {
+                first[m] = i as u32;
+            }
+            if m >= meshes.len() || face as usize != listed[m] || i != (first[m] + face) as usize {
+                return Err(Error::Argument {
+                    arg: "primitives",
+                    message: format!(
+                        "primitive {i}, face {face} of mesh {mesh}, is not where the faces of \
+                         its mesh ({} meshes) are listed in order",
+                        meshes.len()
+                    ),
+                });
+            }
+            listed[m] += 1;
         }
+    }
+    if let Some(m) = (0..meshes.len()).find(|&m| listed[m] != meshes[m].faces().len()) {
+        return Err(Error::Argument {
+            arg: "primitives",
+            message: format!(
+                "mesh {m} has {} faces, {} of them listed",
+                meshes[m].faces().len(),
+                listed[m]
+            ),
+        });
     }
     Ok(first)
 }

@@ -16,7 +16,7 @@
 //! `unsafe`, each with the argument that makes it sound.
 
 use std::ffi::{c_char, c_void};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 use libloading::Library;
 
@@ -255,12 +255,15 @@ pub struct Stream {
 const STREAM_CHUNK: usize = 1 << 20;
 
 /// Triangle meshes in an Embree scene (one geometry each, tracing the
-/// meshes' own vertex and index buffers), with the number of each one's
-/// first face in the scene's list of primitives, by geometry ID.
+/// meshes' own vertex and index buffers, which it keeps), with the number
+/// of each one's first face in the scene's list of primitives, by geometry
+/// ID.
 pub struct Triangles {
     api: &'static Api,
     scene: Handle,
     first: Vec<u32>,
+    /// Kept as long as the scene, which reads their buffers.
+    _meshes: Arc<[Mesh]>,
 }
 
 // SAFETY: a committed Embree scene is read-only and may be traced from
@@ -280,19 +283,22 @@ impl Drop for Triangles {
 }
 
 impl Triangles {
-    /// The faces of `meshes` in an Embree scene of `library`; the faces
-    /// of mesh `m` are the scene's primitives from `first[m]` on. Embree
-    /// reads the meshes' vertices and faces where they are: they must
-    /// stay, unchanged, as long as the scene.
+    /// The faces of `meshes` in an Embree scene of `library` (which reads
+    /// the meshes' vertices and faces where they are, and keeps them); the
+    /// faces of mesh `m` are the scene's primitives from `first[m]` on.
     ///
     /// # Errors
     /// [`Error::Memory`] when the memory cannot be had or Embree runs out
     /// of it; [`Error::Argument`] when Embree fails otherwise.
+    ///
+    /// # Panics
+    /// If `first` is not one number per mesh.
     #[allow(unsafe_code)]
-    pub fn new(library: Library3, meshes: &[Mesh], first: &[u32]) -> Result<Self> {
+    pub fn new(library: Library3, meshes: &Arc<[Mesh]>, first: &[u32]) -> Result<Self> {
         const WHAT: &str = "Embree's BVH";
         let api = library.0;
-        let n: usize = meshes.iter().map(|m| m.faces.len()).sum();
+        assert_eq!(first.len(), meshes.len(), "a first face for every mesh");
+        let n: usize = meshes.iter().map(|m| m.faces().len()).sum();
         // About what Embree allocates: a BVH of some 100 bytes a triangle,
         // as it goes, so check first.
         let bytes = n as u128 * 128;
@@ -301,16 +307,16 @@ impl Triangles {
             meshes
                 .iter()
                 .zip(first)
-                .filter(|(m, _)| !m.faces.is_empty())
+                .filter(|(m, _)| !m.faces().is_empty())
         };
         let mut firsts = crate::alloc::with_capacity(traced().count(), WHAT)?;
         // SAFETY: calls on a valid device, in the order Embree's API
         // requires (buffers set before the geometry is committed,
         // attached, released; the scene committed before it is traced).
-        // The buffers shared are the mesh's: `points.len()` vertices 16
-        // bytes apart (each readable as 16 bytes, as Embree reads them)
-        // and `faces.len()` triples of indices below it; the caller keeps
-        // them as long as the scene.
+        // The buffers shared are a mesh's: its vertices 16 bytes apart
+        // (each readable as 16 bytes, as Embree reads them) and its faces,
+        // triples of indices of its vertices (as `Mesh::new` makes them);
+        // the scene keeps the meshes, which nothing changes.
         unsafe {
             let scene = (api.new_scene)(api.device);
             if scene.is_null() {
@@ -321,6 +327,7 @@ impl Triangles {
                 api,
                 scene,
                 first: Vec::new(),
+                _meshes: Arc::clone(meshes),
             };
             api.check("a scene", bytes)?;
             // RTC_SCENE_FLAG_ROBUST: no optimisation that could let a ray
@@ -331,17 +338,20 @@ impl Triangles {
             (api.set_build_quality)(scene, 2);
             for (mesh, &first) in traced() {
                 let geometry = (api.new_geometry)(api.device, 0);
-                api.check("a triangle mesh", bytes)?;
+                if geometry.is_null() {
+                    api.check("a triangle mesh", bytes)?;
+                    return Err(Error::Memory { what: WHAT, bytes });
+                }
                 // RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3.
                 (api.shared_buffer)(
                     geometry,
                     1,
                     0,
                     0x9003,
-                    mesh.points.as_ptr().cast(),
+                    mesh.points().as_ptr().cast(),
                     0,
                     size_of::<glam::Vec3A>(),
-                    mesh.points.len(),
+                    mesh.points().len(),
                 );
                 // RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3.
                 (api.shared_buffer)(
@@ -349,10 +359,10 @@ impl Triangles {
                     0,
                     0,
                     0x5003,
-                    mesh.faces.as_ptr().cast(),
+                    mesh.faces().as_ptr().cast(),
                     0,
                     size_of::<[u32; 3]>(),
-                    mesh.faces.len(),
+                    mesh.faces().len(),
                 );
                 (api.commit_geometry)(geometry);
                 let id = (api.attach_geometry)(scene, geometry);

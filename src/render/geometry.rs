@@ -1,5 +1,6 @@
-//! The geometry of a shape: triangle meshes (checked, with shading
-//! normals), spheres and disks, and the affine maps that place them.
+//! The geometry of a shape (a triangle mesh, [`super::mesh`], a sphere or
+//! a disk), its primitives in a scene, and the affine maps that place
+//! shapes.
 
 use glam::DVec3;
 
@@ -50,7 +51,7 @@ impl Geometry {
     /// How many primitives it adds to a scene.
     pub(crate) fn primitive_count(&self) -> usize {
         match self {
-            Geometry::Mesh(mesh) => mesh.faces.len(),
+            Geometry::Mesh(mesh) => mesh.faces().len(),
             Geometry::Sphere(_) | Geometry::Disk(_) => 1,
         }
     }
@@ -65,7 +66,7 @@ impl Geometry {
             Geometry::Mesh(mesh) => {
                 // At most MAX_PRIMITIVES faces and meshes (one per shape).
                 let index = meshes.len() as u32;
-                let faces = mesh.faces.len() as u32;
+                let faces = mesh.faces().len() as u32;
                 meshes.push(mesh);
                 Box::new((0..faces).map(move |face| Primitive::Triangle { mesh: index, face }))
             }

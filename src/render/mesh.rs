@@ -7,20 +7,17 @@
 use glam::{DVec3, Vec3A};
 
 use super::geometry::{check_primitives, finite_rows};
-use super::shape::Triangle;
+use super::shape::{SurfacePoint, Triangle};
 use crate::alloc;
 use crate::error::{Error, Result};
 
-/// A triangle mesh (world space).
+/// A triangle mesh (world space), made by [`Mesh::new`] only: its faces
+/// index its vertices (Embree reads them so, unchecked).
 #[derive(Clone, Debug)]
 pub struct Mesh {
-    /// The vertices.
-    pub points: Vec<Vec3A>,
-    /// The faces that have an area, as vertex indices (counter-clockwise
-    /// seen from the front).
-    pub faces: Vec<[u32; 3]>,
-    /// The vertex normals, one per vertex (none: face normals).
-    pub normals: Vec<Vec3A>,
+    points: Vec<Vec3A>,
+    faces: Vec<[u32; 3]>,
+    normals: Vec<Vec3A>,
 }
 
 /// Angle-weighted vertex normals (Thürmer and Wüthrich): each face adds its
@@ -123,6 +120,22 @@ impl Mesh {
         })
     }
 
+    /// The vertices.
+    pub fn points(&self) -> &[Vec3A] {
+        &self.points
+    }
+
+    /// The faces that have an area, as indices of [`Mesh::points`]
+    /// (counter-clockwise seen from the front).
+    pub fn faces(&self) -> &[[u32; 3]] {
+        &self.faces
+    }
+
+    /// The vertex normals, one per vertex (none: face normals).
+    pub fn normals(&self) -> &[Vec3A] {
+        &self.normals
+    }
+
     /// The triangle of face `face` (whose normals index
     /// [`Mesh::normals`]).
     #[inline]
@@ -133,31 +146,43 @@ impl Mesh {
             !self.normals.is_empty(),
         )
     }
+
+    /// The surface point of face `face` at barycentrics `bary`
+    /// ([`Triangle::point`]).
+    #[inline]
+    pub fn point(&self, face: u32, bary: [f32; 2]) -> SurfacePoint {
+        self.triangle(face).point(bary, &self.normals)
+    }
+
+    /// A point of face `face` drawn uniformly by area (density `1 / area`;
+    /// [`Triangle::sample`]).
+    #[inline]
+    pub fn sample(&self, face: u32, u: [f32; 2]) -> SurfacePoint {
+        self.triangle(face).sample(u, &self.normals)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A smooth mesh's triangles blend its own vertex normals; a
-    /// face-normal mesh's shade with the face normal; a face without an
+    /// A smooth face blends its own vertex normals by its barycentrics; a
+    /// face-normal mesh shades with the face normal; a face without an
     /// area is dropped.
     #[test]
-    fn a_face_shades_with_its_own_meshs_normals() {
+    fn a_face_blends_its_vertex_normals() {
         let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
         let faces = [[0, 1, 2], [0, 1, 1]];
         let flat = Mesh::new(&v, &faces, None, true).unwrap();
-        assert_eq!(flat.faces, [[0, 1, 2]]);
-        assert!(flat.normals.is_empty());
-        assert_eq!(
-            flat.triangle(0).point([0.2, 0.3], &flat.normals).ns,
-            Vec3A::Z
-        );
-        for n in [[1.0, 0.0, 1.0], [0.0, 1.0, 1.0]] {
-            let smooth = Mesh::new(&v, &faces, Some(&[n; 3]), false).unwrap();
-            let sp = smooth.triangle(0).point([0.2, 0.3], &smooth.normals);
-            let expected = Vec3A::from(DVec3::from(n).as_vec3()).normalize();
-            assert!((sp.ns - expected).length() < 1e-6, "{} {expected}", sp.ns);
-        }
+        assert_eq!(flat.faces(), [[0, 1, 2]]);
+        assert!(flat.normals().is_empty());
+        assert_eq!(flat.point(0, [0.2, 0.3]).ns, Vec3A::Z);
+        let n = [[1.0, 0.0, 1.0], [0.0, 1.0, 1.0], [0.0, 0.0, 1.0]];
+        let smooth = Mesh::new(&v, &faces, Some(&n), false).unwrap();
+        let sp = smooth.point(0, [0.2, 0.3]);
+        let unit = |n: [f64; 3]| DVec3::from(n).normalize();
+        let expected = (0.5 * unit(n[0]) + 0.2 * unit(n[1]) + 0.3 * unit(n[2])).normalize();
+        assert!((sp.ns.as_dvec3() - expected).length() < 1e-6, "{}", sp.ns);
+        assert!((sp.p - Vec3A::new(0.2, 0.3, 0.0)).length() < 1e-7);
     }
 }
