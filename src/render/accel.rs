@@ -20,6 +20,7 @@ use crate::alloc;
 use crate::error::{Error, Result};
 
 use super::embree::{self, Stream as EmbreeStream, Triangles as Embree};
+use super::geometry::check_primitives;
 use super::mesh::Mesh;
 use super::shape::{
     Candidate, Disk, Ray, Sphere, SurfacePoint, Triangle, Triangles4, triangle_hit,
@@ -50,7 +51,8 @@ pub enum Primitive {
 }
 
 impl Primitive {
-    /// Its triangle, if it is a face of one of `meshes`.
+    /// Its triangle, if it is a face (of one of `meshes`: panics for a
+    /// mesh not among them).
     #[inline]
     pub fn triangle(&self, meshes: &[Mesh]) -> Option<Triangle> {
         match *self {
@@ -248,7 +250,9 @@ impl Accel {
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the BVH's memory cannot be had,
-    /// [`crate::Error::Argument`] when the faces are not listed so.
+    /// [`crate::Error::Argument`] when the faces are not listed so,
+    /// [`crate::Error::TooLarge`] for more than
+    /// [`super::geometry::MAX_PRIMITIVES`] primitives.
     ///
     /// # Panics
     /// If the two lists differ in length.
@@ -265,10 +269,11 @@ impl Accel {
         embree: bool,
     ) -> Result<Self> {
         const WHAT: &str = "the BVH";
-        let meshes: Arc<[Mesh]> = meshes.into();
-        let first = first_faces(&primitives, &meshes)?;
         let n = primitives.len();
         assert_eq!(shape_of.len(), n, "a shape for every primitive");
+        check_primitives("primitives", n)?;
+        let meshes: Arc<[Mesh]> = meshes.into();
+        let first = first_faces(&primitives, &meshes)?;
         let bounds = primitives
             .iter()
             .map(|p| p.bounds(&meshes))
@@ -572,7 +577,10 @@ fn first_faces(primitives: &[Primitive], meshes: &[Mesh]) -> Result<Vec<u32>> {
             if face == 0 && m < meshes.len() {
                 first[m] = i as u32;
             }
-            if m >= meshes.len() || face as usize != listed[m] || i != (first[m] + face) as usize {
+            if m >= meshes.len()
+                || face as usize != listed[m]
+                || i != first[m] as usize + face as usize
+            {
                 return Err(Error::Argument {
                     arg: "primitives",
                     message: format!(

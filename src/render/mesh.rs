@@ -73,6 +73,22 @@ impl Mesh {
         check_primitives("vertices", vertices.len())?;
         check_primitives("faces", faces.len())?;
         finite_rows("vertices", vertices)?;
+        // Kept in single precision: every coordinate must stay finite there.
+        let too_large = |(i, v): (usize, &[f64; 3])| {
+            let k = v.iter().position(|x| x.abs() > f64::from(f32::MAX))?;
+            Some(Error::Element {
+                arg: "vertices",
+                index: format!("[{i}, {k}]"),
+                value: v[k],
+                requirement: format!(
+                    "must be at most {:e} in magnitude (single precision)",
+                    f32::MAX
+                ),
+            })
+        };
+        if let Some(e) = vertices.iter().enumerate().find_map(too_large) {
+            return Err(e);
+        }
         let nv = vertices.len();
         let mut idx: Vec<[u32; 3]> = alloc::with_capacity(faces.len(), "the faces")?;
         for (i, f) in faces.iter().enumerate() {
@@ -184,5 +200,16 @@ mod tests {
         let expected = (0.5 * unit(n[0]) + 0.2 * unit(n[1]) + 0.3 * unit(n[2])).normalize();
         assert!((sp.ns.as_dvec3() - expected).length() < 1e-6, "{}", sp.ns);
         assert!((sp.p - Vec3A::new(0.2, 0.3, 0.0)).length() < 1e-7);
+    }
+
+    /// A coordinate beyond single precision's range is refused by name.
+    #[test]
+    fn a_vertex_beyond_f32_is_refused() {
+        let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1e39, 0.0]];
+        let e = Mesh::new(&v, &[[0, 1, 2]], None, true).unwrap_err();
+        assert!(
+            matches!(&e, Error::Element { arg: "vertices", index, .. } if index == "[2, 1]"),
+            "{e}"
+        );
     }
 }
