@@ -138,6 +138,8 @@ def test_mesh_from_arrays_ply_and_obj_render_alike(tmp_path):
     ({"sensor": {"type": "orthographic"}}, "sensor: type 'orthographic'"),
     ({"sky2": {"type": "constant"}}, "at most one environment"),
     ({"mesh": {"type": "mesh", "vertices": [[0, 0, 0]], "faces": [[0, 1, 2]]}}, "faces"),
+    ({"mesh": {"type": "mesh", "vertices": [[0, 0, 0], [1, 0, 0], [0, 1e39, 0]],
+               "faces": [[0, 1, 2]]}}, r"vertices\[2, 1\].*single precision"),
     ({"mesh": {"type": "ply", "filename": "/nonexistent.ply"}}, "nonexistent"),
 ])
 def test_scene_errors_name_the_key(patch, message):

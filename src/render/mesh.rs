@@ -60,7 +60,8 @@ impl Mesh {
     /// an area are dropped (they are never hit and have no area to sample).
     ///
     /// # Errors
-    /// [`Error::Element`] for a coordinate or normal that is not finite,
+    /// [`Error::Element`] for a coordinate or normal that is not finite (a
+    /// coordinate: in single precision),
     /// [`Error::Index`] for a face index out of range, [`Error::Shape`] for
     /// normals not one per vertex, [`Error::TooLarge`] for more than
     /// [`super::geometry::MAX_PRIMITIVES`] faces or vertices, [`Error::Memory`].
@@ -75,15 +76,14 @@ impl Mesh {
         finite_rows("vertices", vertices)?;
         // Kept in single precision: every coordinate must stay finite there.
         let too_large = |(i, v): (usize, &[f64; 3])| {
-            let k = v.iter().position(|x| x.abs() > f64::from(f32::MAX))?;
+            let k = v.iter().position(|&x| (x as f32).is_infinite())?;
             Some(Error::Element {
                 arg: "vertices",
                 index: format!("[{i}, {k}]"),
                 value: v[k],
-                requirement: format!(
-                    "must be at most {:e} in magnitude (single precision)",
-                    f32::MAX
-                ),
+                requirement: "must be finite in single precision (about 3.4e38 in magnitude at \
+                              most)"
+                    .into(),
             })
         };
         if let Some(e) = vertices.iter().enumerate().find_map(too_large) {

@@ -202,13 +202,14 @@ fn hits_shade_with_their_own_faces_normals() {
     let obvhs = Accel::build(prims, shapes, meshes, false).unwrap();
     for accel in [&embree, &obvhs] {
         for k in 0..40_u32 {
-            let (m, x) = ((k % 2) as usize, 0.1 + 0.145 * f64::from(k / 2));
+            let (m, x) = ((k % 2) as usize, 0.1 + 0.29 * f64::from(k / 2));
             let ray = Ray {
                 o: Vec3A::new((x + 10.0 * m as f64) as f32, 0.3, 5.0),
                 d: Vec3A::NEG_Z,
                 tmax: f32::INFINITY,
             };
             let hit = accel.intersect(&ray).unwrap();
+            assert!((hit.t - 5.0).abs() < 1e-5);
             assert_eq!(accel.shape_of(hit.primitive), m as u32);
             let p = ray.o + ray.d * hit.t;
             let sp = accel.primitives()[hit.primitive as usize].point(p, hit.bary, accel.meshes());
@@ -227,8 +228,8 @@ fn hits_shade_with_their_own_faces_normals() {
     }
 }
 
-/// Faces listed out of their order, missing, split by another primitive
-/// or of a mesh that is not there are refused.
+/// Faces listed out of their order, missing, repeated, split by another
+/// primitive or of a mesh that is not there are refused.
 #[test]
 fn faces_out_of_their_order_are_refused() {
     let (mut prims, mut meshes) = (Vec::new(), Vec::new());
