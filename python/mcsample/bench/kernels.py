@@ -124,18 +124,19 @@ def suite_warps(n: int, repeat: int, mi) -> list[Timing]:
     ]
     out = []
     for name, ours, numpy_impl, args in cases:
-        # float32 into a reused array (out=, as Dr.Jit reuses its memory: no
-        # page faults on a fresh result) and Mitsuba, timed in alternating
-        # blocks.
+        # float32: the plain call, the call into a reused array (out=, as
+        # Dr.Jit reuses its memory) and Mitsuba, timed in alternating
+        # blocks, so that no two of them are compared across a change of
+        # the machine's speed.
         pair: list[tuple[str, Callable[[], object]]] = []
         for dtype, u in (("float64", u64), ("float32", u32)):
-            out.append(Timing(name, "mcsample", dtype, n,
-                              measure(lambda: ours(u, *args), repeat)))
+            plain = (lambda u=u: ours(u, *args))
             buffer = np.empty_like(ours(u[:2], *args), shape=(n,) + ours(u[:1], *args).shape[1:])
             reused = (lambda u=u, buffer=buffer: ours(u, *args, out=buffer))
             if dtype == "float32":
-                pair.append(("mcsample out=", reused))
+                pair += [("mcsample", plain), ("mcsample out=", reused)]
             else:
+                out.append(Timing(name, "mcsample", dtype, n, measure(plain, repeat)))
                 out.append(Timing(name, "mcsample out=", dtype, n, measure(reused, repeat)))
             if numpy_impl is not None:
                 out.append(Timing(name, "numpy", dtype, n,
