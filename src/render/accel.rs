@@ -216,8 +216,8 @@ impl Leaf {
         let (mut triangles, mut spheres, mut others) = (Vec::new(), Vec::new(), Vec::new());
         for &i in ids {
             match &primitives[i as usize] {
-                p @ Primitive::Triangle { .. } => {
-                    triangles.extend(p.triangle(meshes).map(|t| (t, i)))
+                Primitive::Triangle { mesh, face } => {
+                    triangles.push((meshes[*mesh as usize].triangle(*face), i));
                 }
                 Primitive::Sphere(s) => spheres.push((**s, i)),
                 Primitive::Disk(_) => others.push(i),
