@@ -71,6 +71,10 @@ pub trait Real: Float + FloatConst + Debug + Default + Send + Sync + 'static {
     /// [`ln_one_minus`] in `f64`, the same series cut at this type's
     /// precision in `f32` (vectorised at twice the width).
     fn ln_one_minus(u: Self) -> Self;
+    /// `ln x` for a positive normal `x` (`−∞` for 0) in this type's
+    /// precision: [`ln_positive`] in `f64`, the same series cut at this
+    /// type's precision in `f32`.
+    fn ln_positive(x: Self) -> Self;
 
     /// `⌊x⌋` as an index clamped to `[0, last]` (0 for NaN), for `last`
     /// below 2³²: the float is converted to `u32` (saturating), which takes
@@ -267,35 +271,53 @@ pub fn ln_one_minus(u: f64) -> f64 {
     if u < 1.0 { ln } else { f64::NEG_INFINITY }
 }
 
-/// [`ln_one_minus`] in `f32`: `1 − u = m·2ᵉ` read from its bits (`m ∈
-/// [√½, √2)`), `ln(1 − u) = e·ln 2 + 2 atanh(s)` with `s = (m − 1)/(m + 1)`,
-/// or `s = −u/(2 − u)` for `u < 1 − √½`; `|s| ≤ 3 − 2√2`, so five terms of
-/// the series reach `f32` precision (the sixth, `s¹⁰/11`, is below
-/// `2·10⁻⁹` of the sum).
+/// `x = m·2ᵉ` for a positive normal `f32` `x`, `m ∈ [√½, √2)` and the
+/// whole number `e` as a float, read from its bits.
 #[inline(always)]
-fn ln_one_minus_f32(u: f32) -> f32 {
+fn mantissa_exponent_f32(x: f32) -> (f32, f32) {
     const MANTISSA: u32 = (1 << 23) - 1;
-    let x = 1.0 - u;
     let bits = x.to_bits();
     let field = ((bits >> 23) as i32 - 127) as f32;
     let m = f32::from_bits((bits & MANTISSA) | 1.0f32.to_bits());
-    let big = m > std::f32::consts::SQRT_2;
-    let (m, e) = if big {
+    if m > std::f32::consts::SQRT_2 {
         (0.5 * m, field + 1.0)
     } else {
         (m, field)
-    };
+    }
+}
+
+/// `e·ln 2 + 2 atanh(s)` in `f32`: `|s| ≤ 3 − 2√2`, so five terms of the
+/// series reach `f32` precision (the sixth, `s¹⁰/11`, is below `2·10⁻⁹` of
+/// the sum).
+#[inline(always)]
+fn ln_from_parts_f32(e: f32, s: f32) -> f32 {
+    e * std::f32::consts::LN_2 + 2.0 * s * estrin(s * s, &ATANH_OVER_S_F32)
+}
+
+/// [`ln_positive`] in `f32`: `x = m·2ᵉ`, `s = (m − 1)/(m + 1)`.
+#[inline(always)]
+fn ln_positive_f32(x: f32) -> f32 {
+    let (m, e) = mantissa_exponent_f32(x);
+    let ln = ln_from_parts_f32(e, (m - 1.0) / (m + 1.0));
+    if x > 0.0 { ln } else { f32::NEG_INFINITY }
+}
+
+/// [`ln_one_minus`] in `f32`: `1 − u = m·2ᵉ` read from its bits, `s = (m −
+/// 1)/(m + 1)`, or `s = −u/(2 − u)` for `u < 1 − √½`.
+#[inline(always)]
+fn ln_one_minus_f32(u: f32) -> f32 {
+    let (m, e) = mantissa_exponent_f32(1.0 - u);
     let near = u < 1.0 - std::f32::consts::FRAC_1_SQRT_2;
     let (s, e) = if near {
         (-u / (2.0 - u), 0.0)
     } else {
         ((m - 1.0) / (m + 1.0), e)
     };
-    let ln = e * std::f32::consts::LN_2 + 2.0 * s * estrin(s * s, &ATANH_OVER_S_F32);
+    let ln = ln_from_parts_f32(e, s);
     if u < 1.0 { ln } else { f32::NEG_INFINITY }
 }
 
-/// The first five terms of [`ATANH_OVER_S`], for [`ln_one_minus_f32`].
+/// The first five terms of [`ATANH_OVER_S`], for [`ln_from_parts_f32`].
 const ATANH_OVER_S_F32: [f64; 5] = [1.0, 1.0 / 3.0, 1.0 / 5.0, 1.0 / 7.0, 1.0 / 9.0];
 
 /// `1/(2k + 1)`: the series of `atanh(s)/s` in `s²`.
@@ -395,6 +417,10 @@ impl Real for f32 {
         ln_one_minus_f32(u)
     }
     #[inline(always)]
+    fn ln_positive(x: f32) -> f32 {
+        ln_positive_f32(x)
+    }
+    #[inline(always)]
     fn c(x: f64) -> f32 {
         x as f32
     }
@@ -431,6 +457,10 @@ impl Real for f64 {
     #[inline(always)]
     fn ln_one_minus(u: f64) -> f64 {
         ln_one_minus(u)
+    }
+    #[inline(always)]
+    fn ln_positive(x: f64) -> f64 {
+        ln_positive(x)
     }
     #[inline(always)]
     fn c(x: f64) -> f64 {

@@ -66,9 +66,10 @@ impl<F: Copy> EnvSamples<'_, F> {
 
 impl EnvMap {
     /// `out[i] = eval(d[i])` for a batch, in `F`: every direction's place on
-    /// the map by one loop (which vectorises for lat-long maps), then the
-    /// texel reads of the whole block, which overlap. Returns whether
-    /// `valid` held for every direction (it is checked in the same pass).
+    /// the map by one loop (which vectorises for lat-long maps), then its
+    /// texels prefetched and read one block behind ([`pipelined`]). Returns
+    /// whether `valid` held for every direction (it is checked in the same
+    /// pass).
     pub fn eval_into<F: Real>(
         &self,
         d: &[[F; 3]],
@@ -84,7 +85,9 @@ impl EnvMap {
         })
     }
 
-    /// [`EnvMap::eval_into`] with `place` the mapping's `from_dir`.
+    /// [`EnvMap::eval_into`] with `place` the mapping's `from_dir`: the
+    /// texels of a block located and prefetched, read one block behind
+    /// ([`pipelined`]).
     #[inline(always)]
     fn eval_blocks<F: Real>(
         &self,
@@ -93,25 +96,28 @@ impl EnvMap {
         place: &impl Fn([F; 3]) -> [F; 2],
         valid: impl Fn(&[F; 3]) -> bool,
     ) -> bool {
-        let mut ok = true;
-        let mut points = [[F::zero(); 2]; BATCH_BLOCK];
-        for (d, out) in d.chunks(BATCH_BLOCK).zip(out.chunks_mut(BATCH_BLOCK)) {
-            let points = &mut points[..d.len()];
-            ok &= simd::map_rows(points, d, place, &valid, false);
-            for (o, &p) in out.iter_mut().zip(points.iter()) {
-                *o = self.radiance_at(p);
+        let locate = {
+            #[inline(always)]
+            |p: &[F; 2]| {
+                let corners = self.image.corners(self.options.mapping, *p);
+                self.image.prefetch(&corners);
+                corners
             }
-        }
-        ok
+        };
+        let read = {
+            #[inline(always)]
+            |_: &[F; 2], c: &Corners<F>| self.radiance_of(c)
+        };
+        pipelined(d, out, place, valid, locate, read)
     }
 
     /// `out[i] = pdf(d[i])` for a batch, in `F`, in blocks of
-    /// `BATCH_BLOCK`: for the luminance density, every direction's place
-    /// and Jacobian at full SIMD width, then the texels under it; for polar
-    /// tables, every direction's cell by the
-    /// branch-free [`PolarTable::query`] at full SIMD width and its density
-    /// prefetched, then the densities of the block before read (one block
-    /// behind, so that the reads wait on no cache miss); for the others
+    /// `BATCH_BLOCK` ([`pipelined`]): for the luminance density, every
+    /// direction's place and Jacobian at full SIMD width, then the table
+    /// lines under it prefetched; for polar tables, every direction's cell
+    /// by the branch-free [`PolarTable::query`] at full SIMD width and its
+    /// density prefetched; either read one block behind, so that the reads
+    /// wait on no cache miss; for the others
     /// [`EnvMap::pdf_query`] then [`EnvMap::pdf_at`]. Returns whether
     /// `valid` held for every direction (it is checked in the same pass).
     pub fn pdf_into<F: TableFloat>(
@@ -120,69 +126,47 @@ impl EnvMap {
         out: &mut [F],
         valid: impl Fn(&[F; 3]) -> bool,
     ) -> bool {
-        let mut ok = true;
-        let blocks = out.chunks_mut(BATCH_BLOCK).zip(d.chunks(BATCH_BLOCK));
         if let Distribution::Luminance(density) = &self.distribution {
-            // Every direction's place and Jacobian by one loop (which
-            // vectorises), then the texels under it.
-            let mut queries = [[F::zero(); 3]; BATCH_BLOCK];
             let query = {
                 #[inline(always)]
                 |x: [F; 3]| self.luminance_query(x)
             };
-            for (o, x) in blocks {
-                let queries = &mut queries[..x.len()];
-                ok &= simd::map_rows(queries, x, &query, &valid, false);
-                for (o, &q) in o.iter_mut().zip(queries.iter()) {
-                    *o = self.luminance_pdf_of(density, q);
+            let locate = {
+                #[inline(always)]
+                |q: &[F; 3]| {
+                    let corners = self.image.corners(Mapping::LatLong, [q[0], q[1]]);
+                    density.prefetch(corners.0[0]);
+                    corners
                 }
-            }
+            };
+            let read = {
+                #[inline(always)]
+                |q: &[F; 3], c: &Corners<F>| density.table_pdf_of_corners(c) * q[2]
+            };
+            pipelined(d, out, &query, valid, locate, read)
         } else if let Some(table) = &self.polar {
-            // Two blocks in flight: each block's cells are located and their
-            // densities prefetched, then the densities of the block before
-            // are read (by now in the caches), so that the table reads
-            // overlap the next block's arithmetic instead of waiting on it.
-            let mut queries = [[[F::zero(); 3]; BATCH_BLOCK]; 2];
-            let mut cells = [[0usize; BATCH_BLOCK]; 2];
             let densities = F::densities(table);
             let query = {
                 #[inline(always)]
                 |x| table.query(x)
             };
-            let read = {
+            let locate = {
                 #[inline(always)]
-                |o: &mut [F], q: &[[F; 3]; BATCH_BLOCK], c: &[usize; BATCH_BLOCK]| {
-                    for ((o, q), &c) in o.iter_mut().zip(q).zip(c) {
-                        *o = densities.get(c).copied().unwrap_or(F::zero()) * q[2];
-                    }
+                |q: &[F; 3]| {
+                    let c = table.cell(*q);
+                    simd::prefetch(densities, c);
+                    c
                 }
             };
-            ok = simd::dispatch(
+            let read = {
                 #[inline(always)]
-                |_| {
-                    let mut ok = true;
-                    let mut previous: Option<&mut [F]> = None;
-                    for (b, (o, x)) in blocks.enumerate() {
-                        let (q, c) = (&mut queries[b % 2], &mut cells[b % 2]);
-                        ok &= simd::map_rows(&mut q[..x.len()], x, &query, &valid, false);
-                        for (c, q) in c.iter_mut().zip(&q[..x.len()]) {
-                            *c = table.cell(*q);
-                            simd::prefetch(densities, *c);
-                        }
-                        if let Some(p) = previous.replace(o) {
-                            read(p, &queries[(b + 1) % 2], &cells[(b + 1) % 2]);
-                        }
-                    }
-                    if let Some(p) = previous {
-                        let last = d.len().div_ceil(BATCH_BLOCK) - 1;
-                        read(p, &queries[last % 2], &cells[last % 2]);
-                    }
-                    ok
-                },
-            );
+                |q: &[F; 3], &c: &usize| densities.get(c).copied().unwrap_or(F::zero()) * q[2]
+            };
+            pipelined(d, out, &query, valid, locate, read)
         } else {
+            let mut ok = true;
             let mut queries = [PdfQuery::default(); BATCH_BLOCK];
-            for (o, x) in blocks {
+            for (o, x) in out.chunks_mut(BATCH_BLOCK).zip(d.chunks(BATCH_BLOCK)) {
                 for (q, x) in queries.iter_mut().zip(x) {
                     ok &= valid(x);
                     *q = self.pdf_query(x.map(F::f64));
@@ -191,8 +175,8 @@ impl EnvMap {
                     *o = F::c(self.pdf_at(*q));
                 }
             }
+            ok
         }
-        ok
     }
 
     /// `out[i] = sample(us[i])` for a batch, in groups: the table points by
@@ -267,6 +251,9 @@ impl EnvMap {
                 Distribution::Luminance(density) => {
                     let cells = &mut cells[..n];
                     density.cells().sample_groups(us, cells);
+                    for &(cell, _) in cells.iter() {
+                        density.prefetch_cell(cell);
+                    }
                     for (k, &(cell, r)) in cells.iter().enumerate() {
                         place(k, self.place_luminance(density, cell, r));
                     }
@@ -340,12 +327,12 @@ impl EnvMap {
     ) {
         match &self.distribution {
             Distribution::Luminance(density) => {
-                self.sample_cells_by(sampler, draws, out, |c, r| {
-                    self.place_luminance(density, c, r)
-                })
+                let place = |c, r| self.place_luminance(density, c, r);
+                self.sample_cells_by(sampler, draws, out, |c| density.prefetch_cell(c), place)
             }
             Distribution::Piecewise(table) => {
-                self.sample_cells_by(sampler, draws, out, |c, r| self.place_in_cell(table, c, r))
+                let place = |c, r| self.place_in_cell(table, c, r);
+                self.sample_cells_by(sampler, draws, out, |_| {}, place)
             }
             // (Maps without cells have no cell sampler.)
             Distribution::Bilinear(_) | Distribution::Black => {
@@ -354,13 +341,16 @@ impl EnvMap {
         }
     }
 
-    /// [`EnvMap::sample_cells`] with the cell's point placed by `place`.
+    /// [`EnvMap::sample_cells`] with the cell's point placed by `place`,
+    /// the table lines it reads asked for by `prefetch` as the cells are
+    /// drawn.
     #[inline(always)]
     fn sample_cells_by<F: Real>(
         &self,
         sampler: &CellSampler,
         draws: &[(u64, [F; 2])],
         out: &mut Vec<EnvSample<F>>,
+        prefetch: impl Fn((usize, usize)),
         place: impl Fn((usize, usize), [F; 2]) -> Placed<F>,
     ) {
         let zero = F::zero();
@@ -371,6 +361,7 @@ impl EnvMap {
         for draws in draws.chunks(GROUP) {
             for (cell, &(bits, _)) in cells.iter_mut().zip(draws) {
                 *cell = sampler.cell(bits);
+                prefetch(*cell);
             }
             for (k, (&cell, &(_, r))) in cells.iter().zip(draws).enumerate() {
                 let placed = place(cell, r);
@@ -382,4 +373,52 @@ impl EnvMap {
             self.finish_group(points, &corners, &mut frames, |_, s| out.push(s));
         }
     }
+}
+
+/// `out[i] = read(q, locate(q))` with `q = query(d[i])`, in blocks of
+/// `BATCH_BLOCK` with two in flight: each block's queries at full SIMD
+/// width ([`simd::map_rows`], which checks `valid` in the same pass), then
+/// their table entries located (`locate` prefetches them), then the block
+/// before read, its entries by now in the caches: the table reads overlap
+/// the next block's arithmetic instead of waiting on it. Returns whether
+/// `valid` held for every direction.
+#[inline(always)]
+fn pipelined<F: Real, T, C: Copy + Default, const K: usize>(
+    d: &[[F; 3]],
+    out: &mut [T],
+    query: &impl Fn([F; 3]) -> [F; K],
+    valid: impl Fn(&[F; 3]) -> bool,
+    locate: impl Fn(&[F; K]) -> C,
+    read: impl Fn(&[F; K], &C) -> T,
+) -> bool {
+    let mut queries = [[[F::zero(); K]; BATCH_BLOCK]; 2];
+    let mut entries = [[C::default(); BATCH_BLOCK]; 2];
+    let read_block = |o: &mut [T], q: &[[F; K]; BATCH_BLOCK], c: &[C; BATCH_BLOCK]| {
+        for ((o, q), c) in o.iter_mut().zip(q).zip(c) {
+            *o = read(q, c);
+        }
+    };
+    simd::dispatch(
+        #[inline(always)]
+        |_| {
+            let mut ok = true;
+            let mut previous: Option<&mut [T]> = None;
+            let blocks = out.chunks_mut(BATCH_BLOCK).zip(d.chunks(BATCH_BLOCK));
+            for (b, (o, x)) in blocks.enumerate() {
+                let (q, c) = (&mut queries[b % 2], &mut entries[b % 2]);
+                ok &= simd::map_rows(&mut q[..x.len()], x, query, &valid, false);
+                for (c, q) in c.iter_mut().zip(&q[..x.len()]) {
+                    *c = locate(q);
+                }
+                if let Some(p) = previous.replace(o) {
+                    read_block(p, &queries[(b + 1) % 2], &entries[(b + 1) % 2]);
+                }
+            }
+            if let Some(p) = previous {
+                let last = d.len().div_ceil(BATCH_BLOCK) - 1;
+                read_block(p, &queries[last % 2], &entries[last % 2]);
+            }
+            ok
+        },
+    )
 }

@@ -10,6 +10,7 @@ use crate::alloc;
 use crate::distr::Discrete2D;
 use crate::error::Result;
 use crate::math::Real;
+use crate::simd;
 use std::f64::consts::PI;
 
 /// Below this angle (radians) [`angle_terms`] sums Taylor series
@@ -93,6 +94,22 @@ impl LuminanceDensity {
     /// The cells, by their weights.
     pub(super) fn cells(&self) -> &Discrete2D {
         &self.cells
+    }
+
+    /// Asks the CPU for the table lines that [`LuminanceDensity::place`]
+    /// and [`LuminanceDensity::table_pdf_of_corners`] read for the cell
+    /// whose top left texel is `k`: its two rows' luminances and its scale.
+    #[inline(always)]
+    pub(super) fn prefetch(&self, k: usize) {
+        simd::prefetch(&self.lum, k);
+        simd::prefetch(&self.lum, k + self.width);
+        simd::prefetch(&self.scale, k);
+    }
+
+    /// [`LuminanceDensity::prefetch`] of cell `(row, col)`.
+    #[inline(always)]
+    pub(super) fn prefetch_cell(&self, (row, col): (usize, usize)) {
+        self.prefetch(row * self.width + col);
     }
 
     /// The point of cell `(row, col)` that the fractions `r` in `[0, 1]²`

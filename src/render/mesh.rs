@@ -39,6 +39,19 @@ fn vertex_normals(vertices: &[Vec3A], faces: &[[u32; 3]]) -> Result<Vec<Vec3A>> 
     Ok(normals)
 }
 
+/// `v/|v|` in single precision (zero for a zero `v`), `v` divided by its
+/// largest component first: a normal of any finite length, beyond the
+/// range of `f32` or of `|v|²` in `f64`, keeps its direction.
+fn unit(v: [f64; 3]) -> Vec3A {
+    let v = DVec3::from(v);
+    let largest = v.abs().max_element();
+    if largest > 0.0 {
+        Vec3A::from((v / largest).normalize().as_vec3())
+    } else {
+        Vec3A::ZERO
+    }
+}
+
 /// The triangle of face `f` of `points`, with the vertex normals at `f`
 /// if `smooth`.
 #[inline]
@@ -120,11 +133,7 @@ impl Mesh {
                         got: format!("({}, 3)", n.len()),
                     });
                 }
-                Some(alloc::collect(
-                    n.iter()
-                        .map(|v| Vec3A::from(DVec3::from(*v).as_vec3()).normalize_or_zero()),
-                    "the normals",
-                )?)
+                Some(alloc::collect(n.iter().map(|&v| unit(v)), "the normals")?)
             }
             (None, false) => Some(vertex_normals(&points, &idx)?),
         };
@@ -200,6 +209,24 @@ mod tests {
         let expected = (0.5 * unit(n[0]) + 0.2 * unit(n[1]) + 0.3 * unit(n[2])).normalize();
         assert!((sp.ns.as_dvec3() - expected).length() < 1e-6, "{}", sp.ns);
         assert!((sp.p - Vec3A::new(0.2, 0.3, 0.0)).length() < 1e-7);
+    }
+
+    /// A given normal too long or too short for single precision keeps
+    /// its direction (made unit before it is rounded); a zero normal
+    /// shades with the face's.
+    #[test]
+    fn a_normal_of_any_finite_length_keeps_its_direction() {
+        let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        for scale in [1e39, 1e-30, 1e300, 1e-300, 1e-310] {
+            let n = [[0.0, scale, scale]; 3];
+            let mesh = Mesh::new(&v, &[[0, 1, 2]], Some(&n), false).unwrap();
+            let ns = mesh.point(0, [0.2, 0.3]).ns;
+            let expected = Vec3A::new(0.0, 1.0, 1.0).normalize();
+            assert!((ns - expected).length() < 1e-6, "{scale}: {ns}");
+        }
+        let zero = [[0.0; 3]; 3];
+        let mesh = Mesh::new(&v, &[[0, 1, 2]], Some(&zero), false).unwrap();
+        assert_eq!(mesh.point(0, [0.2, 0.3]).ns, Vec3A::Z);
     }
 
     /// A coordinate beyond single precision's range is refused by name.
