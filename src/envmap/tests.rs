@@ -178,8 +178,10 @@ fn batch_sampling_agrees_with_single_draws() {
     }
 }
 
+/// The batch `pdf` and `eval` (both read their tables one block behind the
+/// block they place) give the one-at-a-time values, in `f64` and `f32`.
 #[test]
-fn batch_pdfs_agree_with_single_queries() {
+fn batch_pdfs_and_evals_agree_with_single_queries() {
     // Lengths around the block size, so that the last block (read after the
     // loop) is empty, partial or whole.
     let mut rng = crate::rng::Rng::new(11, 1);
@@ -199,6 +201,20 @@ fn batch_pdfs_agree_with_single_queries() {
             assert!(m.pdf_into(&d[..n], &mut out, |_| true));
             for (x, o) in d.iter().zip(&out) {
                 assert_eq!(*o, m.pdf(*x), "{:?}: n = {n}, d = {x:?}", m.options());
+            }
+            let mut radiance = vec![[-1.0; 3]; n];
+            assert!(m.eval_into(&d[..n], &mut radiance, |_| true));
+            let d32: Vec<[f32; 3]> = d[..n].iter().map(|x| x.map(|v| v as f32)).collect();
+            let mut radiance32 = vec![[-1.0f32; 3]; n];
+            assert!(m.eval_into(&d32, &mut radiance32, |_| true));
+            for ((x, x32), (o, o32)) in d.iter().zip(&d32).zip(radiance.iter().zip(&radiance32)) {
+                assert_eq!(*o, m.eval(*x), "{:?}: n = {n}, d = {x:?}", m.options());
+                assert_eq!(
+                    *o32,
+                    m.eval(*x32),
+                    "{:?}: n = {n}, d = {x32:?}",
+                    m.options()
+                );
             }
         }
         let invalid = |x: &[f64; 3]| x[0] < 0.9;
