@@ -71,9 +71,10 @@ pub trait Real: Float + FloatConst + Debug + Default + Send + Sync + 'static {
     /// [`ln_one_minus`] in `f64`, the same series cut at this type's
     /// precision in `f32` (vectorised at twice the width).
     fn ln_one_minus(u: Self) -> Self;
-    /// `ln x` for a positive normal `x` (`−∞` for 0) in this type's
-    /// precision: [`ln_positive`] in `f64`, the same series cut at this
-    /// type's precision in `f32`.
+    /// `ln x` for a positive `x` (`−∞` for 0) in this type's precision:
+    /// [`ln_positive`] in `f64` (for a normal `x`), the same series cut at
+    /// this type's precision in `f32` (for any positive `x`, subnormals
+    /// too).
     fn ln_positive(x: Self) -> Self;
 
     /// `⌊x⌋` as an index clamped to `[0, last]` (0 for NaN), for `last`
@@ -294,10 +295,15 @@ fn ln_from_parts_f32(e: f32, s: f32) -> f32 {
     e * std::f32::consts::LN_2 + 2.0 * s * estrin(s * s, &ATANH_OVER_S_F32)
 }
 
-/// [`ln_positive`] in `f32`: `x = m·2ᵉ`, `s = (m − 1)/(m + 1)`.
+/// [`ln_positive`] in `f32`: `x = m·2ᵉ`, `s = (m − 1)/(m + 1)`; a
+/// subnormal `x` is scaled by `2²⁴` first (and `e` lowered by 24), so
+/// every positive `f32` has its logarithm.
 #[inline(always)]
 fn ln_positive_f32(x: f32) -> f32 {
-    let (m, e) = mantissa_exponent_f32(x);
+    let subnormal = x < f32::MIN_POSITIVE;
+    let scaled = if subnormal { x * 16_777_216.0 } else { x };
+    let (m, e) = mantissa_exponent_f32(scaled);
+    let e = if subnormal { e - 24.0 } else { e };
     let ln = ln_from_parts_f32(e, (m - 1.0) / (m + 1.0));
     if x > 0.0 { ln } else { f32::NEG_INFINITY }
 }

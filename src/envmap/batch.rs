@@ -9,7 +9,7 @@ use super::distribution::Distribution;
 use super::image::Corners;
 use super::mapping::Mapping;
 use super::polar::TableFloat;
-use super::sample::{PdfQuery, Placed};
+use super::sample::{PdfQuery, Placed, luminance_pdf_at};
 use super::{EnvMap, EnvSample};
 use crate::distr::GROUP;
 use crate::math::Real;
@@ -67,7 +67,7 @@ impl<F: Copy> EnvSamples<'_, F> {
 impl EnvMap {
     /// `out[i] = eval(d[i])` for a batch, in `F`: every direction's place on
     /// the map by one loop (which vectorises for lat-long maps), then its
-    /// texels prefetched and read one block behind ([`pipelined`]). Returns
+    /// texels prefetched and read one block behind (two blocks in flight). Returns
     /// whether `valid` held for every direction (it is checked in the same
     /// pass).
     pub fn eval_into<F: Real>(
@@ -112,7 +112,7 @@ impl EnvMap {
     }
 
     /// `out[i] = pdf(d[i])` for a batch, in `F`, in blocks of
-    /// `BATCH_BLOCK` ([`pipelined`]): for the luminance density, every
+    /// `BATCH_BLOCK`, two in flight: for the luminance density, every
     /// direction's place and Jacobian at full SIMD width, then the table
     /// lines under it prefetched; for polar tables, every direction's cell
     /// by the branch-free [`PolarTable::query`] at full SIMD width and its
@@ -134,14 +134,14 @@ impl EnvMap {
             let locate = {
                 #[inline(always)]
                 |q: &[F; 3]| {
-                    let corners = self.image.corners(Mapping::LatLong, [q[0], q[1]]);
+                    let corners = self.luminance_corners(q);
                     density.prefetch(corners.0[0]);
                     corners
                 }
             };
             let read = {
                 #[inline(always)]
-                |q: &[F; 3], c: &Corners<F>| density.table_pdf_of_corners(c) * q[2]
+                |q: &[F; 3], c: &Corners<F>| luminance_pdf_at(density, q, c)
             };
             pipelined(d, out, &query, valid, locate, read)
         } else if let Some(table) = &self.polar {
@@ -316,7 +316,8 @@ impl EnvMap {
     /// [`CellSampler::sample`] by `sampler` (built for this map) of each
     /// `(bits, r)` of `draws`, appended to `out`, group by group as
     /// [`EnvMap::sample_rows`] draws: the cells (their alias-table reads
-    /// overlap), the points placed in them and their texels prefetched,
+    /// overlap) and the density's table lines for them prefetched, the
+    /// points placed in them and their texels prefetched,
     /// then [`EnvMap::finish_group`].
     #[inline(always)]
     pub(super) fn sample_cells<F: Real>(
@@ -402,7 +403,9 @@ fn pipelined<F: Real, T, C: Copy + Default, const K: usize>(
         #[inline(always)]
         |_| {
             let mut ok = true;
-            let mut previous: Option<&mut [T]> = None;
+            // The block waiting to be read: its buffers' index and its
+            // outputs, as many as its rows.
+            let mut previous: Option<(usize, &mut [T])> = None;
             let blocks = out.chunks_mut(BATCH_BLOCK).zip(d.chunks(BATCH_BLOCK));
             for (b, (o, x)) in blocks.enumerate() {
                 let (q, c) = (&mut queries[b % 2], &mut entries[b % 2]);
@@ -410,13 +413,14 @@ fn pipelined<F: Real, T, C: Copy + Default, const K: usize>(
                 for (c, q) in c.iter_mut().zip(&q[..x.len()]) {
                     *c = locate(q);
                 }
-                if let Some(p) = previous.replace(o) {
-                    read_block(p, &queries[(b + 1) % 2], &entries[(b + 1) % 2]);
+                let rows = x.len().min(o.len());
+                let o = &mut o[..rows];
+                if let Some((p, o)) = previous.replace((b % 2, o)) {
+                    read_block(o, &queries[p], &entries[p]);
                 }
             }
-            if let Some(p) = previous {
-                let last = d.len().div_ceil(BATCH_BLOCK) - 1;
-                read_block(p, &queries[last % 2], &entries[last % 2]);
+            if let Some((p, o)) = previous {
+                read_block(o, &queries[p], &entries[p]);
             }
             ok
         },

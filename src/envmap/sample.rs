@@ -273,11 +273,20 @@ impl EnvMap {
     /// direction `d`, per steradian, computed in `F` from the texels
     /// [`EnvMap::eval`] reads there and `1/(dω/dq)`, as
     /// [`PolarTable::query`] finds it without normalising `d` (0 for
-    /// `d = 0`). Batches run the first half, [`EnvMap::luminance_query`],
-    /// over a block at SIMD width.
+    /// `d = 0`). Batches run its three steps apart: the query
+    /// ([`EnvMap::luminance_query`]) over a block at SIMD width, the
+    /// texels under it ([`EnvMap::luminance_corners`]), prefetched, and
+    /// their blend ([`luminance_pdf_at`]) one block later.
     #[inline(always)]
     pub(super) fn luminance_pdf<F: Real>(&self, density: &LuminanceDensity, d: V3<F>) -> F {
-        self.luminance_pdf_of(density, self.luminance_query(d))
+        let q = self.luminance_query(d);
+        luminance_pdf_at(density, &q, &self.luminance_corners(&q))
+    }
+
+    /// The texels under the query `q` ([`EnvMap::luminance_query`]).
+    #[inline(always)]
+    pub(super) fn luminance_corners<F: Real>(&self, q: &[F; 3]) -> Corners<F> {
+        self.image.corners(Mapping::LatLong, [q[0], q[1]])
     }
 
     /// `[s, t, 1/(dω/dq)]` of the world direction `d` on a lat-long map.
@@ -289,17 +298,6 @@ impl EnvMap {
         let length = (r * r + local[1] * local[1]).sqrt();
         let scaled_sin = r.max(F::c(SIN_FLOOR) * length).max(F::min_positive_value());
         [s, t, length / (F::c(2.0 * PI * PI) * scaled_sin)]
-    }
-
-    /// The second half of [`EnvMap::luminance_pdf`].
-    #[inline(always)]
-    pub(super) fn luminance_pdf_of<F: Real>(
-        &self,
-        density: &LuminanceDensity,
-        [s, t, inv_jacobian]: [F; 3],
-    ) -> F {
-        let corners = self.image.corners(Mapping::LatLong, [s, t]);
-        density.table_pdf_of_corners(&corners) * inv_jacobian
     }
 
     /// The point of the sampling table that looks along the local
@@ -343,4 +341,15 @@ impl EnvMap {
             Mapping::Cube => Mapping::Cube.jacobian(Mapping::Cube.from_dir(d)),
         }
     }
+}
+
+/// The density at the query `q` ([`EnvMap::luminance_query`]) whose
+/// texels are `corners` ([`EnvMap::luminance_corners`]).
+#[inline(always)]
+pub(super) fn luminance_pdf_at<F: Real>(
+    density: &LuminanceDensity,
+    q: &[F; 3],
+    corners: &Corners<F>,
+) -> F {
+    density.table_pdf_of_corners(corners) * q[2]
 }

@@ -217,9 +217,12 @@ fn batch_pdfs_and_evals_agree_with_single_queries() {
                 );
             }
         }
-        let invalid = |x: &[f64; 3]| x[0] < 0.9;
+        // A direction that fails the check in the last, partial block.
+        let invalid = |x: &[f64; 3]| x != &d[3 * BATCH_BLOCK];
         let mut out = vec![0.0; d.len()];
         assert!(!m.pdf_into(&d, &mut out, invalid));
+        let mut radiance = vec![[0.0; 3]; d.len()];
+        assert!(!m.eval_into(&d, &mut radiance, invalid));
     }
 }
 
