@@ -242,11 +242,7 @@ impl EnvMap {
             let us = &*us;
             // Each point's domain point and density, and its texels
             // (prefetched).
-            let mut place = |k: usize, placed: Placed<F>| {
-                self.image.prefetch(&placed.corners);
-                let [s, t] = placed.point;
-                (points[k], corners[k]) = ([s, t, placed.pdf_q], placed.corners);
-            };
+            let mut place = |k: usize, placed| self.keep(placed, &mut points[k], &mut corners[k]);
             match &self.distribution {
                 Distribution::Luminance(density) => {
                     let cells = &mut cells[..n];
@@ -254,16 +250,12 @@ impl EnvMap {
                     for &(cell, _) in cells.iter() {
                         density.prefetch_cell(cell);
                     }
-                    for (k, &(cell, r)) in cells.iter().enumerate() {
-                        place(k, self.place_luminance(density, cell, r));
-                    }
+                    self.place_cells(cells, &mut place);
                 }
                 Distribution::Piecewise(table) => {
                     let cells = &mut cells[..n];
                     table.table().sample_groups(us, cells);
-                    for (k, &(cell, r)) in cells.iter().enumerate() {
-                        place(k, self.place_in_cell(table, cell, r));
-                    }
+                    self.place_cells(cells, &mut place);
                 }
                 Distribution::Bilinear(grid) => {
                     let (u64s, b) = (&mut [[0.0; 2]; GROUP][..n], &mut bilinear[..n]);
@@ -313,6 +305,44 @@ impl EnvMap {
         }
     }
 
+    /// A placed point's texels prefetched, and its domain point and density
+    /// (`[s, t, p_q]`) and texels kept for [`EnvMap::finish_group`].
+    #[inline(always)]
+    fn keep<F: Real>(&self, placed: Placed<F>, point: &mut [F; 3], corners: &mut Corners<F>) {
+        self.image.prefetch(&placed.corners);
+        let [s, t] = placed.point;
+        (*point, *corners) = ([s, t, placed.pdf_q], placed.corners);
+    }
+
+    /// The point at fractions `r` of each `(cell, r)` of `cells` (at most
+    /// [`GROUP`]) placed on the map, handed to `emit` with its index: a
+    /// luminance density's warps together at SIMD width
+    /// ([`LuminanceDensity::place_group`](super::luminance::LuminanceDensity::place_group)),
+    /// a piecewise table's one by one. (Maps without cells place none.)
+    #[inline(always)]
+    fn place_cells<F: Real>(
+        &self,
+        cells: &[((usize, usize), [F; 2])],
+        mut emit: impl FnMut(usize, Placed<F>),
+    ) {
+        match &self.distribution {
+            Distribution::Luminance(density) => {
+                let mut placed = [[0.0; 3]; GROUP];
+                let placed = &mut placed[..cells.len()];
+                density.place_group(cells, placed);
+                for (k, (&(cell, _), &p)) in cells.iter().zip(&*placed).enumerate() {
+                    emit(k, self.luminance_point(cell, p));
+                }
+            }
+            Distribution::Piecewise(table) => {
+                for (k, &(cell, r)) in cells.iter().enumerate() {
+                    emit(k, self.place_in_cell(table, cell, r));
+                }
+            }
+            Distribution::Bilinear(_) | Distribution::Black => {}
+        }
+    }
+
     /// [`CellSampler::sample`] by `sampler` (built for this map) of each
     /// `(bits, r)` of `draws`, appended to `out`, group by group as
     /// [`EnvMap::sample_rows`] draws: the cells (their alias-table reads
@@ -328,13 +358,9 @@ impl EnvMap {
     ) {
         match &self.distribution {
             Distribution::Luminance(density) => {
-                let place = |c, r| self.place_luminance(density, c, r);
-                self.sample_cells_by(sampler, draws, out, |c| density.prefetch_cell(c), place)
+                self.sample_cells_by(sampler, draws, out, |c| density.prefetch_cell(c))
             }
-            Distribution::Piecewise(table) => {
-                let place = |c, r| self.place_in_cell(table, c, r);
-                self.sample_cells_by(sampler, draws, out, |_| {}, place)
-            }
+            Distribution::Piecewise(_) => self.sample_cells_by(sampler, draws, out, |_| {}),
             // (Maps without cells have no cell sampler.)
             Distribution::Bilinear(_) | Distribution::Black => {
                 out.extend(draws.iter().map(|&(bits, r)| sampler.sample(self, bits, r)));
@@ -342,9 +368,9 @@ impl EnvMap {
         }
     }
 
-    /// [`EnvMap::sample_cells`] with the cell's point placed by `place`,
-    /// the table lines it reads asked for by `prefetch` as the cells are
-    /// drawn.
+    /// [`EnvMap::sample_cells`] of a map with cells, the table lines that
+    /// placing a point in a cell reads asked for by `prefetch` as the
+    /// cells are drawn.
     #[inline(always)]
     fn sample_cells_by<F: Real>(
         &self,
@@ -352,24 +378,20 @@ impl EnvMap {
         draws: &[(u64, [F; 2])],
         out: &mut Vec<EnvSample<F>>,
         prefetch: impl Fn((usize, usize)),
-        place: impl Fn((usize, usize), [F; 2]) -> Placed<F>,
     ) {
         let zero = F::zero();
-        let mut cells = [(0, 0); GROUP];
+        let mut cells = [((0, 0), [zero; 2]); GROUP];
         let mut points = [[zero; 3]; GROUP];
         let mut frames = [[zero; 5]; GROUP];
         let mut corners = [([0; 4], [zero; 4]); GROUP];
         for draws in draws.chunks(GROUP) {
-            for (cell, &(bits, _)) in cells.iter_mut().zip(draws) {
-                *cell = sampler.cell(bits);
-                prefetch(*cell);
+            for (cell, &(bits, r)) in cells.iter_mut().zip(draws) {
+                *cell = (sampler.cell(bits), r);
+                prefetch(cell.0);
             }
-            for (k, (&cell, &(_, r))) in cells.iter().zip(draws).enumerate() {
-                let placed = place(cell, r);
-                self.image.prefetch(&placed.corners);
-                let [s, t] = placed.point;
-                (points[k], corners[k]) = ([s, t, placed.pdf_q], placed.corners);
-            }
+            self.place_cells(&cells[..draws.len()], |k, placed| {
+                self.keep(placed, &mut points[k], &mut corners[k]);
+            });
             let points = &points[..draws.len()];
             self.finish_group(points, &corners, &mut frames, |_, s| out.push(s));
         }

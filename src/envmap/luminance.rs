@@ -7,7 +7,7 @@
 use super::bilinear::{bilerp, warp_bilinear};
 use super::image::Corners;
 use crate::alloc;
-use crate::distr::Discrete2D;
+use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;
 use crate::math::Real;
 use crate::simd;
@@ -117,9 +117,34 @@ impl LuminanceDensity {
     #[inline]
     pub(super) fn place(&self, (row, col): (usize, usize), r: [f64; 2]) -> ([f64; 2], f64) {
         let k = row * self.width + col;
-        let c = corners(&self.lum, self.width, k);
-        let [x, y] = warp_bilinear(c, r);
-        ([x, y], bilerp(c, x, y) * self.scale[k])
+        let [x, y, bilerp] = warp_corners(corners(&self.lum, self.width, k), r);
+        ([x, y], bilerp * self.scale[k])
+    }
+
+    /// `[x, y, p_q]` of [`LuminanceDensity::place`] for each `(cell, r)`
+    /// of `cells` (at most [`GROUP`]), into `out`: the cells' corners read
+    /// one by one (their lines prefetched by then), the warps in `f64` at
+    /// SIMD width, the same bits as one by one.
+    #[inline(always)]
+    pub(super) fn place_group<F: Real>(
+        &self,
+        cells: &[((usize, usize), [F; 2])],
+        out: &mut [[f64; 3]],
+    ) {
+        let mut rows = [[0.0; 6]; GROUP];
+        let rows = &mut rows[..cells.len()];
+        for (row, &((j, i), r)) in rows.iter_mut().zip(cells) {
+            let [a, b, c, d] = corners(&self.lum, self.width, j * self.width + i);
+            *row = [a, b, c, d, r[0].f64(), r[1].f64()];
+        }
+        let warp = {
+            #[inline(always)]
+            |[a, b, c, d, r0, r1]: [f64; 6]| warp_corners([a, b, c, d], [r0, r1])
+        };
+        simd::map_rows(out, rows, &warp, |_| true, false);
+        for (o, &((j, i), _)) in out.iter_mut().zip(cells) {
+            o[2] *= self.scale[j * self.width + i];
+        }
     }
 
     /// `p_q` at the fractions `(x, y)` of cell `(row, col)`.
@@ -139,6 +164,14 @@ impl LuminanceDensity {
         }
         y * F::c(self.scale[idx[0]])
     }
+}
+
+/// `[x, y, bilerp(c, x, y)]`: the point of the unit square that `r` places
+/// with density `∝ bilerp(c, ·)` ([`warp_bilinear`]), and that blend there.
+#[inline(always)]
+fn warp_corners(c: [f64; 4], r: [f64; 2]) -> [f64; 3] {
+    let [x, y] = warp_bilinear(c, r);
+    [x, y, bilerp(c, x, y)]
 }
 
 /// The corners `[a, b, c, d]` of cell `k` (row-major, `width` a row):
