@@ -7,11 +7,12 @@
 use super::cell_sampler::CellSampler;
 use super::distribution::Distribution;
 use super::image::Corners;
+use super::luminance::LuminanceDensity;
 use super::mapping::Mapping;
 use super::polar::TableFloat;
 use super::sample::{PdfQuery, Placed, luminance_pdf_at};
 use super::{EnvMap, EnvSample};
-use crate::distr::GROUP;
+use crate::distr::{GROUP, PiecewiseConstant2D};
 use crate::math::Real;
 use crate::simd;
 use crate::warp::V3;
@@ -242,7 +243,7 @@ impl EnvMap {
             let us = &*us;
             // Each point's domain point and density, and its texels
             // (prefetched).
-            let mut place = |k: usize, placed| self.keep(placed, &mut points[k], &mut corners[k]);
+            let mut stage = |k: usize, placed| self.stage(placed, &mut points[k], &mut corners[k]);
             match &self.distribution {
                 Distribution::Luminance(density) => {
                     let cells = &mut cells[..n];
@@ -250,12 +251,12 @@ impl EnvMap {
                     for &(cell, _) in cells.iter() {
                         density.prefetch_cell(cell);
                     }
-                    self.place_cells(cells, &mut place);
+                    self.place_cells(Cells::Luminance(density), cells, &mut stage);
                 }
                 Distribution::Piecewise(table) => {
                     let cells = &mut cells[..n];
                     table.table().sample_groups(us, cells);
-                    self.place_cells(cells, &mut place);
+                    self.place_cells(Cells::Piecewise(table), cells, &mut stage);
                 }
                 Distribution::Bilinear(grid) => {
                     let (u64s, b) = (&mut [[0.0; 2]; GROUP][..n], &mut bilinear[..n]);
@@ -264,7 +265,7 @@ impl EnvMap {
                     }
                     grid.sample_into(u64s, b);
                     for (k, &(q, pdf)) in b.iter().enumerate() {
-                        place(k, self.place_at(q.map(F::c), F::c(pdf)));
+                        stage(k, self.place_at(q.map(F::c), F::c(pdf)));
                     }
                 }
                 Distribution::Black => {
@@ -306,9 +307,9 @@ impl EnvMap {
     }
 
     /// A placed point's texels prefetched, and its domain point and density
-    /// (`[s, t, p_q]`) and texels kept for [`EnvMap::finish_group`].
+    /// (`[s, t, p_q]`) and texels staged for [`EnvMap::finish_group`].
     #[inline(always)]
-    fn keep<F: Real>(&self, placed: Placed<F>, point: &mut [F; 3], corners: &mut Corners<F>) {
+    fn stage<F: Real>(&self, placed: Placed<F>, point: &mut [F; 3], corners: &mut Corners<F>) {
         self.image.prefetch(&placed.corners);
         let [s, t] = placed.point;
         (*point, *corners) = ([s, t, placed.pdf_q], placed.corners);
@@ -318,15 +319,16 @@ impl EnvMap {
     /// [`GROUP`]) placed on the map, handed to `emit` with its index: a
     /// luminance density's warps together at SIMD width
     /// ([`LuminanceDensity::place_group`](super::luminance::LuminanceDensity::place_group)),
-    /// a piecewise table's one by one. (Maps without cells place none.)
+    /// a piecewise table's one by one.
     #[inline(always)]
     fn place_cells<F: Real>(
         &self,
+        table: Cells<'_>,
         cells: &[((usize, usize), [F; 2])],
         mut emit: impl FnMut(usize, Placed<F>),
     ) {
-        match &self.distribution {
-            Distribution::Luminance(density) => {
+        match table {
+            Cells::Luminance(density) => {
                 let mut placed = [[0.0; 3]; GROUP];
                 let placed = &mut placed[..cells.len()];
                 density.place_group(cells, placed);
@@ -334,12 +336,11 @@ impl EnvMap {
                     emit(k, self.luminance_point(cell, p));
                 }
             }
-            Distribution::Piecewise(table) => {
+            Cells::Piecewise(table) => {
                 for (k, &(cell, r)) in cells.iter().enumerate() {
                     emit(k, self.place_in_cell(table, cell, r));
                 }
             }
-            Distribution::Bilinear(_) | Distribution::Black => {}
         }
     }
 
@@ -358,9 +359,11 @@ impl EnvMap {
     ) {
         match &self.distribution {
             Distribution::Luminance(density) => {
-                self.sample_cells_by(sampler, draws, out, |c| density.prefetch_cell(c))
+                self.sample_cells_by(sampler, draws, out, Cells::Luminance(density))
             }
-            Distribution::Piecewise(_) => self.sample_cells_by(sampler, draws, out, |_| {}),
+            Distribution::Piecewise(table) => {
+                self.sample_cells_by(sampler, draws, out, Cells::Piecewise(table))
+            }
             // (Maps without cells have no cell sampler.)
             Distribution::Bilinear(_) | Distribution::Black => {
                 out.extend(draws.iter().map(|&(bits, r)| sampler.sample(self, bits, r)));
@@ -368,16 +371,16 @@ impl EnvMap {
         }
     }
 
-    /// [`EnvMap::sample_cells`] of a map with cells, the table lines that
-    /// placing a point in a cell reads asked for by `prefetch` as the
-    /// cells are drawn.
+    /// [`EnvMap::sample_cells`] of a map whose cells are `table`'s, the
+    /// table lines that placing a point in a cell reads (a luminance
+    /// density's) prefetched as the cells are drawn.
     #[inline(always)]
     fn sample_cells_by<F: Real>(
         &self,
         sampler: &CellSampler,
         draws: &[(u64, [F; 2])],
         out: &mut Vec<EnvSample<F>>,
-        prefetch: impl Fn((usize, usize)),
+        table: Cells<'_>,
     ) {
         let zero = F::zero();
         let mut cells = [((0, 0), [zero; 2]); GROUP];
@@ -387,15 +390,24 @@ impl EnvMap {
         for draws in draws.chunks(GROUP) {
             for (cell, &(bits, r)) in cells.iter_mut().zip(draws) {
                 *cell = (sampler.cell(bits), r);
-                prefetch(cell.0);
+                if let Cells::Luminance(density) = table {
+                    density.prefetch_cell(cell.0);
+                }
             }
-            self.place_cells(&cells[..draws.len()], |k, placed| {
-                self.keep(placed, &mut points[k], &mut corners[k]);
+            self.place_cells(table, &cells[..draws.len()], |k, placed| {
+                self.stage(placed, &mut points[k], &mut corners[k]);
             });
             let points = &points[..draws.len()];
             self.finish_group(points, &corners, &mut frames, |_, s| out.push(s));
         }
     }
+}
+
+/// The table of a map whose draws are a cell and the fractions `r` in it.
+#[derive(Clone, Copy)]
+enum Cells<'a> {
+    Luminance(&'a LuminanceDensity),
+    Piecewise(&'a PiecewiseConstant2D),
 }
 
 /// `out[i] = read(q, locate(q))` with `q = query(d[i])`, in blocks of

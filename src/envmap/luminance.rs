@@ -131,10 +131,12 @@ impl LuminanceDensity {
         cells: &[((usize, usize), [F; 2])],
         out: &mut [[f64; 3]],
     ) {
+        debug_assert_eq!(out.len(), cells.len());
         let mut rows = [[0.0; 6]; GROUP];
         let rows = &mut rows[..cells.len()];
-        for (row, &((j, i), r)) in rows.iter_mut().zip(cells) {
-            let [a, b, c, d] = corners(&self.lum, self.width, j * self.width + i);
+        let index = |(row, col): (usize, usize)| row * self.width + col;
+        for (row, &(cell, r)) in rows.iter_mut().zip(cells) {
+            let [a, b, c, d] = corners(&self.lum, self.width, index(cell));
             *row = [a, b, c, d, r[0].f64(), r[1].f64()];
         }
         let warp = {
@@ -142,8 +144,8 @@ impl LuminanceDensity {
             |[a, b, c, d, r0, r1]: [f64; 6]| warp_corners([a, b, c, d], [r0, r1])
         };
         simd::map_rows(out, rows, &warp, |_| true, false);
-        for (o, &((j, i), _)) in out.iter_mut().zip(cells) {
-            o[2] *= self.scale[j * self.width + i];
+        for (o, &(cell, _)) in out.iter_mut().zip(cells) {
+            o[2] *= self.scale[index(cell)];
         }
     }
 
