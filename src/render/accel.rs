@@ -4,8 +4,9 @@
 //! it, every primitive by obvhs. obvhs holds its primitives in one
 //! compressed wide BVH (CWBVH, built by PLOC), or, when there are at most
 //! [`LEAF_MAX`], as a single leaf, which costs a fraction of a wide-node
-//! traversal: its triangles are tested four at a time ([`Triangles4`]),
-//! its other primitives one after the other. Through the
+//! traversal: one ray's test takes its triangles four at a time, a
+//! batch's tests each primitive against a block of rays at SIMD width
+//! (`leaf`). Through the
 //! BVH, the leaves' primitives are read from a copy in the BVH's order
 //! (`Packed`: a triangle's vertex and edges in 40 bytes), so that a leaf
 //! is a run of memory rather than a scatter over the meshes' vertices.
@@ -19,12 +20,13 @@ use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbv
 use crate::alloc;
 use crate::error::{Error, Result};
 
+mod leaf;
+
 use super::embree::{self, Stream as EmbreeStream, Triangles as Embree};
 use super::geometry::check_primitives;
 use super::mesh::Mesh;
-use super::shape::{
-    Candidate, Disk, Ray, Sphere, SurfacePoint, Triangle, Triangles4, triangle_hit,
-};
+use super::shape::{Candidate, Disk, Ray, Sphere, SurfacePoint, Triangle, triangle_hit};
+use leaf::Leaf;
 
 /// Working memory of the BVH builder per primitive, checked before it
 /// starts: a scene's whole compilation peaked at about 212 bytes a
@@ -69,15 +71,6 @@ impl Primitive {
             Primitive::Triangle { .. } => self.triangle(meshes)?.intersect(ray),
             Primitive::Sphere(s) => s.intersect(ray),
             Primitive::Disk(d) => d.intersect(ray),
-        }
-    }
-
-    /// Whether the primitive lies on the ray in `(0, ray.tmax)`.
-    #[inline]
-    fn occludes(&self, ray: &Ray, meshes: &[Mesh]) -> bool {
-        match self {
-            Primitive::Sphere(s) => s.occludes(ray),
-            _ => self.intersect(ray, meshes).is_some(),
         }
     }
 
@@ -195,50 +188,6 @@ pub struct Accel {
     packed: Vec<Packed>,
     /// The primitives as one leaf, when there is no BVH.
     leaf: Leaf,
-}
-
-/// The primitives of a scene without a BVH, for testing all of them.
-#[derive(Default)]
-struct Leaf {
-    /// The triangles, four to a pack, with their primitive indices.
-    packs: Vec<(Triangles4, [u32; 4])>,
-    /// The spheres, copied in (a test reads no further), with their
-    /// primitive indices.
-    spheres: Vec<(Sphere, u32)>,
-    /// The indices of the disks.
-    others: Vec<u32>,
-}
-
-impl Leaf {
-    /// Sorts the primitives `ids` of `primitives` into packs of triangles,
-    /// the spheres and the others (disks).
-    fn new(primitives: &[Primitive], ids: &[u32], meshes: &[Mesh]) -> Self {
-        let (mut triangles, mut spheres, mut others) = (Vec::new(), Vec::new(), Vec::new());
-        for &i in ids {
-            match &primitives[i as usize] {
-                Primitive::Triangle { mesh, face } => {
-                    triangles.push((meshes[*mesh as usize].triangle(*face), i));
-                }
-                Primitive::Sphere(s) => spheres.push((**s, i)),
-                Primitive::Disk(_) => others.push(i),
-            }
-        }
-        let packs = triangles
-            .chunks(4)
-            .map(|c| {
-                let (t, i): (Vec<Triangle>, Vec<u32>) = c.iter().copied().unzip();
-                (
-                    Triangles4::new(&t),
-                    std::array::from_fn(|l| i.get(l).copied().unwrap_or(0)),
-                )
-            })
-            .collect();
-        Leaf {
-            packs,
-            spheres,
-            others,
-        }
-    }
 }
 
 impl Accel {
@@ -362,7 +311,7 @@ impl Accel {
     #[inline(always)]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         match (self.embree.as_ref(), self.bvh.as_ref()) {
-            (None, None) => self.intersect_leaf(ray),
+            (None, None) => self.leaf.intersect(ray),
             (None, Some(bvh)) => self.intersect_bvh(bvh, ray),
             (Some(embree), _) => self.intersect_embree(embree, ray),
         }
@@ -384,7 +333,7 @@ impl Accel {
             ..*ray
         };
         let other = match self.bvh.as_ref() {
-            None => self.intersect_leaf(&shrunk),
+            None => self.leaf.intersect(&shrunk),
             Some(bvh) => self.intersect_bvh(bvh, &shrunk),
         };
         other.or(hit)
@@ -404,45 +353,24 @@ impl Accel {
         stream: &mut EmbreeStream,
         out: &mut Vec<Option<Hit>>,
     ) -> Result<()> {
-        let Some(embree) = self.embree.as_ref() else {
-            alloc::reserve(out, rays.len(), "the hits")?;
-            out.extend(rays.iter().map(|ray| self.intersect(ray)));
-            return Ok(());
-        };
         let first = out.len();
-        embree.intersect_many(rays, coherent, stream, out)?;
-        for (ray, hit) in rays.iter().zip(&mut out[first..]) {
-            *hit = self.nearer_other(ray, *hit);
+        match self.embree.as_ref() {
+            Some(embree) => embree.intersect_many(rays, coherent, stream, out)?,
+            None => {
+                alloc::reserve(out, rays.len(), "the hits")?;
+                out.resize(first + rays.len(), None);
+            }
+        }
+        let hits = &mut out[first..];
+        match self.bvh {
+            None => self.leaf.intersect_many(rays, hits),
+            Some(_) => {
+                for (ray, hit) in rays.iter().zip(hits) {
+                    *hit = self.nearer_other(ray, *hit);
+                }
+            }
         }
         Ok(())
-    }
-
-    /// [`Accel::intersect`] in a scene without a BVH: every primitive.
-    #[inline(always)]
-    fn intersect_leaf(&self, ray: &Ray) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        let mut shrunk = *ray;
-        let Leaf {
-            packs,
-            spheres,
-            others,
-        } = &self.leaf;
-        for (pack, index) in packs {
-            if let Some((lane, c)) = pack.intersect(&shrunk) {
-                nearer(&mut best, &mut shrunk, index[lane], c);
-            }
-        }
-        for (sphere, primitive) in spheres {
-            if let Some(c) = sphere.intersect(&shrunk) {
-                nearer(&mut best, &mut shrunk, *primitive, c);
-            }
-        }
-        for &primitive in others {
-            if let Some(c) = self.primitives[primitive as usize].intersect(&shrunk, &self.meshes) {
-                nearer(&mut best, &mut shrunk, primitive, c);
-            }
-        }
-        best
     }
 
     /// [`Accel::intersect`] through the BVH.
@@ -506,15 +434,22 @@ impl Accel {
         stream: &mut EmbreeStream,
         out: &mut Vec<bool>,
     ) -> Result<()> {
-        let Some(embree) = self.embree.as_ref() else {
-            alloc::reserve(out, rays.len(), "the shadow rays")?;
-            out.extend(rays.iter().map(|ray| self.occluded(ray)));
-            return Ok(());
-        };
         let first = out.len();
-        embree.occluded_many(rays, stream, out)?;
-        for (ray, blocked) in rays.iter().zip(&mut out[first..]) {
-            *blocked = *blocked || self.others_occlude(ray);
+        match self.embree.as_ref() {
+            Some(embree) => embree.occluded_many(rays, stream, out)?,
+            None => {
+                alloc::reserve(out, rays.len(), "the shadow rays")?;
+                out.resize(first + rays.len(), false);
+            }
+        }
+        let blocked = &mut out[first..];
+        match self.bvh {
+            None => self.leaf.occluded_many(rays, blocked),
+            Some(_) => {
+                for (ray, blocked) in rays.iter().zip(blocked) {
+                    *blocked = *blocked || self.others_occlude(ray);
+                }
+            }
         }
         Ok(())
     }
@@ -524,16 +459,7 @@ impl Accel {
     #[inline]
     fn others_occlude(&self, ray: &Ray) -> bool {
         let Some(bvh) = self.bvh.as_ref() else {
-            let Leaf {
-                packs,
-                spheres,
-                others,
-            } = &self.leaf;
-            return packs.iter().any(|(pack, _)| pack.occludes(ray))
-                || spheres.iter().any(|(s, _)| s.occludes(ray))
-                || others
-                    .iter()
-                    .any(|&p| self.primitives[p as usize].occludes(ray, &self.meshes));
+            return self.leaf.occludes(ray);
         };
         let query = obvhs::ray::Ray::new(ray.o, ray.d, 0.0, ray.tmax);
         !bvh.ray_traverse_miss(query, |_, id| {
@@ -546,18 +472,6 @@ impl Accel {
     pub fn bounds(&self) -> Option<(Vec3A, Vec3A)> {
         self.bounds.map(|b| (b.min, b.max))
     }
-}
-
-/// `c`, the hit of a ray on `primitive`, as the `best` so far, and the
-/// ray `shrunk` to it.
-#[inline(always)]
-fn nearer(best: &mut Option<Hit>, shrunk: &mut Ray, primitive: u32, c: Candidate) {
-    *best = Some(Hit {
-        t: c.t,
-        primitive,
-        bary: c.bary,
-    });
-    shrunk.tmax = c.t;
 }
 
 /// The number among `primitives` of each mesh's first face (0 for a mesh

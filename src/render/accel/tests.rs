@@ -147,6 +147,114 @@ fn embree_and_obvhs_agree() {
     );
 }
 
+/// Scenes small enough for one leaf (triangles in numbers that fill no
+/// pack, with spheres and disks, among them a sphere around the rays'
+/// origins and primitives that cross): the batch tests, a block of rays at
+/// SIMD width, find what one ray at a time finds, bit for bit, for
+/// batches of every length around the block's, without a hit so far and
+/// after another tracer's (which a nearer primitive replaces).
+#[test]
+fn leaf_batches_are_single_rays_bit_for_bit() {
+    let mut rng = crate::rng::Rng::new(3, 5);
+    let mut u = || rng.next_float::<f32>();
+    let mut point = |scale: f32| Vec3A::new(u() - 0.5, u() - 0.5, u() - 0.5) * scale;
+    for (triangles, spheres, disks) in [(1, 1, 0), (3, 2, 1), (5, 1, 2), (8, 0, 0), (0, 2, 1)] {
+        let (mut prims, mut shapes, mut meshes) = (Vec::new(), Vec::new(), Vec::new());
+        let mut add = |g: Geometry, meshes: &mut Vec<Mesh>| {
+            prims.extend(g.into_primitives(meshes));
+            shapes.resize(prims.len(), shapes.len() as u32);
+        };
+        if triangles > 0 {
+            let v: Vec<[f64; 3]> = (0..3 * triangles)
+                .map(|_| point(3.0).as_dvec3().to_array())
+                .collect();
+            let f: Vec<[i64; 3]> = (0..triangles as i64)
+                .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                .collect();
+            add(
+                Geometry::Mesh(Mesh::new(&v, &f, None, true).unwrap()),
+                &mut meshes,
+            );
+        }
+        for k in 0..spheres {
+            let c = point(2.0).as_dvec3().to_array();
+            let radius = if k == 0 { 2.5 } else { 0.4 };
+            add(Geometry::sphere(c, radius, false).unwrap(), &mut meshes);
+        }
+        for _ in 0..disks {
+            let (a, b, c) = (point(2.0), point(2.0), point(2.0));
+            let m = [
+                [a.x, b.x, 0.3, c.x],
+                [a.y, b.y, 0.1, c.y],
+                [a.z, b.z, -0.2, c.z],
+                [0.0, 0.0, 0.0, 1.0],
+            ]
+            .map(|r| r.map(f64::from));
+            add(Geometry::disk(m).unwrap(), &mut meshes);
+        }
+        let accel = Accel::build(prims, shapes, meshes, false).unwrap();
+        assert!(accel.bvh.is_none());
+        let rays: Vec<Ray> = (0..300)
+            .map(|i| Ray {
+                o: point(4.0),
+                d: point(1.0),
+                tmax: [f32::INFINITY, 2.0, 0.5][i % 3],
+            })
+            .collect();
+        let bits =
+            |h: &Option<Hit>| h.map(|h| (h.primitive, h.t.to_bits(), h.bary.map(f32::to_bits)));
+        let mut hit = 0;
+        for n in [0, 1, 63, 64, 65, 129, 300] {
+            let rays = &rays[..n];
+            let (mut many, mut blocked) = (Vec::new(), Vec::new());
+            let mut stream = Default::default();
+            accel
+                .intersect_many(rays, false, &mut stream, &mut many)
+                .unwrap();
+            accel
+                .occluded_many(rays, &mut stream, &mut blocked)
+                .unwrap();
+            let one: Vec<_> = rays.iter().map(|r| accel.intersect(r)).collect();
+            assert!(many.iter().map(bits).eq(one.iter().map(bits)));
+            assert!(
+                blocked
+                    .iter()
+                    .copied()
+                    .eq(rays.iter().map(|r| accel.occluded(r)))
+            );
+            hit += one.iter().flatten().count();
+            // After another tracer's hits (a made-up primitive 99 at half
+            // the nearest distance, or at 1 where nothing was hit).
+            let theirs: Vec<Option<Hit>> = one
+                .iter()
+                .enumerate()
+                .map(|(i, h)| {
+                    (i % 2 == 0).then_some(Hit {
+                        t: h.map_or(1.0, |h| 0.5 * h.t),
+                        primitive: 99,
+                        bary: [0.25, 0.5],
+                    })
+                })
+                .collect();
+            let mut hits = theirs.clone();
+            accel.leaf.intersect_many(rays, &mut hits);
+            for ((ray, theirs), hits) in rays.iter().zip(&theirs).zip(&hits) {
+                let shrunk = Ray {
+                    tmax: theirs.map_or(ray.tmax, |h| h.t),
+                    ..*ray
+                };
+                assert_eq!(bits(hits), bits(&accel.leaf.intersect(&shrunk).or(*theirs)));
+            }
+            let mut blocked: Vec<bool> = (0..n).map(|i| i % 5 == 0).collect();
+            accel.leaf.occluded_many(rays, &mut blocked);
+            for (i, (ray, b)) in rays.iter().zip(&blocked).enumerate() {
+                assert_eq!(*b, i % 5 == 0 || accel.occluded(ray));
+            }
+        }
+        assert!(hit > 30, "{hit}");
+    }
+}
+
 /// A scene's list of primitives holds a triangle as its mesh and face:
 /// spheres and disks stay out of line.
 #[test]

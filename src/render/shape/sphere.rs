@@ -18,52 +18,84 @@ pub struct Sphere {
 }
 
 impl Sphere {
-    /// The roots of `|o + t d − c|² = r²` as `(q, a, k)`: they are `q/a`
-    /// and `k/q`, with `a = d·d`, `h = (o − c)·d`, `k = |o − c|² − r²` and
-    /// `q = −(h + sign(h)·√(h² − a k))`, the form without cancellation. The
-    /// discriminant is `h² − a k = a r² − |(o − c) × d|²` (Lagrange's
-    /// identity), accurate for rays far from the sphere, and needs no
-    /// division, so that a miss (the common case) costs none. `None` when
-    /// the ray's line misses the sphere. In `f64`.
+    /// The roots of `|o + t d − c|² = r²` as `[disc, q, a, k]`: they are
+    /// `q/a` and `k/q`, with `a = d·d`, `h = (o − c)·d`, `k = |o − c|² − r²`
+    /// and `q = −(h + sign(h)·√disc)`, the form without cancellation, when
+    /// the discriminant `disc = h² − a k` is not negative (otherwise the
+    /// ray's line misses the sphere, and `q` is NaN). `disc` is computed
+    /// as `a r² − |(o − c) × d|²` (Lagrange's identity), accurate for rays
+    /// far from the sphere. In `f64`, without branches (for a batch of
+    /// rays at SIMD width as for one).
     #[inline(always)]
-    fn roots(&self, ray: &Ray) -> Option<(f64, f64, f64)> {
-        let o = ray.o.as_dvec3() - self.center;
-        let d = ray.d.as_dvec3();
+    fn terms(&self, o: [f32; 3], d: [f32; 3]) -> [f64; 4] {
+        let o = DVec3::from_array(o.map(f64::from)) - self.center;
+        let d = DVec3::from_array(d.map(f64::from));
         let a = d.length_squared();
         let r2 = self.radius * self.radius;
         let disc = a * r2 - o.cross(d).length_squared();
-        if disc < 0.0 {
-            return None;
-        }
         let h = o.dot(d);
         let q = -(h + h.signum() * disc.sqrt());
-        Some((q, a, o.length_squared() - r2))
+        [disc, q, a, o.length_squared() - r2]
+    }
+
+    /// [`Sphere::terms`] of `ray` as `(q, a, k)`; `None` when its line
+    /// misses the sphere (the common case, which then costs no division).
+    #[inline(always)]
+    fn roots(&self, ray: &Ray) -> Option<(f64, f64, f64)> {
+        let [disc, q, a, k] = self.terms(ray.o.to_array(), ray.d.to_array());
+        (disc >= 0.0).then_some((q, a, k))
+    }
+
+    /// Whether the nearer root `t` of `(q, a, k)` in `(0, ∞)` lies below
+    /// `tmax`, and `t`.
+    #[inline(always)]
+    fn nearer_root(q: f64, a: f64, k: f64, tmax: f32) -> (bool, f32) {
+        let (t0, t1) = (q / a, k / q);
+        let (near, far) = (t0.min(t1), t0.max(t1));
+        let t = if near > 0.0 { near } else { far };
+        (t > 0.0 && t < f64::from(tmax), t as f32)
+    }
+
+    /// Whether a root of `(q, a, k)` lies in `(0, tmax)`, without
+    /// dividing: `q/a` does when `0 < q < a·tmax`, and `k/q` when `0 < σk <
+    /// |q|·tmax` with `σ` the sign of `q` (`a > 0`).
+    #[inline(always)]
+    fn root_within(q: f64, a: f64, k: f64, tmax: f32) -> bool {
+        let tmax = f64::from(tmax);
+        let sk = q.signum() * k;
+        (q > 0.0 && q < a * tmax) | (sk > 0.0 && sk < q.abs() * tmax)
     }
 
     /// The nearer root in `(0, tmax)`.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<Candidate> {
         let (q, a, k) = self.roots(ray)?;
-        let (t0, t1) = (q / a, k / q);
-        let (near, far) = (t0.min(t1), t0.max(t1));
-        let t = if near > 0.0 { near } else { far };
-        (t > 0.0 && t < f64::from(ray.tmax)).then_some(Candidate {
-            t: t as f32,
-            bary: [0.0; 2],
-        })
+        let (hit, t) = Self::nearer_root(q, a, k, ray.tmax);
+        hit.then_some(Candidate { t, bary: [0.0; 2] })
     }
 
-    /// Whether a root lies in `(0, tmax)`, without dividing: `q/a` does
-    /// when `0 < q < a·tmax`, and `k/q` when `0 < σk < |q|·tmax` with `σ`
-    /// the sign of `q` (`a > 0`).
+    /// Whether a root lies in `(0, tmax)` ([`Sphere::root_within`]).
     #[inline(always)]
     pub fn occludes(&self, ray: &Ray) -> bool {
-        let Some((q, a, k)) = self.roots(ray) else {
-            return false;
-        };
-        let tmax = f64::from(ray.tmax);
-        let sk = q.signum() * k;
-        (q > 0.0 && q < a * tmax) || (sk > 0.0 && sk < q.abs() * tmax)
+        self.roots(ray)
+            .is_some_and(|(q, a, k)| Self::root_within(q, a, k, ray.tmax))
+    }
+
+    /// [`Sphere::intersect`] of the ray from `o` along `d` without
+    /// branches, for a batch of rays at SIMD width: whether it meets the
+    /// sphere in `(0, tmax)`, and where (the same bits as `intersect`).
+    #[inline(always)]
+    pub fn hit_lanes(&self, o: [f32; 3], d: [f32; 3], tmax: f32) -> (bool, f32) {
+        let [disc, q, a, k] = self.terms(o, d);
+        let (hit, t) = Self::nearer_root(q, a, k, tmax);
+        ((disc >= 0.0) & hit, t)
+    }
+
+    /// [`Sphere::occludes`] without branches ([`Sphere::hit_lanes`]).
+    #[inline(always)]
+    pub fn occludes_lanes(&self, o: [f32; 3], d: [f32; 3], tmax: f32) -> bool {
+        let [disc, q, a, k] = self.terms(o, d);
+        (disc >= 0.0) & Self::root_within(q, a, k, tmax)
     }
 
     /// The point on the sphere nearest to `p` (a hit point, snapped back onto

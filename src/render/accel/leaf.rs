@@ -1,0 +1,252 @@
+//! The primitives of a scene without a BVH (at most [`super::LEAF_MAX`]
+//! that obvhs would trace), all tested against each ray: one ray at a time
+//! (its triangles four at once, [`Triangles4`]), or a block of rays at once,
+//! each primitive tested against the whole block at SIMD width
+//! ([`Leaf::intersect_many`], [`Leaf::occluded_many`]). Both run the same
+//! arithmetic in the same order, so they find the same hits, bit for bit.
+
+use super::{Hit, Primitive};
+use crate::render::mesh::Mesh;
+use crate::render::shape::{Candidate, Disk, Ray, Sphere, Triangle, Triangles4, moller_trumbore};
+use crate::simd;
+
+/// Rays per block of the batch tests (the loops over a block's rays
+/// vectorise; 64 keeps a block's columns within the L1 cache).
+const BLOCK: usize = 64;
+
+/// The primitive number of "no hit" in a block's best hits.
+const NONE: u32 = u32::MAX;
+
+/// A triangle's vertex `p0` and edges `e1`, `e2`, by components.
+type Corners = [[f32; 3]; 3];
+
+/// The primitives of a scene without a BVH, for testing all of them.
+#[derive(Default)]
+pub(super) struct Leaf {
+    /// The triangles, four to a pack, with their primitive indices (one
+    /// ray at a time).
+    packs: Vec<(Triangles4, [u32; 4])>,
+    /// The same triangles one by one, in the same order (a block of rays
+    /// at a time).
+    triangles: Vec<(Corners, u32)>,
+    /// The spheres, copied in (a test reads no further), with their
+    /// primitive indices.
+    spheres: Vec<(Sphere, u32)>,
+    /// The disks, likewise.
+    disks: Vec<(Disk, u32)>,
+}
+
+impl Leaf {
+    /// Sorts the primitives `ids` of `primitives` into triangles (in packs
+    /// of four and one by one), spheres and disks.
+    pub(super) fn new(primitives: &[Primitive], ids: &[u32], meshes: &[Mesh]) -> Self {
+        let (mut triangles, mut leaf) = (Vec::new(), Leaf::default());
+        for &i in ids {
+            match &primitives[i as usize] {
+                Primitive::Triangle { mesh, face } => {
+                    triangles.push((meshes[*mesh as usize].triangle(*face), i));
+                }
+                Primitive::Sphere(s) => leaf.spheres.push((**s, i)),
+                Primitive::Disk(d) => leaf.disks.push((**d, i)),
+            }
+        }
+        leaf.packs = triangles
+            .chunks(4)
+            .map(|c| {
+                let (t, i): (Vec<Triangle>, Vec<u32>) = c.iter().copied().unzip();
+                (
+                    Triangles4::new(&t),
+                    std::array::from_fn(|l| i.get(l).copied().unwrap_or(0)),
+                )
+            })
+            .collect();
+        leaf.triangles = triangles
+            .iter()
+            .map(|(t, i)| ([t.p0, t.e1, t.e2].map(|v| v.to_array()), *i))
+            .collect();
+        leaf
+    }
+
+    /// The nearest hit of `ray` in `(0, ray.tmax)`: the triangles (a pack
+    /// at a time), then the spheres, then the disks, each tested against
+    /// the ray shortened to the nearest hit so far.
+    #[inline(always)]
+    pub(super) fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut shrunk = *ray;
+        for (pack, index) in &self.packs {
+            if let Some((lane, c)) = pack.intersect(&shrunk) {
+                nearer(&mut best, &mut shrunk, index[lane], c);
+            }
+        }
+        for (sphere, primitive) in &self.spheres {
+            if let Some(c) = sphere.intersect(&shrunk) {
+                nearer(&mut best, &mut shrunk, *primitive, c);
+            }
+        }
+        for (disk, primitive) in &self.disks {
+            if let Some(c) = disk.intersect(&shrunk) {
+                nearer(&mut best, &mut shrunk, *primitive, c);
+            }
+        }
+        best
+    }
+
+    /// Whether a primitive lies on `ray` in `(0, ray.tmax)`.
+    #[inline]
+    pub(super) fn occludes(&self, ray: &Ray) -> bool {
+        self.packs.iter().any(|(pack, _)| pack.occludes(ray))
+            || self.spheres.iter().any(|(s, _)| s.occludes(ray))
+            || self.disks.iter().any(|(d, _)| d.intersect(ray).is_some())
+    }
+
+    /// For each ray of `rays` and its hit so far in `hits` (another ray
+    /// tracer's, or `None`), the nearer hit of [`Leaf::intersect`] on the
+    /// ray shortened to it, if any: what `hits[i].or(...)` of one ray at
+    /// a time gives, bit for bit. The triangles and spheres are tested
+    /// against [`BLOCK`] rays at once, at SIMD width.
+    pub(super) fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        debug_assert_eq!(rays.len(), hits.len());
+        simd::dispatch(
+            #[inline(always)]
+            |_| {
+                for (rays, hits) in rays.chunks(BLOCK).zip(hits.chunks_mut(BLOCK)) {
+                    self.intersect_block(rays, hits);
+                }
+            },
+        );
+    }
+
+    /// [`Leaf::intersect_many`] of at most [`BLOCK`] rays.
+    #[inline(always)]
+    fn intersect_block(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        let block = Block::new(rays);
+        // The best hit so far (the padding rays, of `tmax` 0, meet nothing).
+        let (mut t, mut primitive, mut bary) = ([0.0; BLOCK], [NONE; BLOCK], [[0.0; BLOCK]; 2]);
+        for (i, (ray, hit)) in rays.iter().zip(&*hits).enumerate() {
+            t[i] = hit.map_or(ray.tmax, |h| h.t);
+            primitive[i] = hit.map_or(NONE, |h| h.primitive);
+            [bary[0][i], bary[1][i]] = hit.map_or([0.0; 2], |h| h.bary);
+        }
+        for &([p0, e1, e2], id) in &self.triangles {
+            for i in 0..BLOCK {
+                let scaled = moller_trumbore(block.o(i), block.d(i), p0, e1, e2);
+                let (ahead, t_hit, [b1, b2]) = scaled.hit(t[i]);
+                let take = scaled.inside & ahead;
+                t[i] = if take { t_hit } else { t[i] };
+                primitive[i] = if take { id } else { primitive[i] };
+                bary[0][i] = if take { b1 } else { bary[0][i] };
+                bary[1][i] = if take { b2 } else { bary[1][i] };
+            }
+        }
+        for &(sphere, id) in &self.spheres {
+            for i in 0..BLOCK {
+                let (take, t_hit) = sphere.hit_lanes(block.o(i), block.d(i), t[i]);
+                t[i] = if take { t_hit } else { t[i] };
+                primitive[i] = if take { id } else { primitive[i] };
+                bary[0][i] = if take { 0.0 } else { bary[0][i] };
+                bary[1][i] = if take { 0.0 } else { bary[1][i] };
+            }
+        }
+        for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+            let mut best = (primitive[i] != NONE).then_some(Hit {
+                t: t[i],
+                primitive: primitive[i],
+                bary: [bary[0][i], bary[1][i]],
+            });
+            let mut shrunk = Ray { tmax: t[i], ..*ray };
+            for (disk, id) in &self.disks {
+                if let Some(c) = disk.intersect(&shrunk) {
+                    nearer(&mut best, &mut shrunk, *id, c);
+                }
+            }
+            *hit = best;
+        }
+    }
+
+    /// `blocked[i] ||` [`Leaf::occludes`] of `rays[i]`, for each, the
+    /// triangles and spheres tested against [`BLOCK`] rays at once.
+    pub(super) fn occluded_many(&self, rays: &[Ray], blocked: &mut [bool]) {
+        debug_assert_eq!(rays.len(), blocked.len());
+        simd::dispatch(
+            #[inline(always)]
+            |_| {
+                for (rays, blocked) in rays.chunks(BLOCK).zip(blocked.chunks_mut(BLOCK)) {
+                    self.occluded_block(rays, blocked);
+                }
+            },
+        );
+    }
+
+    /// [`Leaf::occluded_many`] of at most [`BLOCK`] rays.
+    #[inline(always)]
+    fn occluded_block(&self, rays: &[Ray], blocked: &mut [bool]) {
+        let block = Block::new(rays);
+        let mut tmax = [0.0; BLOCK];
+        let mut any = [false; BLOCK];
+        for (i, (ray, &b)) in rays.iter().zip(&*blocked).enumerate() {
+            tmax[i] = ray.tmax;
+            any[i] = b;
+        }
+        for &([p0, e1, e2], _) in &self.triangles {
+            for i in 0..BLOCK {
+                let scaled = moller_trumbore(block.o(i), block.d(i), p0, e1, e2);
+                any[i] |= scaled.inside & scaled.hit(tmax[i]).0;
+            }
+        }
+        for (sphere, _) in &self.spheres {
+            for i in 0..BLOCK {
+                any[i] |= sphere.occludes_lanes(block.o(i), block.d(i), tmax[i]);
+            }
+        }
+        for (i, (ray, b)) in rays.iter().zip(blocked).enumerate() {
+            *b = any[i] || self.disks.iter().any(|(d, _)| d.intersect(ray).is_some());
+        }
+    }
+}
+
+/// A block's ray origins and directions, one array per component (the
+/// rows past the block's rays are zero).
+struct Block {
+    o: [[f32; BLOCK]; 3],
+    d: [[f32; BLOCK]; 3],
+}
+
+impl Block {
+    #[inline(always)]
+    fn new(rays: &[Ray]) -> Self {
+        let mut block = Block {
+            o: [[0.0; BLOCK]; 3],
+            d: [[0.0; BLOCK]; 3],
+        };
+        for (i, ray) in rays.iter().enumerate().take(BLOCK) {
+            for k in 0..3 {
+                block.o[k][i] = ray.o[k];
+                block.d[k][i] = ray.d[k];
+            }
+        }
+        block
+    }
+
+    #[inline(always)]
+    fn o(&self, i: usize) -> [f32; 3] {
+        [self.o[0][i], self.o[1][i], self.o[2][i]]
+    }
+
+    #[inline(always)]
+    fn d(&self, i: usize) -> [f32; 3] {
+        [self.d[0][i], self.d[1][i], self.d[2][i]]
+    }
+}
+
+/// `c`, the hit of a ray on `primitive`, as the `best` so far, and the
+/// ray `shrunk` to it.
+#[inline(always)]
+fn nearer(best: &mut Option<Hit>, shrunk: &mut Ray, primitive: u32, c: Candidate) {
+    *best = Some(Hit {
+        t: c.t,
+        primitive,
+        bary: c.bary,
+    });
+    shrunk.tmax = c.t;
+}
