@@ -321,14 +321,17 @@ impl Batch {
         for first in (0..self.rays.len()).step_by(BATCH) {
             let slots = first..(first + BATCH).min(self.rays.len());
             self.paths.start(slots.len())?;
+            // Slot `s` is sample `k = s mod spp` of pixel `s / spp`,
+            // counted along (not divided for each).
+            let (mut pixel, mut k) = (first / spp, first % spp);
             for slot in slots {
-                let index = samples.first + (slot % spp) as u64;
+                let index = samples.first + k as u64;
                 self.paths.push(
                     scene,
                     settings,
                     CameraSample {
                         slot: slot as u32,
-                        pixel: (slot / spp) as u32,
+                        pixel: pixel as u32,
                         index: index as u32,
                         ray: self.rays[slot],
                         hit: self.hits[slot],
@@ -338,6 +341,10 @@ impl Batch {
                         rng: self.resume.get(slot).cloned(),
                     },
                 );
+                k += 1;
+                if k == spp {
+                    (pixel, k) = (pixel + 1, 0);
+                }
             }
             self.paths
                 .trace(scene, settings, &mut streams, &mut self.radiance)?;
