@@ -5,8 +5,8 @@
 //! compressed wide BVH (CWBVH, built by PLOC), or, when there are at most
 //! [`LEAF_MAX`], as a single leaf, which costs a fraction of a wide-node
 //! traversal: one ray's test takes its triangles four at a time, a
-//! batch's tests each primitive against a block of rays at SIMD width
-//! (`leaf`). Through the
+//! batch's tests each triangle and sphere against a block of rays at SIMD
+//! width (`leaf`). Through the
 //! BVH, the leaves' primitives are read from a copy in the BVH's order
 //! (`Packed`: a triangle's vertex and edges in 40 bytes), so that a leaf
 //! is a run of memory rather than a scatter over the meshes' vertices.

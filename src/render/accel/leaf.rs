@@ -1,8 +1,9 @@
 //! The primitives of a scene without a BVH (at most [`super::LEAF_MAX`]
 //! that obvhs would trace), all tested against each ray: one ray at a time
 //! (its triangles four at once, [`Triangles4`]), or a block of rays at once,
-//! each primitive tested against the whole block at SIMD width
-//! ([`Leaf::intersect_many`], [`Leaf::occluded_many`]). Both run the same
+//! each triangle and sphere tested against the whole block at SIMD width
+//! ([`Leaf::intersect_many`], [`Leaf::occluded_many`]; the disks after,
+//! ray by ray). Both run the same
 //! arithmetic in the same order, so they find the same hits, bit for bit.
 
 use super::{Hit, Primitive};
@@ -18,7 +19,7 @@ const BLOCK: usize = 64;
 const NONE: u32 = u32::MAX;
 
 /// A triangle's vertex `p0` and edges `e1`, `e2`, by components.
-type Corners = [[f32; 3]; 3];
+type VertexEdges = [[f32; 3]; 3];
 
 /// The primitives of a scene without a BVH, for testing all of them.
 #[derive(Default)]
@@ -28,7 +29,7 @@ pub(super) struct Leaf {
     packs: Vec<(Triangles4, [u32; 4])>,
     /// The same triangles one by one, in the same order (a block of rays
     /// at a time).
-    triangles: Vec<(Corners, u32)>,
+    triangles: Vec<(VertexEdges, u32)>,
     /// The spheres, copied in (a test reads no further), with their
     /// primitive indices.
     spheres: Vec<(Sphere, u32)>,
@@ -101,12 +102,15 @@ impl Leaf {
     }
 
     /// For each ray of `rays` and its hit so far in `hits` (another ray
-    /// tracer's, or `None`), the nearer hit of [`Leaf::intersect`] on the
-    /// ray shortened to it, if any: what `hits[i].or(...)` of one ray at
-    /// a time gives, bit for bit. The triangles and spheres are tested
+    /// tracer's, or `None`), the hit of [`Leaf::intersect`] on the ray
+    /// shortened to it if there is one, else the hit so far: what
+    /// `leaf.intersect(shortened).or(hits[i])` gives, bit for bit. The triangles and spheres are tested
     /// against [`BLOCK`] rays at once, at SIMD width.
     pub(super) fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         debug_assert_eq!(rays.len(), hits.len());
+        if self.triangles.is_empty() && self.spheres.is_empty() && self.disks.is_empty() {
+            return;
+        }
         simd::dispatch(
             #[inline(always)]
             |_| {
@@ -121,46 +125,32 @@ impl Leaf {
     #[inline(always)]
     fn intersect_block(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         let block = Block::new(rays);
-        // The best hit so far (the padding rays, of `tmax` 0, meet nothing).
-        let (mut t, mut primitive, mut bary) = ([0.0; BLOCK], [NONE; BLOCK], [[0.0; BLOCK]; 2]);
-        for (i, (ray, hit)) in rays.iter().zip(&*hits).enumerate() {
-            t[i] = hit.map_or(ray.tmax, |h| h.t);
-            primitive[i] = hit.map_or(NONE, |h| h.primitive);
-            [bary[0][i], bary[1][i]] = hit.map_or([0.0; 2], |h| h.bary);
-        }
+        let mut best = Best::new(rays, hits);
         for &([p0, e1, e2], id) in &self.triangles {
             for i in 0..BLOCK {
                 let scaled = moller_trumbore(block.o(i), block.d(i), p0, e1, e2);
-                let (ahead, t_hit, [b1, b2]) = scaled.hit(t[i]);
-                let take = scaled.inside & ahead;
-                t[i] = if take { t_hit } else { t[i] };
-                primitive[i] = if take { id } else { primitive[i] };
-                bary[0][i] = if take { b1 } else { bary[0][i] };
-                bary[1][i] = if take { b2 } else { bary[1][i] };
+                let (ahead, t, bary) = scaled.hit(best.t[i]);
+                best.take(i, scaled.inside & ahead, t, id, bary);
             }
         }
         for &(sphere, id) in &self.spheres {
             for i in 0..BLOCK {
-                let (take, t_hit) = sphere.hit_lanes(block.o(i), block.d(i), t[i]);
-                t[i] = if take { t_hit } else { t[i] };
-                primitive[i] = if take { id } else { primitive[i] };
-                bary[0][i] = if take { 0.0 } else { bary[0][i] };
-                bary[1][i] = if take { 0.0 } else { bary[1][i] };
+                let (take, t) = sphere.hit_branchless(block.o(i), block.d(i), best.t[i]);
+                best.take(i, take, t, id, [0.0; 2]);
             }
         }
         for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
-            let mut best = (primitive[i] != NONE).then_some(Hit {
-                t: t[i],
-                primitive: primitive[i],
-                bary: [bary[0][i], bary[1][i]],
-            });
-            let mut shrunk = Ray { tmax: t[i], ..*ray };
+            let mut nearest = best.hit(i);
+            let mut shrunk = Ray {
+                tmax: best.t[i],
+                ..*ray
+            };
             for (disk, id) in &self.disks {
                 if let Some(c) = disk.intersect(&shrunk) {
-                    nearer(&mut best, &mut shrunk, *id, c);
+                    nearer(&mut nearest, &mut shrunk, *id, c);
                 }
             }
-            *hit = best;
+            *hit = nearest;
         }
     }
 
@@ -168,6 +158,9 @@ impl Leaf {
     /// triangles and spheres tested against [`BLOCK`] rays at once.
     pub(super) fn occluded_many(&self, rays: &[Ray], blocked: &mut [bool]) {
         debug_assert_eq!(rays.len(), blocked.len());
+        if self.triangles.is_empty() && self.spheres.is_empty() && self.disks.is_empty() {
+            return;
+        }
         simd::dispatch(
             #[inline(always)]
             |_| {
@@ -196,7 +189,7 @@ impl Leaf {
         }
         for (sphere, _) in &self.spheres {
             for i in 0..BLOCK {
-                any[i] |= sphere.occludes_lanes(block.o(i), block.d(i), tmax[i]);
+                any[i] |= sphere.occludes_branchless(block.o(i), block.d(i), tmax[i]);
             }
         }
         for (i, (ray, b)) in rays.iter().zip(blocked).enumerate() {
@@ -236,6 +229,54 @@ impl Block {
     #[inline(always)]
     fn d(&self, i: usize) -> [f32; 3] {
         [self.d[0][i], self.d[1][i], self.d[2][i]]
+    }
+}
+
+/// The nearest hit so far of each ray of a block: distance, primitive
+/// ([`NONE`] for none) and barycentrics. Rows past the block's rays have
+/// distance 0, so that nothing is nearer.
+struct Best {
+    t: [f32; BLOCK],
+    primitive: [u32; BLOCK],
+    bary: [[f32; BLOCK]; 2],
+}
+
+impl Best {
+    /// The hits so far `hits` of `rays`, or their `tmax` where there is
+    /// none.
+    #[inline(always)]
+    fn new(rays: &[Ray], hits: &[Option<Hit>]) -> Self {
+        let mut best = Best {
+            t: [0.0; BLOCK],
+            primitive: [NONE; BLOCK],
+            bary: [[0.0; BLOCK]; 2],
+        };
+        for (i, (ray, hit)) in rays.iter().zip(hits).enumerate().take(BLOCK) {
+            best.t[i] = hit.map_or(ray.tmax, |h| h.t);
+            best.primitive[i] = hit.map_or(NONE, |h| h.primitive);
+            [best.bary[0][i], best.bary[1][i]] = hit.map_or([0.0; 2], |h| h.bary);
+        }
+        best
+    }
+
+    /// Row `i` becomes the hit at `t` on `primitive` where `take`, without
+    /// a branch.
+    #[inline(always)]
+    fn take(&mut self, i: usize, take: bool, t: f32, primitive: u32, bary: [f32; 2]) {
+        self.t[i] = if take { t } else { self.t[i] };
+        self.primitive[i] = if take { primitive } else { self.primitive[i] };
+        self.bary[0][i] = if take { bary[0] } else { self.bary[0][i] };
+        self.bary[1][i] = if take { bary[1] } else { self.bary[1][i] };
+    }
+
+    /// Row `i` as a hit, if any.
+    #[inline(always)]
+    fn hit(&self, i: usize) -> Option<Hit> {
+        (self.primitive[i] != NONE).then_some(Hit {
+            t: self.t[i],
+            primitive: self.primitive[i],
+            bary: [self.bary[0][i], self.bary[1][i]],
+        })
     }
 }
 

@@ -147,38 +147,47 @@ fn embree_and_obvhs_agree() {
     );
 }
 
-/// Scenes small enough for one leaf (triangles in numbers that fill no
-/// pack, with spheres and disks, among them a sphere around the rays'
-/// origins and primitives that cross): the batch tests, a block of rays at
-/// SIMD width, find what one ray at a time finds, bit for bit, for
-/// batches of every length around the block's, without a hit so far and
-/// after another tracer's (which a nearer primitive replaces).
+/// Scenes small enough for one leaf (triangles in numbers that fill a
+/// pack or not, with spheres and disks, among them a sphere around the
+/// rays' origins, primitives that cross, and ties: a face listed twice, in
+/// one pack or across two, and a sphere listed twice): the batch tests, a
+/// block of rays at SIMD width, find what one ray at a time finds, bit for
+/// bit, for batches of every length around the block's, with degenerate
+/// rays among them, without a hit so far and after another tracer's (kept
+/// when nearer or as near, replaced when farther).
 #[test]
 fn leaf_batches_are_single_rays_bit_for_bit() {
     let mut rng = crate::rng::Rng::new(3, 5);
     let mut u = || rng.next_float::<f32>();
     let mut point = |scale: f32| Vec3A::new(u() - 0.5, u() - 0.5, u() - 0.5) * scale;
-    for (triangles, spheres, disks) in [(1, 1, 0), (3, 2, 1), (5, 1, 2), (8, 0, 0), (0, 2, 1)] {
+    // (faces, spheres, disks); one more face repeats the first.
+    for (faces, spheres, disks) in [(1, 1, 0), (3, 3, 1), (4, 1, 2), (7, 0, 0), (0, 2, 1)] {
         let (mut prims, mut shapes, mut meshes) = (Vec::new(), Vec::new(), Vec::new());
         let mut add = |g: Geometry, meshes: &mut Vec<Mesh>| {
             prims.extend(g.into_primitives(meshes));
             shapes.resize(prims.len(), shapes.len() as u32);
         };
-        if triangles > 0 {
-            let v: Vec<[f64; 3]> = (0..3 * triangles)
-                .map(|_| point(3.0).as_dvec3().to_array())
+        if faces > 0 {
+            let v: Vec<[f64; 3]> = (0..3 * faces)
+                .map(|_| point(6.0).as_dvec3().to_array())
                 .collect();
-            let f: Vec<[i64; 3]> = (0..triangles as i64)
+            let f: Vec<[i64; 3]> = (0..faces as i64)
                 .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                .chain([[0, 1, 2]])
                 .collect();
             add(
                 Geometry::Mesh(Mesh::new(&v, &f, None, true).unwrap()),
                 &mut meshes,
             );
         }
+        let around = point(2.0).as_dvec3().to_array();
         for k in 0..spheres {
-            let c = point(2.0).as_dvec3().to_array();
-            let radius = if k == 0 { 2.5 } else { 0.4 };
+            // The first around the origins, the second the same again.
+            let (c, radius) = if k < 2 {
+                (around, 2.5)
+            } else {
+                (point(2.0).as_dvec3().to_array(), 0.4)
+            };
             add(Geometry::sphere(c, radius, false).unwrap(), &mut meshes);
         }
         for _ in 0..disks {
@@ -194,16 +203,32 @@ fn leaf_batches_are_single_rays_bit_for_bit() {
         }
         let accel = Accel::build(prims, shapes, meshes, false).unwrap();
         assert!(accel.bvh.is_none());
-        let rays: Vec<Ray> = (0..300)
+        let mut rays: Vec<Ray> = (0..296)
             .map(|i| Ray {
                 o: point(4.0),
                 d: point(1.0),
                 tmax: [f32::INFINITY, 2.0, 0.5][i % 3],
             })
             .collect();
+        let ray = rays[0];
+        rays.splice(
+            100..100,
+            [
+                Ray {
+                    o: Vec3A::splat(f32::NAN),
+                    ..ray
+                },
+                Ray {
+                    d: Vec3A::ZERO,
+                    ..ray
+                },
+                Ray { tmax: 0.0, ..ray },
+                Ray { tmax: -1.0, ..ray },
+            ],
+        );
         let bits =
             |h: &Option<Hit>| h.map(|h| (h.primitive, h.t.to_bits(), h.bary.map(f32::to_bits)));
-        let mut hit = 0;
+        let (mut on_kind, mut replaced) = ([0; 3], 0);
         for n in [0, 1, 63, 64, 65, 129, 300] {
             let rays = &rays[..n];
             let (mut many, mut blocked) = (Vec::new(), Vec::new());
@@ -222,15 +247,22 @@ fn leaf_batches_are_single_rays_bit_for_bit() {
                     .copied()
                     .eq(rays.iter().map(|r| accel.occluded(r)))
             );
-            hit += one.iter().flatten().count();
-            // After another tracer's hits (a made-up primitive 99 at half
-            // the nearest distance, or at 1 where nothing was hit).
+            for h in one.iter().flatten() {
+                on_kind[match accel.primitives()[h.primitive as usize] {
+                    Primitive::Triangle { .. } => 0,
+                    Primitive::Sphere(_) => 1,
+                    Primitive::Disk(_) => 2,
+                }] += 1;
+            }
+            // After another tracer's hits (a made-up primitive 99), on every
+            // other ray: nearer than the leaf's, as near, or farther (at 1
+            // where the leaf has none).
             let theirs: Vec<Option<Hit>> = one
                 .iter()
                 .enumerate()
                 .map(|(i, h)| {
                     (i % 2 == 0).then_some(Hit {
-                        t: h.map_or(1.0, |h| 0.5 * h.t),
+                        t: h.map_or(1.0, |h| [0.5, 1.0, 2.0][(i / 2) % 3] * h.t),
                         primitive: 99,
                         bary: [0.25, 0.5],
                     })
@@ -244,6 +276,7 @@ fn leaf_batches_are_single_rays_bit_for_bit() {
                     ..*ray
                 };
                 assert_eq!(bits(hits), bits(&accel.leaf.intersect(&shrunk).or(*theirs)));
+                replaced += usize::from(theirs.is_some() && hits.unwrap().primitive != 99);
             }
             let mut blocked: Vec<bool> = (0..n).map(|i| i % 5 == 0).collect();
             accel.leaf.occluded_many(rays, &mut blocked);
@@ -251,7 +284,13 @@ fn leaf_batches_are_single_rays_bit_for_bit() {
                 assert_eq!(*b, i % 5 == 0 || accel.occluded(ray));
             }
         }
-        assert!(hit > 30, "{hit}");
+        // Every kind of primitive there was hit, and some of the other
+        // tracer's hits were replaced.
+        let present = [faces > 0, spheres > 0, disks > 0];
+        for (count, present) in on_kind.iter().zip(present) {
+            assert_eq!(*count > 0, present, "{on_kind:?}");
+        }
+        assert!(replaced > 10, "{replaced}");
     }
 }
 

@@ -74,26 +74,27 @@ impl Sphere {
         hit.then_some(Candidate { t, bary: [0.0; 2] })
     }
 
-    /// Whether a root lies in `(0, tmax)` ([`Sphere::root_within`]).
+    /// Whether a root lies in `(0, tmax)` ([`Sphere::root_within`]; no
+    /// division, so no branch is needed to skip one).
     #[inline(always)]
     pub fn occludes(&self, ray: &Ray) -> bool {
-        self.roots(ray)
-            .is_some_and(|(q, a, k)| Self::root_within(q, a, k, ray.tmax))
+        self.occludes_branchless(ray.o.to_array(), ray.d.to_array(), ray.tmax)
     }
 
     /// [`Sphere::intersect`] of the ray from `o` along `d` without
     /// branches, for a batch of rays at SIMD width: whether it meets the
     /// sphere in `(0, tmax)`, and where (the same bits as `intersect`).
     #[inline(always)]
-    pub fn hit_lanes(&self, o: [f32; 3], d: [f32; 3], tmax: f32) -> (bool, f32) {
+    pub fn hit_branchless(&self, o: [f32; 3], d: [f32; 3], tmax: f32) -> (bool, f32) {
         let [disc, q, a, k] = self.terms(o, d);
         let (hit, t) = Self::nearer_root(q, a, k, tmax);
         ((disc >= 0.0) & hit, t)
     }
 
-    /// [`Sphere::occludes`] without branches ([`Sphere::hit_lanes`]).
+    /// Whether a root of the ray from `o` along `d` lies in `(0, tmax)`,
+    /// without branches ([`Sphere::hit_branchless`]).
     #[inline(always)]
-    pub fn occludes_lanes(&self, o: [f32; 3], d: [f32; 3], tmax: f32) -> bool {
+    pub fn occludes_branchless(&self, o: [f32; 3], d: [f32; 3], tmax: f32) -> bool {
         let [disc, q, a, k] = self.terms(o, d);
         (disc >= 0.0) & Self::root_within(q, a, k, tmax)
     }
