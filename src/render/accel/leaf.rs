@@ -104,20 +104,15 @@ impl Leaf {
     /// For each ray of `rays` and its hit so far in `hits` (another ray
     /// tracer's, or `None`), the hit of [`Leaf::intersect`] on the ray
     /// shortened to it if there is one, else the hit so far: what
-    /// `leaf.intersect(shortened).or(hits[i])` gives, bit for bit. The triangles and spheres are tested
-    /// against [`BLOCK`] rays at once, at SIMD width.
+    /// `leaf.intersect(shortened).or(hits[i])` gives, bit for bit. The
+    /// triangles and spheres are tested against [`BLOCK`] rays at once, at
+    /// SIMD width.
     pub(super) fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-        debug_assert_eq!(rays.len(), hits.len());
-        if self.triangles.is_empty() && self.spheres.is_empty() && self.disks.is_empty() {
-            return;
-        }
-        simd::dispatch(
+        self.by_blocks(
+            rays,
+            hits,
             #[inline(always)]
-            |_| {
-                for (rays, hits) in rays.chunks(BLOCK).zip(hits.chunks_mut(BLOCK)) {
-                    self.intersect_block(rays, hits);
-                }
-            },
+            |rays, hits| self.intersect_block(rays, hits),
         );
     }
 
@@ -157,15 +152,28 @@ impl Leaf {
     /// `blocked[i] ||` [`Leaf::occludes`] of `rays[i]`, for each, the
     /// triangles and spheres tested against [`BLOCK`] rays at once.
     pub(super) fn occluded_many(&self, rays: &[Ray], blocked: &mut [bool]) {
-        debug_assert_eq!(rays.len(), blocked.len());
+        self.by_blocks(
+            rays,
+            blocked,
+            #[inline(always)]
+            |rays, blocked| self.occluded_block(rays, blocked),
+        );
+    }
+
+    /// `test` of each block of at most [`BLOCK`] rays of `rays` and their
+    /// rows of `out`, compiled for the widest vector unit
+    /// ([`simd::dispatch`]); nothing at all for an empty leaf.
+    #[inline(always)]
+    fn by_blocks<T>(&self, rays: &[Ray], out: &mut [T], test: impl Fn(&[Ray], &mut [T])) {
+        debug_assert_eq!(rays.len(), out.len());
         if self.triangles.is_empty() && self.spheres.is_empty() && self.disks.is_empty() {
             return;
         }
         simd::dispatch(
             #[inline(always)]
             |_| {
-                for (rays, blocked) in rays.chunks(BLOCK).zip(blocked.chunks_mut(BLOCK)) {
-                    self.occluded_block(rays, blocked);
+                for (rays, out) in rays.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+                    test(rays, out);
                 }
             },
         );
