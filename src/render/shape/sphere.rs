@@ -74,8 +74,8 @@ impl Sphere {
         hit.then_some(Candidate { t, bary: [0.0; 2] })
     }
 
-    /// Whether a root lies in `(0, tmax)` ([`Sphere::root_within`]; no
-    /// division, so no branch is needed to skip one).
+    /// Whether a root lies in `(0, tmax)`, tested without a division (so
+    /// no branch is needed to skip one).
     #[inline(always)]
     pub fn occludes(&self, ray: &Ray) -> bool {
         self.occludes_branchless(ray.o.to_array(), ray.d.to_array(), ray.tmax)
