@@ -127,7 +127,6 @@ pub struct Wavefront {
     surfaces: Vec<(u32, SurfacePoint)>,
     /// What the stream of next rays found.
     found: Vec<Option<Hit>>,
-    next: Vec<Path>,
     rays: Vec<Ray>,
     shadows: Vec<Unshadowed>,
     shadow_rays: Vec<Ray>,
@@ -169,7 +168,6 @@ impl Wavefront {
             self.hits,
             self.surfaces,
             self.found,
-            self.next,
             self.rays,
             self.shadows,
             self.shadow_rays,
@@ -227,7 +225,6 @@ impl Wavefront {
         l: &mut [[f32; 3]],
     ) -> Result<()> {
         while !self.paths.is_empty() {
-            self.next.clear();
             self.rays.clear();
             self.shadows.clear();
             self.shadow_rays.clear();
@@ -257,13 +254,16 @@ impl Wavefront {
                 let samples = self.paths.iter().map(|p| (p.pixel, p.index));
                 self.drawn.draw(streams, samples, &self.dims)?;
             }
-            let shading_points = self.hits.iter().zip(&self.surfaces);
-            for (k, (mut path, (hit, surface))) in
-                self.paths.drain(..).zip(shading_points).enumerate()
-            {
+            // Each path shaded where it lies; those that stop leave the
+            // list (the others move down over them, not into another list).
+            let mut shading_points = self.hits.iter().zip(&self.surfaces).enumerate();
+            self.paths.retain_mut(|path| {
+                let Some((k, (hit, surface))) = shading_points.next() else {
+                    return false;
+                };
                 let stream = &mut streams[path.pixel as usize];
                 stream.start(path.index);
-                swap_generators(stream, &mut path);
+                swap_generators(stream, path);
                 let drawn = (&self.dims[..], &self.drawn.values[..]);
                 let mut numbers = Numbers::new(stream, drawn, k);
                 let bounce = Bounce {
@@ -275,13 +275,13 @@ impl Wavefront {
                     by_inversion: &mut self.by_inversion,
                 };
                 let l = &mut l[path.slot as usize];
-                let goes_on = bounce.shade(&mut path, (hit.t, *surface), &mut numbers, l);
-                swap_generators(numbers.stream, &mut path);
+                let goes_on = bounce.shade(path, (hit.t, *surface), &mut numbers, l);
+                swap_generators(numbers.stream, path);
                 if goes_on {
                     self.rays.push(path.ray);
-                    self.next.push(path);
                 }
-            }
+                goes_on
+            });
             // The deferred environment samples, together: their table reads
             // overlap, and their directions are computed at SIMD width.
             self.light_samples.clear();
@@ -322,21 +322,27 @@ impl Wavefront {
                 .accel()
                 .intersect_many(&self.rays, false, &mut self.stream, &mut self.found)?;
             self.hits.clear();
-            for (path, &found) in self.next.drain(..).zip(&self.found) {
+            let mut found = self.found.iter();
+            self.paths.retain(|path| {
+                let Some(&found) = found.next() else {
+                    return false;
+                };
                 let hit = if scene.moves() {
                     scene.intersect_movers(&path.ray, path.time, found)
                 } else {
                     found
                 };
                 if let Some(hit) = hit {
-                    self.paths.push(path);
                     self.hits.push(hit);
-                } else if scene.environment().is_some() && settings.strategy != Strategy::Emitter {
+                    return true;
+                }
+                if scene.environment().is_some() && settings.strategy != Strategy::Emitter {
                     let mis = settings.strategy == Strategy::Mis;
                     let pdf = mis.then_some(path.bsdf_pdf);
                     self.escaped.push(path.slot, path.ray.d, path.beta, pdf);
                 }
-            }
+                false
+            });
         }
         Ok(())
     }
