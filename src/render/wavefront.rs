@@ -216,7 +216,9 @@ impl Wavefront {
     /// [`Wavefront::escaped`].
     ///
     /// # Errors
-    /// [`crate::Error::Memory`] when the ray streams' memory cannot be had.
+    /// [`crate::Error::Memory`] when the ray streams' memory cannot be had;
+    /// the paths left are then meaningless ([`Wavefront::start`] again
+    /// before the next `trace`).
     pub fn trace(
         &mut self,
         scene: &Scene,
@@ -254,11 +256,15 @@ impl Wavefront {
                 let samples = self.paths.iter().map(|p| (p.pixel, p.index));
                 self.drawn.draw(streams, samples, &self.dims)?;
             }
-            // Each path shaded where it lies; those that stop leave the
-            // list (the others move down over them, not into another list).
+            // Each path shaded in place; those that stop are removed, the
+            // others keep their order (so that they line up with their rays
+            // in `self.rays`, then with `self.found`).
+            debug_assert_eq!(self.hits.len(), self.paths.len());
+            debug_assert_eq!(self.surfaces.len(), self.paths.len());
             let mut shading_points = self.hits.iter().zip(&self.surfaces).enumerate();
             self.paths.retain_mut(|path| {
                 let Some((k, (hit, surface))) = shading_points.next() else {
+                    debug_assert!(false, "a path without its hit");
                     return false;
                 };
                 let stream = &mut streams[path.pixel as usize];
@@ -321,10 +327,14 @@ impl Wavefront {
             scene
                 .accel()
                 .intersect_many(&self.rays, false, &mut self.stream, &mut self.found)?;
+            // The paths whose next ray meets the scene stay, with their
+            // hits; the others' rays go to the escaped rays.
+            debug_assert_eq!(self.found.len(), self.paths.len());
             self.hits.clear();
-            let mut found = self.found.iter();
+            let mut stream_hits = self.found.iter();
             self.paths.retain(|path| {
-                let Some(&found) = found.next() else {
+                let Some(&found) = stream_hits.next() else {
+                    debug_assert!(false, "a path without its ray's hit");
                     return false;
                 };
                 let hit = if scene.moves() {
