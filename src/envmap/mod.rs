@@ -245,6 +245,24 @@ impl EnvMap {
         &self.options
     }
 
+    /// The same map with `compensate` set (its radiance, its mapping and
+    /// sampling; the density of MIS compensation), or `None` when it is
+    /// already compensated.
+    ///
+    /// # Errors
+    /// [`Error::Memory`] when the copy or its tables cannot be had.
+    pub fn compensated(&self) -> Result<Option<EnvMap>> {
+        if self.options.compensate {
+            return Ok(None);
+        }
+        let options = Options {
+            compensate: true,
+            ..self.options
+        };
+        let image = self.image.try_clone()?;
+        Self::from_image(image, options).map(Some)
+    }
+
     /// The local direction of the world direction `d`: `to_worldᵀ·d`.
     #[inline(always)]
     fn to_local<F: Real>(&self, d: V3<F>) -> V3<F> {

@@ -342,6 +342,14 @@ fn compensation_removes_the_mean() {
         assert_eq!(m.pdf(floor), 0.0);
         assert!(plain.pdf(floor) > 0.0);
         assert!((integrate(|d| m.pdf(d)) - 1.0).abs() < 5e-3);
+        // The twin the renderer draws under MIS is that map.
+        let twin = plain.compensated().unwrap().unwrap();
+        assert_eq!(twin.options(), m.options());
+        for p in [floor, m.uv_to_dir([0.45, 0.45]), m.uv_to_dir([0.5, 0.9])] {
+            assert_eq!(twin.pdf(p), m.pdf(p));
+            assert_eq!(twin.eval(p), plain.eval(p));
+        }
+        assert!(m.compensated().unwrap().is_none());
     }
     // A constant map is left as it is.
     let flat = EnvMap::new(

@@ -24,7 +24,7 @@
 use glam::Vec3A;
 
 use super::accel::Hit;
-use super::scene::{LightSample, Scene};
+use super::scene::{EnvDensity, LightSample, Scene};
 use super::shape::Ray;
 use crate::alloc;
 use crate::frame::Frame;
@@ -127,6 +127,17 @@ pub struct Settings {
 }
 
 impl Settings {
+    /// The density emitter sampling draws the environment by: compensated
+    /// under MIS (whose BSDF samples cover what it leaves out), complete
+    /// under emitter sampling alone.
+    pub(super) fn env_density(&self) -> EnvDensity {
+        if self.strategy == Strategy::Mis {
+            EnvDensity::Compensated
+        } else {
+            EnvDensity::Complete
+        }
+    }
+
     pub(super) fn weight(&self, pdf_a: f32, pdf_b: f32) -> f32 {
         self.heuristic.weight(pdf_a, pdf_b)
     }
@@ -311,7 +322,7 @@ pub fn add_escaped(scene: &Scene, settings: &Settings, escaped: &mut Escaped, l:
     env.eval_into(&escaped.dir, &mut escaped.radiance);
     if escaped.bsdf_pdf.iter().any(Option::is_some) {
         escaped.light_pdf.resize(n, 0.0);
-        scene.environment_pdf_into(&escaped.dir, &mut escaped.light_pdf);
+        scene.environment_pdf_into(&escaped.dir, &mut escaped.light_pdf, settings.env_density());
     }
     for i in 0..n {
         let w = escaped.bsdf_pdf[i].map_or(1.0, |p| settings.weight(p, escaped.light_pdf[i]));

@@ -15,14 +15,13 @@ use super::motion::{Motion, Mover};
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
 use crate::distr::Discrete1D;
-use crate::envmap::CellSampler;
 use crate::error::{Error, Result};
 use crate::math::luminance;
 use crate::phong::Phong;
 
 mod lights;
-use lights::{AreaLight, Light};
-pub use lights::{ChosenLight, Emission, InvertedSamples, LightSample};
+use lights::{AreaLight, EnvLight, Light};
+pub use lights::{ChosenLight, Emission, EnvDensity, InvertedSamples, LightSample};
 
 /// A surface's BSDF: the Phong BRDF (a diffuse material is Phong with
 /// `ρs = 0`), reflecting on the front side only unless `two_sided`, as in
@@ -200,11 +199,7 @@ impl Scene {
             let power = std::f64::consts::PI * radius * radius * env.luminance_integral();
             if power > 0.0 {
                 env_light = Some(lights.len() as u32);
-                let cells = match env {
-                    Environment::Map(map) => CellSampler::new(map)?,
-                    Environment::Constant(_) => None,
-                };
-                lights.push(Light::Environment { cells });
+                lights.push(Light::Environment(EnvLight::new(env)?));
                 powers.push(power);
             }
         }

@@ -5,6 +5,7 @@
 //! light samples they aim at.
 
 use glam::{Affine3A, DVec3, Quat, Vec3, Vec3A};
+use std::sync::Arc;
 
 use super::camera::{Camera, FovAxis};
 use super::integrator;
@@ -13,6 +14,7 @@ use super::scene::{Environment, Geometry, Material, Shape};
 use super::shape::Ray;
 use super::wavefront::{CameraSample, Wavefront};
 use super::{Heuristic, Integrator, Scene, Settings, Strategy};
+use crate::envmap::{EnvMap, Options};
 use crate::phong::{Phong, Selection};
 use crate::rng::Rng;
 use crate::sampler::zorder::ZOrder;
@@ -448,6 +450,63 @@ fn floor_under_a_constant_sky_reflects_its_albedo() {
         if strategy == Strategy::Bsdf {
             assert!(se < 1e-6, "{se}");
         }
+    }
+}
+
+/// A sky of radiance 1 with a block of 50. MIS draws it by its
+/// compensated density, never in the dim part (whose light BSDF sampling
+/// brings, with MIS weight 1), emitter sampling alone by the complete one;
+/// and a floor under it gets the same light by both, with either
+/// integrator, as by BSDF sampling (which reads no density of the map).
+#[test]
+fn mis_draws_a_compensated_sky_and_stays_unbiased() {
+    let (w, h) = (16, 9);
+    let mut data = vec![1.0f32; w * h * 3];
+    for y in 2..7 {
+        for x in 4..12 {
+            data[(y * w + x) * 3..(y * w + x) * 3 + 3].fill(50.0);
+        }
+    }
+    let map = EnvMap::new(w, h, &data, Options::default()).unwrap();
+    let floor = Shape {
+        geometry: rectangle(Affine3A::from_scale(Vec3::splat(50.0))),
+        material: diffuse(0.7),
+        emission: None,
+        motion: None,
+    };
+    let sky = Environment::Map(Arc::new(map));
+    let scene = Scene::new(vec![floor], Some(sky), camera(), 4, 4).unwrap();
+    let mut rng = Rng::new(3, 0);
+    for (strategy, dim_least, dim_most) in [(Strategy::Emitter, 20, 4096), (Strategy::Mis, 0, 0)] {
+        let density = settings(Integrator::Direct, strategy).env_density();
+        let dim = (0..4096)
+            .filter(|_| {
+                let light = scene.choose_light(0.5, density).unwrap();
+                let u = [rng.next_float(), rng.next_float()];
+                let bits = light.cells().map(|_| rng.next_u64());
+                let ls = scene.sample_chosen(light, Vec3A::ZERO, u, bits).unwrap();
+                ls.radiance[0] <= 1.0 + 1e-5
+            })
+            .count();
+        assert!(
+            (dim_least..=dim_most).contains(&dim),
+            "{strategy:?}: {dim} dim draws"
+        );
+    }
+    let (from, to) = (Vec3A::new(0.0, 0.3, 1.0), Vec3A::ZERO);
+    let bsdf = settings(Integrator::Direct, Strategy::Bsdf);
+    let (reference, se_ref) = estimate(&scene, from, to, &bsdf, 1 << 18);
+    for (integrator, strategy) in [Integrator::Direct, Integrator::Path]
+        .into_iter()
+        .flat_map(|i| [Strategy::Emitter, Strategy::Mis].map(|s| (i, s)))
+    {
+        let s = settings(integrator, strategy);
+        let (mean, se) = estimate(&scene, from, to, &s, 1 << 16);
+        let bound = 5.0 * se.hypot(se_ref);
+        assert!(
+            (mean - reference).abs() < bound,
+            "{integrator:?} {strategy:?}: {mean} ± {se}, BSDF sampling {reference} ± {se_ref}"
+        );
     }
 }
 

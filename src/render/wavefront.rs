@@ -295,11 +295,13 @@ impl Wavefront {
                 &self.by_cells.draws,
                 &mut self.env_samples,
                 &mut self.light_samples,
+                settings.env_density(),
             );
             scene.sample_environment_inverted(
                 &self.by_inversion.draws,
                 &mut self.inverted,
                 &mut self.light_samples,
+                settings.env_density(),
             );
             let waiting = (self.by_cells.vertices.iter()).chain(&self.by_inversion.vertices);
             debug_assert_eq!(self.light_samples.len(), waiting.clone().count());
@@ -479,7 +481,7 @@ impl Bounce<'_> {
             // The independent sampler picks environment cells from extra
             // random bits (an alias table); the others by inversion, which
             // keeps their stratification.
-            if let Some(light) = scene.choose_light(choice) {
+            if let Some(light) = scene.choose_light(choice, settings.env_density()) {
                 let bits = light
                     .cells()
                     .and(numbers.independent())

@@ -2,6 +2,7 @@
 //! sampled, and the densities of those draws.
 
 use glam::Vec3A;
+use std::sync::Arc;
 
 use super::{Environment, Scene};
 use crate::distr::Discrete1D;
@@ -14,9 +15,76 @@ use crate::render::shape::{Ray, SurfacePoint};
 pub(super) enum Light {
     /// An area light.
     Area(AreaLight),
-    /// The environment, drawn by its map's [`CellSampler`] where it has
-    /// one.
-    Environment { cells: Option<CellSampler> },
+    /// The environment, by either density.
+    Environment(EnvLight),
+}
+
+/// The density emitter sampling draws the environment by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvDensity {
+    /// The environment's own: positive wherever it shines, so that emitter
+    /// sampling alone is unbiased (and light tracing and bidirectional
+    /// path tracing, whose weights need every strategy's density).
+    Complete,
+    /// For MIS with BSDF sampling (the direct and path integrators), a
+    /// map's density with `compensate` ([`EnvMap::compensated`]: its
+    /// luminance less the mean, clamped at 0; MIS compensation, Karlík et
+    /// al. 2019, as pbrt-v4 samples its image lights under MIS): the dark
+    /// parts are left to BSDF sampling, whose MIS weight is 1 there. A
+    /// constant environment keeps its uniform density.
+    Compensated,
+}
+
+/// The environment as a light: a way to draw it by each density.
+#[derive(Clone, Debug)]
+pub(in crate::render) struct EnvLight {
+    complete: EnvDraw,
+    compensated: Option<EnvDraw>,
+}
+
+/// One density of the environment: the environment drawn by it (a map's
+/// own or its compensated twin, or a constant) and the map's
+/// [`CellSampler`] where it has one.
+#[derive(Clone, Debug)]
+struct EnvDraw {
+    env: Environment,
+    cells: Option<CellSampler>,
+}
+
+impl EnvLight {
+    /// The light of `env`; a map gets its compensated twin.
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when the twin or a cell sampler cannot be
+    /// had.
+    pub(in crate::render) fn new(env: &Environment) -> crate::Result<Self> {
+        let draw = |env: Environment| -> crate::Result<EnvDraw> {
+            let cells = match &env {
+                Environment::Map(map) => CellSampler::new(map)?,
+                Environment::Constant(_) => None,
+            };
+            Ok(EnvDraw { env, cells })
+        };
+        let twin = match env {
+            Environment::Map(map) => map.compensated()?,
+            Environment::Constant(_) => None,
+        };
+        Ok(EnvLight {
+            complete: draw(env.clone())?,
+            compensated: twin
+                .map(|m| draw(Environment::Map(Arc::new(m))))
+                .transpose()?,
+        })
+    }
+
+    /// The draw by `density` (the complete one where there is no twin).
+    #[inline]
+    fn draw(&self, density: EnvDensity) -> &EnvDraw {
+        match (density, &self.compensated) {
+            (EnvDensity::Compensated, Some(twin)) => twin,
+            _ => &self.complete,
+        }
+    }
 }
 
 /// A light chosen for emitter sampling ([`Scene::choose_light`]) and the
@@ -25,21 +93,23 @@ pub(super) enum Light {
 pub struct ChosenLight<'a> {
     light: &'a Light,
     pmf: f32,
+    density: EnvDensity,
 }
 
 impl ChosenLight<'_> {
     /// Whether the light is the environment.
     #[inline]
     pub fn is_environment(&self) -> bool {
-        matches!(self.light, Light::Environment { .. })
+        matches!(self.light, Light::Environment(_))
     }
 
-    /// The environment map's cell sampler, when the light is a map that
-    /// has one: its draws take 64 random bits.
+    /// The environment map's cell sampler (of the density it was chosen
+    /// for), when the light is a map that has one: its draws take 64
+    /// random bits.
     #[inline]
     pub fn cells(&self) -> Option<&CellSampler> {
         match self.light {
-            Light::Environment { cells } => cells.as_ref(),
+            Light::Environment(light) => light.draw(self.density).cells.as_ref(),
             Light::Area(_) => None,
         }
     }
@@ -154,18 +224,26 @@ impl Scene {
             .map_or(0.0, |env| self.choice_pmf(self.env_light) * env.pdf(d))
     }
 
-    /// `out[i]`: the density per steradian with which emitter sampling
-    /// draws the environment direction `d[i]` (the choice of the
+    /// `out[i]`: the density per steradian with which emitter sampling by
+    /// `density` draws the environment direction `d[i]` (the choice of the
     /// environment among the lights included).
-    pub fn environment_pdf_into(&self, d: &[[f32; 3]], out: &mut [f32]) {
+    pub fn environment_pdf_into(&self, d: &[[f32; 3]], out: &mut [f32], density: EnvDensity) {
         let pmf = self.choice_pmf(self.env_light);
-        match &self.environment {
+        match self.env_draw(density).map(|draw| &draw.env) {
             Some(Environment::Map(env)) => {
                 env.pdf_into(d, out, |_| true);
                 out.iter_mut().for_each(|p| *p *= pmf);
             }
             Some(env) => out.fill(pmf * env.pdf(Vec3A::Z)),
             None => out.fill(0.0),
+        }
+    }
+
+    /// The environment light's draw by `density`, when it is a light.
+    fn env_draw(&self, density: EnvDensity) -> Option<&EnvDraw> {
+        match self.lights.get(self.env_light? as usize)? {
+            Light::Environment(light) => Some(light.draw(density)),
+            Light::Area(_) => None,
         }
     }
 
@@ -201,7 +279,7 @@ impl Scene {
                         }
                     }
                 }
-                Light::Environment { .. } => {
+                Light::Environment(_) => {
                     if let Some(env) = &self.environment {
                         pdf += self.choice_pmf(Some(index as u32)) * env.pdf(d);
                     }
@@ -235,7 +313,7 @@ impl Scene {
         let index = choice.sample(u[0]);
         let pmf = choice.pmf(index) as f32;
         match &self.lights[index] {
-            Light::Environment { .. } => {
+            Light::Environment(_) => {
                 let (d, pdf, radiance) = self.environment.as_ref()?.sample([u[1], u[2]], None);
                 (pdf > 0.0).then_some(Emission::Environment {
                     d,
@@ -263,8 +341,9 @@ impl Scene {
     /// (`u[1..3]`; a map's cell by its [`CellSampler`] from 64 bits of
     /// `bits` when given, else by
     /// [`EnvMap::sample`](crate::envmap::EnvMap::sample) of `u[1..3]`, with
-    /// the same density). `None` when the scene has no light or the sample
-    /// carries no radiance.
+    /// the same density), by the complete density ([`EnvDensity::Complete`]).
+    /// `None` when the scene has no light or the sample carries no
+    /// radiance.
     #[inline]
     pub fn sample_light(
         &self,
@@ -272,38 +351,41 @@ impl Scene {
         u: [f32; 3],
         bits: Option<impl FnOnce() -> u64>,
     ) -> Option<LightSample> {
-        let light = self.choose_light(u[0])?;
+        let light = self.choose_light(u[0], EnvDensity::Complete)?;
         let bits = light.cells().and(bits).map(|bits| bits());
         self.sample_chosen(light, x, [u[1], u[2]], bits)
     }
 
-    /// [`Scene::sample_chosen`] of the environment, chosen with probability
-    /// `pmf`: by its map's cell sampler and 64 random bits when `cells`
-    /// gives them, else by inversion of `u`.
+    /// [`Scene::sample_chosen`] of the environment by `draw`, chosen with
+    /// probability `pmf`: by its map's cell sampler and the 64 random
+    /// `bits` when both are there, else by inversion of `u`.
     #[inline]
-    pub fn sample_environment(
-        &self,
+    fn sample_environment(
+        draw: &EnvDraw,
         pmf: f32,
         u: [f32; 2],
-        cells: Option<(&CellSampler, u64)>,
+        bits: Option<u64>,
     ) -> Option<LightSample> {
-        let (d, pdf, radiance) = self.environment.as_ref()?.sample(u, cells);
+        let (d, pdf, radiance) = draw.env.sample(u, draw.cells.as_ref().zip(bits));
         environment_sample(d, pdf, pmf, radiance)
     }
 
-    /// [`Scene::sample_environment`] by the map's cell sampler
-    /// ([`Scene::environment_cells`]) of each `(bits, u)` of `draws`, the
-    /// same samples, drawn together ([`CellSampler::sample_many`]) and
-    /// appended to `out` (`scratch`: the map's samples); nothing without a
-    /// cell sampler.
+    /// The environment drawn by `density` (by the map's cell sampler,
+    /// [`Scene::environment_cells`]) for each `(bits, u)` of `draws`: the
+    /// samples [`Scene::sample_chosen`] draws one at a time, drawn
+    /// together ([`CellSampler::sample_many`]) and appended to `out`
+    /// (`scratch`: the map's samples); nothing without a cell sampler.
     pub fn sample_environment_cells(
         &self,
         draws: &[(u64, [f32; 2])],
         scratch: &mut Vec<EnvSample<f32>>,
         out: &mut Vec<Option<LightSample>>,
+        density: EnvDensity,
     ) {
-        let (Some(Environment::Map(env)), Some(cells)) =
-            (&self.environment, self.environment_cells())
+        let Some(EnvDraw {
+            env: Environment::Map(env),
+            cells: Some(cells),
+        }) = self.env_draw(density)
         else {
             return;
         };
@@ -317,17 +399,23 @@ impl Scene {
         );
     }
 
-    /// [`Scene::sample_environment`] by inversion (no cells) of each `u` of
-    /// `us`, the same samples, drawn together ([`EnvMap::sample_into`], in
-    /// `f64` as one draw is) and appended to `out` (`scratch`: the map's
-    /// samples); nothing when the environment is not a map.
+    /// The environment drawn by `density`, by inversion (no cells), for
+    /// each `u` of `us`: the samples [`Scene::sample_chosen`] draws one at
+    /// a time, drawn together ([`EnvMap::sample_into`], in `f64` as one
+    /// draw is) and appended to `out` (`scratch`: the map's samples);
+    /// nothing when the environment is not a map.
     pub fn sample_environment_inverted(
         &self,
         us: &[[f64; 2]],
         scratch: &mut InvertedSamples,
         out: &mut Vec<Option<LightSample>>,
+        density: EnvDensity,
     ) {
-        let Some(env) = self.environment_map() else {
+        let Some(EnvDraw {
+            env: Environment::Map(env),
+            ..
+        }) = self.env_draw(density)
+        else {
             return;
         };
         let pmf = self.choice_pmf(self.env_light);
@@ -368,15 +456,6 @@ impl Scene {
         }
     }
 
-    /// The environment map's cell sampler, when the scene's environment
-    /// is a map that has one.
-    pub fn environment_cells(&self) -> Option<&CellSampler> {
-        match self.lights.get(self.env_light? as usize)? {
-            Light::Environment { cells } => cells.as_ref(),
-            Light::Area(_) => None,
-        }
-    }
-
     /// Whether the scene has more than one light, so that
     /// [`Scene::choose_light`] reads its number.
     #[inline]
@@ -384,15 +463,17 @@ impl Scene {
         self.lights.len() > 1
     }
 
-    /// The light emitter sampling draws by `u` (by power), or `None` when
-    /// the scene has none.
+    /// The light emitter sampling draws by `u` (by power), to be sampled
+    /// by `density` if it is the environment, or `None` when the scene has
+    /// none.
     #[inline]
-    pub fn choose_light(&self, u: f32) -> Option<ChosenLight<'_>> {
+    pub fn choose_light(&self, u: f32, density: EnvDensity) -> Option<ChosenLight<'_>> {
         let choice = self.light_choice.as_ref()?;
         let index = choice.sample(u);
         Some(ChosenLight {
             light: &self.lights[index],
             pmf: choice.pmf(index) as f32,
+            density,
         })
     }
 
@@ -402,15 +483,17 @@ impl Scene {
     #[inline]
     pub fn sample_chosen(
         &self,
-        ChosenLight { light, pmf }: ChosenLight<'_>,
+        ChosenLight {
+            light,
+            pmf,
+            density,
+        }: ChosenLight<'_>,
         x: Vec3A,
         u: [f32; 2],
         bits: Option<u64>,
     ) -> Option<LightSample> {
         match light {
-            Light::Environment { cells } => {
-                self.sample_environment(pmf, u, cells.as_ref().zip(bits))
-            }
+            Light::Environment(env) => Self::sample_environment(env.draw(density), pmf, u, bits),
             Light::Area(area) => {
                 let (primitive, u2) = self.pick_primitive(area, u);
                 // A sphere seen from outside: by the cone it subtends.
