@@ -82,7 +82,14 @@ def render(scene: Scene, spp: int | None = None, *,
     strategy : "bsdf", "emitter" or "mis"
         How light is found: BSDF sampling, emitter sampling (envmap
         importance sampling; area lights uniformly by area, converted to
-        solid angle; lights chosen by power), or MIS of the two.
+        solid angle; lights chosen by power), or MIS of the two. Under MIS
+        an environment map is drawn by its compensated density (as
+        ``EnvMap(..., compensate=True)``: luminance less its mean, clamped
+        at 0; MIS compensation, as pbrt-v4 samples image lights under MIS),
+        which leaves its dark parts to BSDF sampling (an estimate with the
+        same mean and about 1.3 times less variance on the demo scene);
+        emitter sampling alone, "ptracer" and "bdpt" draw it by its own
+        density.
     heuristic : "balance" or "power"
         The MIS weight (power: exponent 2, as Mitsuba).
     max_depth : int, optional

@@ -77,7 +77,10 @@ record! {
 /// compensate : bool
 ///     MIS compensation: the mean luminance is subtracted before the
 ///     sampling density is built (Karlik et al. 2019), as Mitsuba's
-///     ``mis_compensation``. Only for use in MIS.
+///     ``mis_compensation``. Only for use in MIS. ``render`` needs no
+///     compensated map: under MIS it draws every map by its compensated
+///     density by itself, and by its own under emitter sampling alone
+///     (where a map given with ``compensate=True`` would be biased).
 ///
 /// Everything after ``image`` is keyword-only.
 #[pyclass(module = "mcsample._core", name = "EnvMap", frozen)]

@@ -370,8 +370,8 @@ impl Scene {
         environment_sample(d, pdf, pmf, radiance)
     }
 
-    /// The environment drawn by `density` (by the map's cell sampler,
-    /// [`Scene::environment_cells`]) for each `(bits, u)` of `draws`: the
+    /// The environment drawn by `density` (by that density's cell sampler,
+    /// [`ChosenLight::cells`]) for each `(bits, u)` of `draws`: the
     /// samples [`Scene::sample_chosen`] draws one at a time, drawn
     /// together ([`CellSampler::sample_many`]) and appended to `out`
     /// (`scratch`: the map's samples); nothing without a cell sampler.
