@@ -31,18 +31,6 @@ pub struct Image {
 pub type Corners<F> = ([usize; 4], [F; 4]);
 
 impl Image {
-    /// A copy, its texels allocated fallibly.
-    ///
-    /// # Errors
-    /// [`Error::Memory`] when the texels cannot be had.
-    pub fn try_clone(&self) -> Result<Self> {
-        Ok(Image {
-            width: self.width,
-            height: self.height,
-            texels: alloc::copy(&self.texels, "the map's texels")?,
-        })
-    }
-
     /// An image of `width × height` RGB texels (`data` row-major, 3 floats
     /// a texel) for `mapping`, checked to be finite and `>= 0`. Lat-long
     /// maps narrower than 2 columns or shorter than 3 rows are padded by

@@ -81,6 +81,7 @@ use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::warp::V3;
 use distribution::Distribution;
+use std::sync::Arc;
 
 #[cfg(doc)]
 use crate::distr::PiecewiseConstant2D;
@@ -185,7 +186,8 @@ impl Default for Options {
 /// sampler of directions with a density close to `L`.
 #[derive(Clone, Debug)]
 pub struct EnvMap {
-    image: Image,
+    /// Shared with the compensated twin ([`EnvMap::compensated`]).
+    image: Arc<Image>,
     options: Options,
     distribution: Distribution,
     polar: Option<PolarTable>,
@@ -228,7 +230,7 @@ impl EnvMap {
         }
         let (distribution, polar) = distribution::build(&image, &options)?;
         Ok(EnvMap {
-            image,
+            image: Arc::new(image),
             options,
             distribution,
             polar,
@@ -245,12 +247,12 @@ impl EnvMap {
         &self.options
     }
 
-    /// The same map with `compensate` set (its radiance, its mapping and
-    /// sampling; the density of MIS compensation), or `None` when it is
-    /// already compensated.
+    /// The same map with `compensate` set (its texels shared, its mapping
+    /// and sampling; the density of MIS compensation), or `None` when it
+    /// is already compensated.
     ///
     /// # Errors
-    /// [`Error::Memory`] when the copy or its tables cannot be had.
+    /// [`Error::Memory`] when its tables cannot be had.
     pub fn compensated(&self) -> Result<Option<EnvMap>> {
         if self.options.compensate {
             return Ok(None);
@@ -259,8 +261,13 @@ impl EnvMap {
             compensate: true,
             ..self.options
         };
-        let image = self.image.try_clone()?;
-        Self::from_image(image, options).map(Some)
+        let (distribution, polar) = distribution::build(&self.image, &options)?;
+        Ok(Some(EnvMap {
+            image: Arc::clone(&self.image),
+            options,
+            distribution,
+            polar,
+        }))
     }
 
     /// The local direction of the world direction `d`: `to_worldᵀ·d`.
