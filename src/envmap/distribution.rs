@@ -66,22 +66,37 @@ pub(super) fn build(
 }
 
 /// Texel luminances, with the mean subtracted and clamped at 0 when
-/// `compensate` is set (and the map is not nearly constant). `weights` are
-/// the luminance coefficients; for angular maps only texels inside the
-/// circle count toward the mean.
+/// `compensate` is set (and the map is not nearly constant,
+/// [`compensation_mean`]). `weights` are the luminance coefficients.
 fn sampling_luminance(
     image: &Image,
     mapping: Mapping,
     weights: [f64; 3],
     compensate: bool,
 ) -> Result<Vec<f64>> {
-    let luminance = |t: &[f32; 3]| (0..3).map(|k| weights[k] * f64::from(t[k])).sum::<f64>();
-    let mut lum = parallel::install(|| {
-        alloc::par_collect(image.texels().par_iter().map(luminance), "the luminances")
-    })??;
-    if !compensate {
-        return Ok(lum);
+    let mut lum = luminances(image, weights)?;
+    if let Some(mean) = compensate
+        .then(|| compensation_mean(&lum, image, mapping))
+        .flatten()
+    {
+        lum.iter_mut().for_each(|l| *l = (*l - mean).max(0.0));
     }
+    Ok(lum)
+}
+
+/// Each texel's luminance by the coefficients `weights`.
+fn luminances(image: &Image, weights: [f64; 3]) -> Result<Vec<f64>> {
+    let luminance = |t: &[f32; 3]| (0..3).map(|k| weights[k] * f64::from(t[k])).sum::<f64>();
+    parallel::install(|| {
+        alloc::par_collect(image.texels().par_iter().map(luminance), "the luminances")
+    })?
+}
+
+/// The mean of the texel luminances `lum` that compensation subtracts (for
+/// angular maps, of the texels inside the circle), or `None` when the map
+/// is nearly constant (its minimum within 1 % of the mean) or black, and
+/// compensation is switched off.
+fn compensation_mean(lum: &[f64], image: &Image, mapping: Mapping) -> Option<f64> {
     let (w, h) = (image.width(), image.height());
     let (mut sum, mut count, mut min) = (0.0, 0usize, f64::INFINITY);
     for (i, &l) in lum.iter().enumerate() {
@@ -94,11 +109,24 @@ fn sampling_luminance(
         }
     }
     let mean = sum / count.max(1) as f64;
-    if mean - min <= 0.01 * mean {
-        return Ok(lum);
+    (mean - min > 0.01 * mean).then_some(mean)
+}
+
+/// Whether `compensate` changes the density of `options` over `image`
+/// (not for a black map, `scale = 0` or a nearly constant one).
+///
+/// # Errors
+/// As [`parallel::install`].
+pub(super) fn compensates(image: &Image, options: &Options) -> Result<bool> {
+    if options.scale == 0.0 {
+        return Ok(false);
     }
-    lum.iter_mut().for_each(|l| *l = (*l - mean).max(0.0));
-    Ok(lum)
+    let weights = match options.sampling {
+        Sampling::Mitsuba => MITSUBA_LUMINANCE,
+        Sampling::Luminance | Sampling::Piecewise => REC709,
+    };
+    let lum = luminances(image, weights)?;
+    Ok(compensation_mean(&lum, image, options.mapping).is_some())
 }
 
 /// The density of [`Sampling::Luminance`] over a lat-long `image`.

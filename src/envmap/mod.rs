@@ -248,13 +248,14 @@ impl EnvMap {
     }
 
     /// The same map with `compensate` set (its texels shared, its mapping
-    /// and sampling; the density of MIS compensation), or `None` when it
-    /// is already compensated.
+    /// and sampling; the density of MIS compensation), or `None` when that
+    /// changes nothing: a map already compensated, or one whose
+    /// compensation is switched off (black, or nearly constant).
     ///
     /// # Errors
     /// [`Error::Memory`] when its tables cannot be had.
     pub fn compensated(&self) -> Result<Option<EnvMap>> {
-        if self.options.compensate {
+        if self.options.compensate || !distribution::compensates(&self.image, &self.options)? {
             return Ok(None);
         }
         let options = Options {
@@ -363,4 +364,4 @@ fn check_rotation(m: &Matrix3) -> Result<()> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

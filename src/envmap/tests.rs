@@ -4,6 +4,7 @@
 use super::batch::BATCH_BLOCK;
 use super::*;
 use crate::warp;
+use std::ops::Range;
 
 /// A smooth map with a bright spot, `w × h` (cube: faces of `w`).
 fn test_image(mapping: Mapping, w: usize, h: usize) -> Vec<f32> {
@@ -316,17 +317,25 @@ fn black_maps_sample_nothing() {
     assert_eq!(m.pdf([0.0, 1.0, 0.0]), 0.0);
 }
 
+/// A 16 × 9 lat-long image of radiance 1 with a block of 50 on the texel
+/// rows `rows` and columns `cols`.
+pub(crate) fn dim_sky_with_block(rows: Range<usize>, cols: Range<usize>) -> Vec<f32> {
+    let w = 16;
+    let mut data = vec![1.0f32; w * 9 * 3];
+    for y in rows {
+        for x in cols.clone() {
+            data[(y * w + x) * 3..(y * w + x) * 3 + 3].fill(50.0);
+        }
+    }
+    data
+}
+
 #[test]
 fn compensation_removes_the_mean() {
     // A floor of 1 with a 3 × 3 block of 50: compensated, the floor gets no
     // samples.
     let (w, h) = (16, 9);
-    let mut data = vec![1.0f32; w * h * 3];
-    for y in 3..6 {
-        for x in 6..9 {
-            data[(y * w + x) * 3..(y * w + x) * 3 + 3].fill(50.0);
-        }
-    }
+    let data = dim_sky_with_block(3..6, 6..9);
     for sampling in [Sampling::Luminance, Sampling::Piecewise, Sampling::Mitsuba] {
         let options = Options {
             sampling,
@@ -362,6 +371,9 @@ fn compensation_removes_the_mean() {
         },
     );
     assert!(flat.unwrap().pdf([0.0, 0.0, 1.0]) > 0.0);
+    // Nor does it get a twin.
+    let flat = EnvMap::new(w, h, &vec![2.0f32; w * h * 3], Options::default()).unwrap();
+    assert!(flat.compensated().unwrap().is_none());
 }
 
 #[test]

@@ -342,7 +342,9 @@ impl PyScene {
         })
     }
 
-    /// Emitter sampling, as the renderer's next-event estimation does it:
+    /// Emitter sampling, as the renderer's next-event estimation does it
+    /// under emitter sampling alone (under MIS a map is drawn by its
+    /// compensated density instead):
     /// from points ``x`` (N, 3) or (3,), with uniform numbers ``u`` (N, 3)
     /// or (3,) in [0, 1] (the light's choice, then two for the point or
     /// direction on it). Returns float64 (N, 8) or (8,): the unit

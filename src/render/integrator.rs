@@ -128,10 +128,11 @@ pub struct Settings {
 
 impl Settings {
     /// The density emitter sampling draws the environment by: compensated
-    /// under MIS (whose BSDF samples cover what it leaves out), complete
-    /// under emitter sampling alone.
+    /// under MIS in the direct and path integrators (whose BSDF samples
+    /// cover what it leaves out), complete otherwise.
     pub(super) fn env_density(&self) -> EnvDensity {
-        if self.strategy == Strategy::Mis {
+        let bsdf_paths = matches!(self.integrator, Integrator::Direct | Integrator::Path);
+        if bsdf_paths && self.strategy == Strategy::Mis {
             EnvDensity::Compensated
         } else {
             EnvDensity::Complete

@@ -34,10 +34,12 @@
 //! bits as one at a time).
 //!
 //! Emitter sampling draws an environment map with the density of its own
-//! [`crate::envmap::EnvMap::pdf`], but by its
-//! [`crate::envmap::CellSampler`] (an alias table over the sampling table's
-//! cells, in `f32`), all of a bounce's draws together: a cell costs one
-//! load and no search of the table's running sums.
+//! [`crate::envmap::EnvMap::pdf`] (under MIS in the direct and path
+//! integrators, of its compensated twin,
+//! [`crate::envmap::EnvMap::compensated`]: [`scene::EnvDensity`]), but by
+//! its [`crate::envmap::CellSampler`] (an alias table over the sampling
+//! table's cells, in `f32`), all of a bounce's draws together: a cell costs
+//! one load and no search of the table's running sums.
 
 pub mod accel;
 pub mod bdpt;

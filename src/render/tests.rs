@@ -14,6 +14,7 @@ use super::scene::{Environment, Geometry, Material, Shape};
 use super::shape::Ray;
 use super::wavefront::{CameraSample, Wavefront};
 use super::{Heuristic, Integrator, Scene, Settings, Strategy};
+use crate::envmap::tests::dim_sky_with_block;
 use crate::envmap::{EnvMap, Options};
 use crate::phong::{Phong, Selection};
 use crate::rng::Rng;
@@ -456,18 +457,16 @@ fn floor_under_a_constant_sky_reflects_its_albedo() {
 /// A sky of radiance 1 with a block of 50. MIS draws it by its
 /// compensated density, never in the dim part (whose light BSDF sampling
 /// brings, with MIS weight 1), emitter sampling alone by the complete one;
-/// and a floor under it gets the same light by both, with either
-/// integrator, as by BSDF sampling (which reads no density of the map).
+/// each draw's density is the one the MIS weights of escaping BSDF
+/// samples read; and a floor under it gets the same light by both, with
+/// either integrator and (MIS) every sampler, as by BSDF sampling (which
+/// reads no density of the map).
 #[test]
 fn mis_draws_a_compensated_sky_and_stays_unbiased() {
-    let (w, h) = (16, 9);
-    let mut data = vec![1.0f32; w * h * 3];
-    for y in 2..7 {
-        for x in 4..12 {
-            data[(y * w + x) * 3..(y * w + x) * 3 + 3].fill(50.0);
-        }
-    }
-    let map = EnvMap::new(w, h, &data, Options::default()).unwrap();
+    let data = dim_sky_with_block(2..7, 4..12);
+    let map = EnvMap::new(16, 9, &data, Options::default()).unwrap();
+    // The centre of texel (row 4, column 1): dim, and so are its neighbours.
+    let dim_direction = map.uv_to_dir([1.5 / 16.0, 0.5]).map(|v| v as f32);
     let floor = Shape {
         geometry: rectangle(Affine3A::from_scale(Vec3::splat(50.0))),
         material: diffuse(0.7),
@@ -477,6 +476,7 @@ fn mis_draws_a_compensated_sky_and_stays_unbiased() {
     let sky = Environment::Map(Arc::new(map));
     let scene = Scene::new(vec![floor], Some(sky), camera(), 4, 4).unwrap();
     let mut rng = Rng::new(3, 0);
+    let mut pdf = [0.0f32];
     for (strategy, dim_least, dim_most) in [(Strategy::Emitter, 20, 4096), (Strategy::Mis, 0, 0)] {
         let density = settings(Integrator::Direct, strategy).env_density();
         let dim = (0..4096)
@@ -485,6 +485,12 @@ fn mis_draws_a_compensated_sky_and_stays_unbiased() {
                 let u = [rng.next_float(), rng.next_float()];
                 let bits = light.cells().map(|_| rng.next_u64());
                 let ls = scene.sample_chosen(light, Vec3A::ZERO, u, bits).unwrap();
+                scene.environment_pdf_into(&[ls.d.to_array()], &mut pdf, density);
+                assert!(
+                    (pdf[0] - ls.pdf).abs() <= 1e-4 * ls.pdf,
+                    "{pdf:?} {}",
+                    ls.pdf
+                );
                 ls.radiance[0] <= 1.0 + 1e-5
             })
             .count();
@@ -492,20 +498,53 @@ fn mis_draws_a_compensated_sky_and_stays_unbiased() {
             (dim_least..=dim_most).contains(&dim),
             "{strategy:?}: {dim} dim draws"
         );
+        scene.environment_pdf_into(&[dim_direction], &mut pdf, density);
+        assert_eq!(
+            pdf[0] == 0.0,
+            strategy == Strategy::Mis,
+            "{strategy:?}: {pdf:?}"
+        );
     }
+    // A BSDF sample escaping toward the dim part brings its light with MIS
+    // weight 1 (the compensated density is 0 there), one toward the block
+    // with less.
+    let mis = settings(Integrator::Direct, Strategy::Mis);
+    let block_direction = dim_direction.map(|v| -v);
+    let mut escaped = integrator::Escaped::default();
+    let mut l = [[0.0f32; 3]; 2];
+    escaped.push(0, Vec3A::from(dim_direction), [1.0; 3], Some(0.3));
+    escaped.push(1, Vec3A::from(block_direction), [1.0; 3], Some(0.3));
+    integrator::add_escaped(&scene, &mis, &mut escaped, &mut l);
+    assert_eq!(
+        l[0][0],
+        scene
+            .environment()
+            .unwrap()
+            .eval(Vec3A::from(dim_direction))[0]
+    );
+    assert!(l[1][0] < 50.0 * 0.99, "{l:?}");
     let (from, to) = (Vec3A::new(0.0, 0.3, 1.0), Vec3A::ZERO);
     let bsdf = settings(Integrator::Direct, Strategy::Bsdf);
     let (reference, se_ref) = estimate(&scene, from, to, &bsdf, 1 << 18);
-    for (integrator, strategy) in [Integrator::Direct, Integrator::Path]
+    let cases = [Integrator::Direct, Integrator::Path]
         .into_iter()
-        .flat_map(|i| [Strategy::Emitter, Strategy::Mis].map(|s| (i, s)))
-    {
-        let s = settings(integrator, strategy);
-        let (mean, se) = estimate(&scene, from, to, &s, 1 << 16);
+        .flat_map(|i| {
+            let emitter = settings(i, Strategy::Emitter);
+            let mis = Sampler::NAMES.iter().map(move |&(_, sampler)| Settings {
+                sampler,
+                ..settings(i, Strategy::Mis)
+            });
+            std::iter::once(emitter).chain(mis)
+        });
+    for s in cases {
+        let (mean, se) = estimate(&scene, from, to, &s, 1 << 15);
         let bound = 5.0 * se.hypot(se_ref);
         assert!(
             (mean - reference).abs() < bound,
-            "{integrator:?} {strategy:?}: {mean} ± {se}, BSDF sampling {reference} ± {se_ref}"
+            "{:?} {:?} {:?}: {mean} ± {se}, BSDF sampling {reference} ± {se_ref}",
+            s.integrator,
+            s.strategy,
+            s.sampler
         );
     }
 }

@@ -180,7 +180,9 @@ class Scene:
         return self.compiled.ray_tracer
 
     def sample_emitter(self, x: Any, u: Any) -> "EmitterSample":
-        """Emitter sampling as the renderer's next-event estimation does it.
+        """Emitter sampling as the renderer's next-event estimation does it
+        under ``strategy="emitter"`` (under MIS an environment map is drawn
+        by its compensated density instead: see :func:`mcsample.render`).
 
         Parameters
         ----------

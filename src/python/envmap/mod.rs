@@ -79,8 +79,9 @@ record! {
 ///     sampling density is built (Karlik et al. 2019), as Mitsuba's
 ///     ``mis_compensation``. Only for use in MIS. ``render`` needs no
 ///     compensated map: under MIS it draws every map by its compensated
-///     density by itself, and by its own under emitter sampling alone
-///     (where a map given with ``compensate=True`` would be biased).
+///     density by itself, and by its own under emitter sampling alone,
+///     light tracing and BDPT (where a map given with ``compensate=True``
+///     would be biased).
 ///
 /// Everything after ``image`` is keyword-only.
 #[pyclass(module = "mcsample._core", name = "EnvMap", frozen)]

@@ -22,9 +22,10 @@ pub(super) enum Light {
 /// The density emitter sampling draws the environment by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EnvDensity {
-    /// The environment's own: positive wherever it shines, so that emitter
-    /// sampling alone is unbiased (and light tracing and bidirectional
-    /// path tracing, whose weights need every strategy's density).
+    /// The map's own (the one it was built with): for emitter sampling
+    /// alone, light tracing and bidirectional path tracing, whose weights
+    /// need every strategy's density. Unless the map was built
+    /// compensated, it is positive wherever the map shines.
     Complete,
     /// For MIS with BSDF sampling (the direct and path integrators), a
     /// map's density with `compensate` ([`EnvMap::compensated`]: its
@@ -87,8 +88,9 @@ impl EnvLight {
     }
 }
 
-/// A light chosen for emitter sampling ([`Scene::choose_light`]) and the
-/// probability of that choice.
+/// A light chosen for emitter sampling ([`Scene::choose_light`]), the
+/// probability of that choice, and the density to draw the environment by
+/// if it is chosen.
 #[derive(Clone, Copy, Debug)]
 pub struct ChosenLight<'a> {
     light: &'a Light,
@@ -477,9 +479,10 @@ impl Scene {
         })
     }
 
-    /// [`Scene::sample_light`] of the chosen `light`, with `u` the
-    /// position's numbers and `bits` the [`CellSampler`]'s (used only when
-    /// [`ChosenLight::cells`] has one).
+    /// [`Scene::sample_light`] of the chosen `light` (the environment by
+    /// the density it was chosen for), with `u` the position's numbers and
+    /// `bits` the [`CellSampler`]'s (used only when [`ChosenLight::cells`]
+    /// has one).
     #[inline]
     pub fn sample_chosen(
         &self,
