@@ -6,11 +6,11 @@
 
 use super::cell_sampler::CellSampler;
 use super::distribution::Distribution;
-use super::image::Corners;
+use super::image::{Corners, LatLongPlace};
 use super::luminance::LuminanceDensity;
 use super::mapping::Mapping;
 use super::polar::TableFloat;
-use super::sample::{PdfQuery, Placed, luminance_pdf_at};
+use super::sample::{PdfQuery, Placed};
 use super::{EnvMap, EnvSample};
 use crate::distr::{GROUP, PiecewiseConstant2D};
 use crate::math::Real;
@@ -18,7 +18,7 @@ use crate::simd;
 use crate::warp::V3;
 
 #[cfg(doc)]
-use super::PolarTable;
+use super::{PolarTable, image::Image};
 
 /// Directions per block of [`EnvMap::eval_into`] and [`EnvMap::pdf_into`].
 pub(super) const BATCH_BLOCK: usize = 256;
@@ -67,49 +67,52 @@ impl<F: Copy> EnvSamples<'_, F> {
 
 impl EnvMap {
     /// `out[i] = eval(d[i])` for a batch, in `F`: every direction's place on
-    /// the map by one loop (which vectorises for lat-long maps), then its
-    /// texels prefetched and read one block behind (two blocks in flight). Returns
-    /// whether `valid` held for every direction (it is checked in the same
-    /// pass).
+    /// the map by one loop at SIMD width (for lat-long maps its cell and
+    /// weights too, [`Image::lat_long_place`]), then its texels located
+    /// and prefetched, and read one block behind (two blocks in flight).
+    /// Returns whether `valid` held for every direction (it is checked in
+    /// the same pass).
     pub fn eval_into<F: Real>(
         &self,
         d: &[[F; 3]],
         out: &mut [[F; 3]],
         valid: impl Fn(&[F; 3]) -> bool,
     ) -> bool {
-        per_mapping!(self.options.mapping, |M| {
-            let place = {
-                #[inline(always)]
-                |x: [F; 3]| self.uv_of(M, x)
-            };
-            self.eval_blocks(d, out, &place, valid)
-        })
-    }
-
-    /// [`EnvMap::eval_into`] with `place` the mapping's `from_dir`: the
-    /// texels of a block located and prefetched, read one block behind
-    /// ([`pipelined`]).
-    #[inline(always)]
-    fn eval_blocks<F: Real>(
-        &self,
-        d: &[[F; 3]],
-        out: &mut [[F; 3]],
-        place: &impl Fn([F; 3]) -> [F; 2],
-        valid: impl Fn(&[F; 3]) -> bool,
-    ) -> bool {
-        let locate = {
-            #[inline(always)]
-            |p: &[F; 2]| {
-                let corners = self.image.corners(self.options.mapping, *p);
-                self.image.prefetch(&corners);
-                corners
-            }
-        };
         let read = {
             #[inline(always)]
-            |_: &[F; 2], c: &Corners<F>| self.radiance_of(c)
+            |c: &Corners<F>| self.radiance_of(c)
         };
-        pipelined(d, out, place, valid, locate, read)
+        match self.options.mapping {
+            Mapping::LatLong => {
+                let place = {
+                    #[inline(always)]
+                    |x: [F; 3]| self.image.lat_long_place(self.uv_of(Mapping::LatLong, x))
+                };
+                let locate = {
+                    #[inline(always)]
+                    |q: &LatLongPlace<F>| self.prefetched(self.image.placed_corners(q))
+                };
+                pipelined(d, out, &place, valid, locate, |_, c| read(c))
+            }
+            mapping @ (Mapping::Angular | Mapping::Cube) => {
+                let place = {
+                    #[inline(always)]
+                    |x: [F; 3]| self.uv_of(mapping, x)
+                };
+                let locate = {
+                    #[inline(always)]
+                    |p: &[F; 2]| self.prefetched(self.image.corners(mapping, *p))
+                };
+                pipelined(d, out, &place, valid, locate, |_, c| read(c))
+            }
+        }
+    }
+
+    /// `corners`, their texels prefetched.
+    #[inline(always)]
+    fn prefetched<F: Real>(&self, corners: Corners<F>) -> Corners<F> {
+        self.image.prefetch(&corners.0);
+        corners
     }
 
     /// `out[i] = pdf(d[i])` for a batch, in `F`, in blocks of
@@ -128,23 +131,7 @@ impl EnvMap {
         valid: impl Fn(&[F; 3]) -> bool,
     ) -> bool {
         if let Distribution::Luminance(density) = &self.distribution {
-            let query = {
-                #[inline(always)]
-                |x: [F; 3]| self.luminance_query(x)
-            };
-            let locate = {
-                #[inline(always)]
-                |q: &[F; 3]| {
-                    let corners = self.luminance_corners(q);
-                    density.prefetch(corners.0[0]);
-                    corners
-                }
-            };
-            let read = {
-                #[inline(always)]
-                |q: &[F; 3], c: &Corners<F>| luminance_pdf_at(density, q, c)
-            };
-            pipelined(d, out, &query, valid, locate, read)
+            self.luminance_pdf_into(density, d, out, valid)
         } else if let Some(table) = &self.polar {
             let densities = F::densities(table);
             let query = {
@@ -178,6 +165,64 @@ impl EnvMap {
             }
             ok
         }
+    }
+
+    /// [`EnvMap::pdf_into`] of the luminance `density`, in blocks of
+    /// [`simd::BLOCK`], two in flight: each block's queries
+    /// ([`EnvMap::luminance_query`]) at SIMD width into columns, their cells
+    /// located and the cells' table lines prefetched, then the block before
+    /// read ([`EnvMap::luminance_pdf_in`]) by a loop over columns that
+    /// gathers at SIMD width, its lines by now in the caches.
+    fn luminance_pdf_into<F: Real>(
+        &self,
+        density: &LuminanceDensity,
+        d: &[[F; 3]],
+        out: &mut [F],
+        valid: impl Fn(&[F; 3]) -> bool,
+    ) -> bool {
+        const B: usize = simd::BLOCK;
+        let query = {
+            #[inline(always)]
+            |x: [F; 3]| self.luminance_query(x)
+        };
+        let tables = density.tables();
+        let read = {
+            #[inline(always)]
+            move |out: &mut [F], q: &[[F; B]; 7], cells: &[usize; B]| {
+                let rows = B.min(out.len());
+                let out = &mut out[..rows];
+                for (i, o) in out.iter_mut().enumerate() {
+                    let qi = std::array::from_fn(|m| q[m][i]);
+                    *o = EnvMap::luminance_pdf_in(tables, &qi, cells[i]);
+                }
+            }
+        };
+        let mut queries = [[[F::zero(); B]; 7]; 2];
+        let mut cells = [[0; B]; 2];
+        simd::dispatch(
+            #[inline(always)]
+            |level| {
+                let mut ok = true;
+                // The block waiting to be read: its buffers' index and its
+                // outputs.
+                let mut previous: Option<(usize, &mut [F])> = None;
+                for (b, (o, x)) in out.chunks_mut(B).zip(d.chunks(B)).enumerate() {
+                    let (q, c) = (&mut queries[b % 2], &mut cells[b % 2]);
+                    ok &= simd::map_to_columns(q, x, &query, &valid, level);
+                    for (c, (&x0, &y0)) in c.iter_mut().zip(q[0].iter().zip(&q[1])) {
+                        *c = self.image.place_texel(x0, y0);
+                        density.prefetch(*c);
+                    }
+                    if let Some((p, o)) = previous.replace((b % 2, o)) {
+                        read(o, &queries[p], &cells[p]);
+                    }
+                }
+                if let Some((p, o)) = previous {
+                    read(o, &queries[p], &cells[p]);
+                }
+                ok
+            },
+        )
     }
 
     /// `out[i] = sample(us[i])` for a batch, in groups: the table points by
@@ -310,7 +355,7 @@ impl EnvMap {
     /// (`[s, t, p_q]`) and texels staged for [`EnvMap::finish_group`].
     #[inline(always)]
     fn stage<F: Real>(&self, placed: Placed<F>, point: &mut [F; 3], corners: &mut Corners<F>) {
-        self.image.prefetch(&placed.corners);
+        self.image.prefetch(&placed.corners.0);
         let [s, t] = placed.point;
         (*point, *corners) = ([s, t, placed.pdf_q], placed.corners);
     }

@@ -30,6 +30,10 @@ pub struct Image {
 /// where the map has no light), in the float type of the point.
 pub type Corners<F> = ([usize; 4], [F; 4]);
 
+/// A lat-long point's cell and bilinear weights, `[x₀, y₀, w₀, w₁, w₂, w₃]`
+/// ([`Image::lat_long_place`]).
+pub type LatLongPlace<F> = [F; 6];
+
 impl Image {
     /// An image of `width × height` RGB texels (`data` row-major, 3 floats
     /// a texel) for `mapping`, checked to be finite and `>= 0`. Lat-long
@@ -138,20 +142,10 @@ impl Image {
     /// `[0, 1]`) and their weights (see the module docs), computed in `F`.
     #[inline(always)]
     pub fn corners<F: Real>(&self, mapping: Mapping, p: [F; 2]) -> Corners<F> {
-        let (w, h) = (self.width, self.height);
+        let w = self.width;
         let (zero, one) = (F::zero(), F::one());
         match mapping {
-            Mapping::LatLong => {
-                // `p[0]` in [0, 1]: one wrap below 0 (no call to `floor`).
-                let x = p[0] - F::c(0.5 / w as f64);
-                let x = (x + if x < zero { one } else { zero }) * F::c(w as f64);
-                let y = p[1].max(zero).min(one) * F::c((h - 1) as f64);
-                let (x0, y0) = (x.floor_index(w - 1), y.floor_index(h - 2));
-                let fx = (x - F::c(x0 as f64)).max(zero).min(one);
-                let fy = y - F::c(y0 as f64);
-                let x1 = if x0 + 1 == w { 0 } else { x0 + 1 };
-                quad([x0, x1], [y0, y0 + 1], w, fx, fy)
-            }
+            Mapping::LatLong => self.placed_corners(&self.lat_long_place(p)),
             Mapping::Angular | Mapping::Cube => {
                 let face_rows = w;
                 let (face, t) = match mapping {
@@ -176,6 +170,52 @@ impl Image {
         }
     }
 
+    /// Where the lat-long point `p` (`s` in `[0, 1]`) falls among the
+    /// texel centres, as a [`LatLongPlace`]: with `x = ((s − ½/W) mod 1) W`
+    /// and `y = clamp(t, 0, 1) (H − 1)`, the cell `x₀ = ⌊x⌋ ≤ W − 1`,
+    /// `y₀ = ⌊y⌋ ≤ H − 2` and the fractions `f_x = clamp(x − x₀, 0, 1)`,
+    /// `f_y = y − y₀` give the weights `(1 − f_x)(1 − f_y)`, `f_x (1 − f_y)`,
+    /// `(1 − f_x) f_y`, `f_x f_y` of the texels `(x₀, y₀)`, `(x₀ + 1, y₀)`
+    /// (wrapped), `(x₀, y₀ + 1)`, `(x₀ + 1, y₀ + 1)`. Branch-free and
+    /// without indices, so that a batch computes it at SIMD width; the
+    /// indices follow by [`Image::placed_corners`].
+    #[inline(always)]
+    pub fn lat_long_place<F: Real>(&self, p: [F; 2]) -> LatLongPlace<F> {
+        let (w, h) = (self.width, self.height);
+        let (zero, one) = (F::zero(), F::one());
+        // `p[0]` in [0, 1]: one wrap below 0.
+        let x = p[0] - F::c(0.5 / w as f64);
+        let x = (x + if x < zero { one } else { zero }) * F::c(w as f64);
+        let y = p[1].max(zero).min(one) * F::c((h - 1) as f64);
+        // (`max` first: a NaN lands in cell 0, as `floor_index` puts it.)
+        let x0 = x.floor().max(zero).min(F::c((w - 1) as f64));
+        let y0 = y.floor().max(zero).min(F::c((h - 2) as f64));
+        let fx = (x - x0).max(zero).min(one);
+        let fy = y - y0;
+        let [w00, w10, w01, w11] = bilinear_weights(fx, fy);
+        [x0, y0, w00, w10, w01, w11]
+    }
+
+    /// The texels and weights of a lat-long place (the first six numbers
+    /// of `place`, as [`Image::lat_long_place`] makes them).
+    #[inline(always)]
+    pub fn placed_corners<F: Real>(&self, place: &[F]) -> Corners<F> {
+        let (w, k) = (self.width, self.place_texel(place[0], place[1]));
+        let right = right_of(k, place[0], w);
+        (
+            [k, right, k + w, right + w],
+            [place[2], place[3], place[4], place[5]],
+        )
+    }
+
+    /// The top-left texel of the cell `(x₀, y₀)` of a lat-long place (which
+    /// is also the cell's index).
+    #[inline(always)]
+    pub fn place_texel<F: Real>(&self, x0: F, y0: F) -> usize {
+        let w = self.width;
+        y0.floor_index(self.height - 2) * w + x0.floor_index(w - 1)
+    }
+
     /// The texels of a lat-long map's table cell `(row, col)` (the patch
     /// between texel centres `row, row + 1` and `col, col + 1`, wrapped) and
     /// their weights at fractions `r` of the cell: the corners of the point
@@ -186,10 +226,10 @@ impl Image {
         quad([col, next], [row, row + 1], self.width, r[0], r[1])
     }
 
-    /// Prefetches the texels of `corners`.
+    /// Prefetches the texels at `indices`.
     #[inline(always)]
-    pub fn prefetch<F: Real>(&self, corners: &Corners<F>) {
-        for &i in &corners.0 {
+    pub fn prefetch(&self, indices: &[usize; 4]) {
+        for &i in indices {
             simd::prefetch(&self.texels, i);
         }
     }
@@ -214,6 +254,17 @@ impl Image {
     }
 }
 
+/// The texel right of texel `k` of column `x₀` on a lat-long map `width`
+/// texels wide, wrapped from the row's last column to its first.
+#[inline(always)]
+pub fn right_of<F: Real>(k: usize, x0: F, width: usize) -> usize {
+    if x0 == F::c((width - 1) as f64) {
+        k + 1 - width
+    } else {
+        k + 1
+    }
+}
+
 /// Texel indices `[x0, x1]` and the fraction toward `x1` along an axis of
 /// `n` texels centred at `(x + ½)/n`, clamped at both ends.
 #[inline(always)]
@@ -228,7 +279,6 @@ fn clamped_axis<F: Real>(s: F, n: usize) -> ([usize; 2], F) {
 
 #[inline(always)]
 fn quad<F: Real>(xs: [usize; 2], ys: [usize; 2], width: usize, fx: F, fy: F) -> Corners<F> {
-    let one = F::one();
     (
         [
             ys[0] * width + xs[0],
@@ -236,13 +286,21 @@ fn quad<F: Real>(xs: [usize; 2], ys: [usize; 2], width: usize, fx: F, fy: F) -> 
             ys[1] * width + xs[0],
             ys[1] * width + xs[1],
         ],
-        [
-            (one - fx) * (one - fy),
-            fx * (one - fy),
-            (one - fx) * fy,
-            fx * fy,
-        ],
+        bilinear_weights(fx, fy),
     )
+}
+
+/// The weights of the texels `(x₀, y₀)`, `(x₁, y₀)`, `(x₀, y₁)`, `(x₁, y₁)`
+/// at fractions `(f_x, f_y)` of the way from `(x₀, y₀)` to `(x₁, y₁)`.
+#[inline(always)]
+fn bilinear_weights<F: Real>(fx: F, fy: F) -> [F; 4] {
+    let one = F::one();
+    [
+        (one - fx) * (one - fy),
+        fx * (one - fy),
+        (one - fx) * fy,
+        fx * fy,
+    ]
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 //! [`Sampling::Luminance`]: super::Sampling::Luminance
 
 use super::bilinear::{bilerp, warp_bilinear};
-use super::image::Corners;
+use super::image::right_of;
 use crate::alloc;
 use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;
@@ -97,7 +97,7 @@ impl LuminanceDensity {
     }
 
     /// Asks the CPU for the table lines that [`LuminanceDensity::place`]
-    /// and [`LuminanceDensity::table_pdf_of_corners`] read for the cell
+    /// and [`Tables::pdf_at`] read for the cell
     /// whose top left texel is `k`: its two rows' luminances and its scale.
     #[inline(always)]
     pub(super) fn prefetch(&self, k: usize) {
@@ -156,15 +156,45 @@ impl LuminanceDensity {
         bilerp(corners(&self.lum, self.width, k), x, y) * self.scale[k]
     }
 
-    /// `p_q` at the blend of an image's corners of a point (texel
-    /// `idx[0]` is the top left of its cell, whose index it is), in `F`.
+    /// The tables that [`Tables::pdf_at`] reads.
     #[inline(always)]
-    pub(super) fn table_pdf_of_corners<F: Real>(&self, (idx, wt): &Corners<F>) -> F {
-        let mut y = F::zero();
-        for (&i, &w) in idx.iter().zip(wt) {
-            y = y + w * F::c(self.lum[i]);
+    pub(super) fn tables(&self) -> Tables<'_> {
+        Tables {
+            width: self.width,
+            lum: &self.lum,
+            below: &self.lum[self.width..],
+            scale: &self.scale,
         }
-        y * F::c(self.scale[idx[0]])
+    }
+}
+
+/// The tables of a [`LuminanceDensity`] that its density reads, as slices
+/// that a batch takes out of its loop.
+#[derive(Clone, Copy)]
+pub(super) struct Tables<'a> {
+    /// The map's width in texels.
+    width: usize,
+    /// The texels' luminances.
+    lum: &'a [f64],
+    /// The same from the second row on: texel `k + W` is `below[k]`.
+    below: &'a [f64],
+    /// The cells' `P_c · WH' / Ȳ_c`.
+    scale: &'a [f64],
+}
+
+impl Tables<'_> {
+    /// `p_q` at the blend by `wt` of the texels of cell `k` (its top-left
+    /// texel) of column `x₀`: texel `k`, the one right of it
+    /// ([`right_of`]) and the two below them, in `F`. A texel outside the tables reads as 0 (never for a cell of the
+    /// map), a read without a panic that a loop of these gathers at SIMD
+    /// width.
+    #[inline(always)]
+    pub(super) fn pdf_at<F: Real>(self, k: usize, x0: F, wt: [F; 4]) -> F {
+        let right = right_of(k, x0, self.width);
+        let at = |table: &[f64], i: usize| F::c(table.get(i).copied().unwrap_or(0.0));
+        let y = wt[0] * at(self.lum, k) + wt[1] * at(self.lum, right);
+        let y = y + wt[2] * at(self.below, k) + wt[3] * at(self.below, right);
+        y * at(self.scale, k)
     }
 }
 

@@ -10,7 +10,7 @@
 use super::EnvMap;
 use super::distribution::Distribution;
 use super::image::Corners;
-use super::luminance::LuminanceDensity;
+use super::luminance::{LuminanceDensity, Tables};
 use super::mapping::{Mapping, normalized, polar_angle};
 use super::polar::{SIN_FLOOR, polar_jacobian};
 use crate::distr::PiecewiseConstant2D;
@@ -19,7 +19,7 @@ use crate::warp::{self, V3};
 use std::f64::consts::PI;
 
 #[cfg(doc)]
-use super::{CellSampler, PolarTable};
+use super::{CellSampler, PolarTable, image::Image, image::LatLongPlace};
 
 /// A direction drawn from an environment map: the record of every way of
 /// drawing one ([`EnvMap::sample`], [`EnvMap::sample_into`],
@@ -287,29 +287,36 @@ impl EnvMap {
     /// [`PolarTable::query`] finds it without normalising `d` (0 for
     /// `d = 0`). Batches run its three steps apart: the query
     /// ([`EnvMap::luminance_query`]) over a block at SIMD width, the
-    /// texels under it ([`EnvMap::luminance_corners`]), prefetched, and
-    /// their blend ([`luminance_pdf_at`]) one block later.
+    /// cell under it ([`Image::place_texel`]), its table lines prefetched,
+    /// and the density there ([`EnvMap::luminance_pdf_in`]) one block
+    /// later, at SIMD width.
     #[inline(always)]
     pub(super) fn luminance_pdf<F: Real>(&self, density: &LuminanceDensity, d: V3<F>) -> F {
         let q = self.luminance_query(d);
-        luminance_pdf_at(density, &q, &self.luminance_corners(&q))
+        Self::luminance_pdf_in(density.tables(), &q, self.image.place_texel(q[0], q[1]))
     }
 
-    /// The texels under the query `q` ([`EnvMap::luminance_query`]).
+    /// The density at the query `q` ([`EnvMap::luminance_query`]), whose
+    /// cell (its top-left texel) is `k`, from the `tables` of this map's
+    /// luminance density.
     #[inline(always)]
-    pub(super) fn luminance_corners<F: Real>(&self, q: &[F; 3]) -> Corners<F> {
-        self.image.corners(Mapping::LatLong, [q[0], q[1]])
+    pub(super) fn luminance_pdf_in<F: Real>(tables: Tables<'_>, q: &[F; 7], k: usize) -> F {
+        tables.pdf_at(k, q[0], [q[2], q[3], q[4], q[5]]) * q[6]
     }
 
-    /// `[s, t, 1/(dω/dq)]` of the world direction `d` on a lat-long map.
+    /// The place on a lat-long map of the world direction `d` and
+    /// `1/(dω/dq)` there: `[x₀, y₀, w₀, w₁, w₂, w₃, 1/(dω/dq)]`, the
+    /// [`LatLongPlace`] of its domain point `(s, t)` and the Jacobian.
     #[inline(always)]
-    pub(super) fn luminance_query<F: Real>(&self, d: V3<F>) -> [F; 3] {
+    pub(super) fn luminance_query<F: Real>(&self, d: V3<F>) -> [F; 7] {
         let local = self.to_local(d);
-        let [s, t] = Mapping::LatLong.from_dir(local);
+        let place = self.image.lat_long_place(Mapping::LatLong.from_dir(local));
         let r = (local[0] * local[0] + local[2] * local[2]).sqrt();
         let length = (r * r + local[1] * local[1]).sqrt();
         let scaled_sin = r.max(F::c(SIN_FLOOR) * length).max(F::min_positive_value());
-        [s, t, length / (F::c(2.0 * PI * PI) * scaled_sin)]
+        let [x0, y0, w00, w10, w01, w11] = place;
+        let jacobian_inv = length / (F::c(2.0 * PI * PI) * scaled_sin);
+        [x0, y0, w00, w10, w01, w11, jacobian_inv]
     }
 
     /// The point of the sampling table that looks along the local
@@ -353,15 +360,4 @@ impl EnvMap {
             Mapping::Cube => Mapping::Cube.jacobian(Mapping::Cube.from_dir(d)),
         }
     }
-}
-
-/// The density at the query `q` ([`EnvMap::luminance_query`]) whose
-/// texels are `corners` ([`EnvMap::luminance_corners`]).
-#[inline(always)]
-pub(super) fn luminance_pdf_at<F: Real>(
-    density: &LuminanceDensity,
-    q: &[F; 3],
-    corners: &Corners<F>,
-) -> F {
-    density.table_pdf_of_corners(corners) * q[2]
 }

@@ -185,14 +185,26 @@ fn batch_sampling_agrees_with_single_draws() {
 fn batch_pdfs_and_evals_agree_with_single_queries() {
     // Lengths around the block size, so that the last block (read after the
     // loop) is empty, partial or whole.
+    // (Also around the luminance density's blocks of `simd::BLOCK`.)
     let mut rng = crate::rng::Rng::new(11, 1);
-    let d: Vec<[f64; 3]> = (0..3 * BATCH_BLOCK + 1)
-        .map(|_| warp::square_to_uniform_sphere([rng.next_float(), rng.next_float()]))
-        .collect();
+    let block = crate::simd::BLOCK;
     for m in all_maps() {
+        // Random directions after those along the seam and the poles of a
+        // lat-long map, where the cells wrap and clamp.
+        let w = m.image.width() as f64;
+        let seam = [0.0, 0.2 / w, 0.5 / w, 1.0 - 0.5 / w, 1.0 - 0.2 / w, 1.0];
+        let edges = seam
+            .iter()
+            .flat_map(|&s| [0.0, 0.3, 1.0].map(|t| m.uv_to_dir([s, t])));
+        let random = (0..3 * BATCH_BLOCK + 1)
+            .map(|_| warp::square_to_uniform_sphere([rng.next_float(), rng.next_float()]));
+        let d: Vec<[f64; 3]> = edges.chain(random).take(3 * BATCH_BLOCK + 1).collect();
         for n in [
             0,
             1,
+            block - 1,
+            block,
+            block + 1,
             BATCH_BLOCK - 1,
             BATCH_BLOCK,
             BATCH_BLOCK + 1,
@@ -202,6 +214,16 @@ fn batch_pdfs_and_evals_agree_with_single_queries() {
             assert!(m.pdf_into(&d[..n], &mut out, |_| true));
             for (x, o) in d.iter().zip(&out) {
                 assert_eq!(*o, m.pdf(*x), "{:?}: n = {n}, d = {x:?}", m.options());
+            }
+            if let Distribution::Luminance(density) = &m.distribution {
+                // In `f32` the batch computes what the one-at-a-time
+                // luminance density does in `f32`.
+                let d32: Vec<[f32; 3]> = d[..n].iter().map(|x| x.map(|v| v as f32)).collect();
+                let mut out32 = vec![-1.0f32; n];
+                assert!(m.pdf_into(&d32, &mut out32, |_| true));
+                for (x, o) in d32.iter().zip(&out32) {
+                    assert_eq!(*o, m.luminance_pdf(density, *x), "n = {n}, d = {x:?}");
+                }
             }
             let mut radiance = vec![[-1.0; 3]; n];
             assert!(m.eval_into(&d[..n], &mut radiance, |_| true));

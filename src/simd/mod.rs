@@ -125,8 +125,8 @@ fn prefetch_address(address: *const u8) {
 /// Cache line size in bytes (x86-64 and most other targets).
 const LINE: usize = 64;
 
-/// Rows per block of [`map_rows`].
-const BLOCK: usize = 64;
+/// Rows per block of [`map_rows`] and [`map_to_columns`].
+pub const BLOCK: usize = 64;
 
 /// How many blocks ahead [`map_rows`] prefetches its input: the loads of a
 /// block come in an order the hardware prefetchers do not follow, and a
@@ -248,6 +248,64 @@ where
     F: Copy + Default,
     T: Copy + Default,
 {
+    let mut results = [[T::default(); BLOCK]; M];
+    let ok = map_block_to_columns(&mut results, inputs, kernel, valid, level);
+    if !permute_columns_to_rows(&results, out, level, stream) {
+        if stream {
+            let mut rows = [[T::default(); M]; BLOCK];
+            interleave(&results, &mut rows);
+            stream_copy(out, &rows);
+        } else {
+            interleave(&results, out);
+        }
+    }
+    ok
+}
+
+/// `columns[m][i] = kernel(rows[i])[m]` for a block of at most [`BLOCK`]
+/// rows, at full SIMD width, with the results left in columns (the rest of
+/// each column is the kernel of the first row); returns whether `valid`
+/// holds for every row. For batches whose next step reads tables at the
+/// results' indices: a loop over columns gathers at SIMD width, which a
+/// loop over rows does not. Call it inside [`dispatch`], with its level.
+#[inline(always)]
+pub fn map_to_columns<F, T, const K: usize, const M: usize>(
+    columns: &mut [[T; BLOCK]; M],
+    rows: &[[F; K]],
+    kernel: &impl Fn([F; K]) -> [T; M],
+    valid: impl Fn(&[F; K]) -> bool,
+    level: Level,
+) -> bool
+where
+    F: Copy + Default,
+    T: Copy + Default,
+{
+    debug_assert!(rows.len() <= BLOCK);
+    if let Ok(block) = <&[[F; K]; BLOCK]>::try_from(rows) {
+        return map_block_to_columns(columns, block, kernel, &valid, level);
+    }
+    let Some(&first) = rows.first() else {
+        return true;
+    };
+    let padded: [[F; K]; BLOCK] = std::array::from_fn(|i| rows.get(i).copied().unwrap_or(first));
+    map_block_to_columns(columns, &padded, kernel, &valid, level)
+}
+
+/// The columns of one block of [`map_rows`]: its rows transposed to
+/// columns (by permutes on AVX-512 where [`lanes`] handles the shape),
+/// then mapped by a loop over columns of constant length that vectorises.
+#[inline(always)]
+fn map_block_to_columns<F, T, const K: usize, const M: usize>(
+    results: &mut [[T; BLOCK]; M],
+    inputs: &[[F; K]; BLOCK],
+    kernel: &impl Fn([F; K]) -> [T; M],
+    valid: &impl Fn(&[F; K]) -> bool,
+    level: Level,
+) -> bool
+where
+    F: Copy + Default,
+    T: Copy,
+{
     let mut columns = [[F::default(); BLOCK]; K];
     if !permute_rows_to_columns(inputs, &mut columns, level) {
         for i in 0..BLOCK {
@@ -257,22 +315,12 @@ where
         }
     }
     let mut ok = true;
-    let mut results = [[T::default(); BLOCK]; M];
     for i in 0..BLOCK {
         let x = std::array::from_fn(|k| columns[k][i]);
         ok &= valid(&x);
         let r = kernel(x);
         for m in 0..M {
             results[m][i] = r[m];
-        }
-    }
-    if !permute_columns_to_rows(&results, out, level, stream) {
-        if stream {
-            let mut rows = [[T::default(); M]; BLOCK];
-            interleave(&results, &mut rows);
-            stream_copy(out, &rows);
-        } else {
-            interleave(&results, out);
         }
     }
     ok
