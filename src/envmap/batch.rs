@@ -20,7 +20,8 @@ use crate::warp::V3;
 #[cfg(doc)]
 use super::{PolarTable, image::Image};
 
-/// Directions per block of [`EnvMap::eval_into`] and [`EnvMap::pdf_into`].
+/// Directions per block of [`EnvMap::pdf_into`] for the densities that
+/// are read one direction at a time ([`EnvMap::pdf_query`]).
 pub(super) const BATCH_BLOCK: usize = 256;
 
 /// `$run`, once per mapping with `$m` that mapping as a constant, so that
@@ -68,8 +69,8 @@ impl<F: Copy> EnvSamples<'_, F> {
 impl EnvMap {
     /// `out[i] = eval(d[i])` for a batch, in `F`: every direction's place on
     /// the map by one loop at SIMD width (for lat-long maps its cell and
-    /// weights too, [`Image::lat_long_place`]), then its texels located
-    /// and prefetched, and read one block behind (two blocks in flight).
+    /// weights too), then its texels located and prefetched, and read one
+    /// block behind (two blocks in flight).
     /// Returns whether `valid` held for every direction (it is checked in
     /// the same pass).
     pub fn eval_into<F: Real>(
@@ -78,10 +79,6 @@ impl EnvMap {
         out: &mut [[F; 3]],
         valid: impl Fn(&[F; 3]) -> bool,
     ) -> bool {
-        let read = {
-            #[inline(always)]
-            |c: &Corners<F>| self.radiance_of(c)
-        };
         match self.options.mapping {
             Mapping::LatLong => {
                 let place = {
@@ -92,20 +89,33 @@ impl EnvMap {
                     #[inline(always)]
                     |q: &LatLongPlace<F>| self.prefetched(self.image.placed_corners(q))
                 };
-                pipelined(d, out, &place, valid, locate, |_, c| read(c))
+                pipelined(d, out, &place, valid, locate, |_, c| self.radiance_of(c))
             }
-            mapping @ (Mapping::Angular | Mapping::Cube) => {
-                let place = {
-                    #[inline(always)]
-                    |x: [F; 3]| self.uv_of(mapping, x)
-                };
-                let locate = {
-                    #[inline(always)]
-                    |p: &[F; 2]| self.prefetched(self.image.corners(mapping, *p))
-                };
-                pipelined(d, out, &place, valid, locate, |_, c| read(c))
-            }
+            Mapping::Angular => self.eval_by_corners(d, out, valid, Mapping::Angular),
+            Mapping::Cube => self.eval_by_corners(d, out, valid, Mapping::Cube),
         }
+    }
+
+    /// [`EnvMap::eval_into`] of a map whose places are found by
+    /// [`Image::corners`] (called with each `mapping` as a constant, so that
+    /// its formulas are inlined without a branch).
+    #[inline(always)]
+    fn eval_by_corners<F: Real>(
+        &self,
+        d: &[[F; 3]],
+        out: &mut [[F; 3]],
+        valid: impl Fn(&[F; 3]) -> bool,
+        mapping: Mapping,
+    ) -> bool {
+        let place = {
+            #[inline(always)]
+            |x: [F; 3]| self.uv_of(mapping, x)
+        };
+        let locate = {
+            #[inline(always)]
+            |p: &[F; 2]| self.prefetched(self.image.corners(mapping, *p))
+        };
+        pipelined(d, out, &place, valid, locate, |_, c| self.radiance_of(c))
     }
 
     /// `corners`, their texels prefetched.
@@ -116,14 +126,15 @@ impl EnvMap {
     }
 
     /// `out[i] = pdf(d[i])` for a batch, in `F`, in blocks of
-    /// `BATCH_BLOCK`, two in flight: for the luminance density, every
-    /// direction's place and Jacobian at full SIMD width, then the table
-    /// lines under it prefetched; for polar tables, every direction's cell
-    /// by the branch-free [`PolarTable::query`] at full SIMD width and its
-    /// density prefetched; either read one block behind, so that the reads
-    /// wait on no cache miss; for the others
-    /// [`EnvMap::pdf_query`] then [`EnvMap::pdf_at`]. Returns whether
-    /// `valid` held for every direction (it is checked in the same pass).
+    /// [`simd::BLOCK`], two in flight: for the luminance density, every
+    /// direction's cell, bilinear weights and Jacobian at full SIMD width
+    /// (`EnvMap::luminance_query`), then the table lines of the cell
+    /// prefetched; for polar tables, every direction's cell by the
+    /// branch-free [`PolarTable::query`] at full SIMD width and its density
+    /// prefetched; either read one block behind, so that the reads wait on
+    /// no cache miss; for the others [`EnvMap::pdf_query`] then
+    /// [`EnvMap::pdf_at`]. Returns whether `valid` held for every direction
+    /// (it is checked in the same pass).
     pub fn pdf_into<F: TableFloat>(
         &self,
         d: &[[F; 3]],
@@ -131,7 +142,24 @@ impl EnvMap {
         valid: impl Fn(&[F; 3]) -> bool,
     ) -> bool {
         if let Distribution::Luminance(density) = &self.distribution {
-            self.luminance_pdf_into(density, d, out, valid)
+            let query = {
+                #[inline(always)]
+                |x: [F; 3]| self.luminance_query(x)
+            };
+            let locate = {
+                #[inline(always)]
+                |q: &[F; 7]| {
+                    let k = self.image.place_texel(q[0], q[1]);
+                    density.prefetch(k);
+                    k
+                }
+            };
+            let tables = density.tables();
+            let read = {
+                #[inline(always)]
+                move |q: &[F; 7], &k: &usize| EnvMap::luminance_pdf_in(tables, q, k)
+            };
+            pipelined(d, out, &query, valid, locate, read)
         } else if let Some(table) = &self.polar {
             let densities = F::densities(table);
             let query = {
@@ -165,64 +193,6 @@ impl EnvMap {
             }
             ok
         }
-    }
-
-    /// [`EnvMap::pdf_into`] of the luminance `density`, in blocks of
-    /// [`simd::BLOCK`], two in flight: each block's queries
-    /// ([`EnvMap::luminance_query`]) at SIMD width into columns, their cells
-    /// located and the cells' table lines prefetched, then the block before
-    /// read ([`EnvMap::luminance_pdf_in`]) by a loop over columns that
-    /// gathers at SIMD width, its lines by now in the caches.
-    fn luminance_pdf_into<F: Real>(
-        &self,
-        density: &LuminanceDensity,
-        d: &[[F; 3]],
-        out: &mut [F],
-        valid: impl Fn(&[F; 3]) -> bool,
-    ) -> bool {
-        const B: usize = simd::BLOCK;
-        let query = {
-            #[inline(always)]
-            |x: [F; 3]| self.luminance_query(x)
-        };
-        let tables = density.tables();
-        let read = {
-            #[inline(always)]
-            move |out: &mut [F], q: &[[F; B]; 7], cells: &[usize; B]| {
-                let rows = B.min(out.len());
-                let out = &mut out[..rows];
-                for (i, o) in out.iter_mut().enumerate() {
-                    let qi = std::array::from_fn(|m| q[m][i]);
-                    *o = EnvMap::luminance_pdf_in(tables, &qi, cells[i]);
-                }
-            }
-        };
-        let mut queries = [[[F::zero(); B]; 7]; 2];
-        let mut cells = [[0; B]; 2];
-        simd::dispatch(
-            #[inline(always)]
-            |level| {
-                let mut ok = true;
-                // The block waiting to be read: its buffers' index and its
-                // outputs.
-                let mut previous: Option<(usize, &mut [F])> = None;
-                for (b, (o, x)) in out.chunks_mut(B).zip(d.chunks(B)).enumerate() {
-                    let (q, c) = (&mut queries[b % 2], &mut cells[b % 2]);
-                    ok &= simd::map_to_columns(q, x, &query, &valid, level);
-                    for (c, (&x0, &y0)) in c.iter_mut().zip(q[0].iter().zip(&q[1])) {
-                        *c = self.image.place_texel(x0, y0);
-                        density.prefetch(*c);
-                    }
-                    if let Some((p, o)) = previous.replace((b % 2, o)) {
-                        read(o, &queries[p], &cells[p]);
-                    }
-                }
-                if let Some((p, o)) = previous {
-                    read(o, &queries[p], &cells[p]);
-                }
-                ok
-            },
-        )
     }
 
     /// `out[i] = sample(us[i])` for a batch, in groups: the table points by
@@ -456,12 +426,12 @@ enum Cells<'a> {
 }
 
 /// `out[i] = read(q, locate(q))` with `q = query(d[i])`, in blocks of
-/// `BATCH_BLOCK` with two in flight: each block's queries at full SIMD
-/// width ([`simd::map_rows`], which checks `valid` in the same pass), then
-/// their table entries located (`locate` prefetches them), then the block
-/// before read, its entries by now in the caches: the table reads overlap
-/// the next block's arithmetic instead of waiting on it. Returns whether
-/// `valid` held for every direction.
+/// [`simd::BLOCK`] with two in flight: each block's queries at full SIMD
+/// width into columns ([`simd::map_to_columns`], which checks `valid` in
+/// the same pass), then their table entries located (`locate` prefetches
+/// them), then the block before read, its entries by now in the caches:
+/// the table reads overlap the next block's arithmetic instead of waiting
+/// on it. Returns whether `valid` held for every direction.
 #[inline(always)]
 fn pipelined<F: Real, T, C: Copy + Default, const K: usize>(
     d: &[[F; 3]],
@@ -471,11 +441,13 @@ fn pipelined<F: Real, T, C: Copy + Default, const K: usize>(
     locate: impl Fn(&[F; K]) -> C,
     read: impl Fn(&[F; K], &C) -> T,
 ) -> bool {
-    let mut queries = [[[F::zero(); K]; BATCH_BLOCK]; 2];
-    let mut entries = [[C::default(); BATCH_BLOCK]; 2];
-    let read_block = |o: &mut [T], q: &[[F; K]; BATCH_BLOCK], c: &[C; BATCH_BLOCK]| {
-        for ((o, q), c) in o.iter_mut().zip(q).zip(c) {
-            *o = read(q, c);
+    const B: usize = simd::BLOCK;
+    let mut queries = [[[F::zero(); B]; K]; 2];
+    let mut entries = [[C::default(); B]; 2];
+    let row = |q: &[[F; B]; K], i: usize| -> [F; K] { std::array::from_fn(|m| q[m][i]) };
+    let read_block = |o: &mut [T], q: &[[F; B]; K], c: &[C; B]| {
+        for (i, (o, c)) in o.iter_mut().zip(c).enumerate() {
+            *o = read(&row(q, i), c);
         }
     };
     simd::dispatch(
@@ -485,16 +457,14 @@ fn pipelined<F: Real, T, C: Copy + Default, const K: usize>(
             // The block waiting to be read: its buffers' index and its
             // outputs, as many as its rows.
             let mut previous: Option<(usize, &mut [T])> = None;
-            let blocks = out.chunks_mut(BATCH_BLOCK).zip(d.chunks(BATCH_BLOCK));
-            for (b, (o, x)) in blocks.enumerate() {
+            for (b, (o, x)) in out.chunks_mut(B).zip(d.chunks(B)).enumerate() {
                 let (q, c) = (&mut queries[b % 2], &mut entries[b % 2]);
-                ok &= simd::map_rows(&mut q[..x.len()], x, query, &valid, false);
-                for (c, q) in c.iter_mut().zip(&q[..x.len()]) {
-                    *c = locate(q);
+                ok &= simd::map_to_columns(q, x, query, &valid);
+                for (i, c) in c[..x.len()].iter_mut().enumerate() {
+                    *c = locate(&row(q, i));
                 }
                 let rows = x.len().min(o.len());
-                let o = &mut o[..rows];
-                if let Some((p, o)) = previous.replace((b % 2, o)) {
+                if let Some((p, o)) = previous.replace((b % 2, &mut o[..rows])) {
                     read_block(o, &queries[p], &entries[p]);
                 }
             }

@@ -180,7 +180,7 @@ impl Image {
     /// without indices, so that a batch computes it at SIMD width; the
     /// indices follow by [`Image::placed_corners`].
     #[inline(always)]
-    pub fn lat_long_place<F: Real>(&self, p: [F; 2]) -> LatLongPlace<F> {
+    pub(crate) fn lat_long_place<F: Real>(&self, p: [F; 2]) -> LatLongPlace<F> {
         let (w, h) = (self.width, self.height);
         let (zero, one) = (F::zero(), F::one());
         // `p[0]` in [0, 1]: one wrap below 0.
@@ -196,12 +196,11 @@ impl Image {
         [x0, y0, w00, w10, w01, w11]
     }
 
-    /// The texels and weights of a lat-long place (the first six numbers
-    /// of `place`, as [`Image::lat_long_place`] makes them).
+    /// The texels and weights of a lat-long place ([`Image::lat_long_place`]).
     #[inline(always)]
-    pub fn placed_corners<F: Real>(&self, place: &[F]) -> Corners<F> {
+    pub(crate) fn placed_corners<F: Real>(&self, place: &LatLongPlace<F>) -> Corners<F> {
         let (w, k) = (self.width, self.place_texel(place[0], place[1]));
-        let right = right_of(k, place[0], w);
+        let right = right_of(k, place[0].floor_index(w - 1), w);
         (
             [k, right, k + w, right + w],
             [place[2], place[3], place[4], place[5]],
@@ -211,7 +210,7 @@ impl Image {
     /// The top-left texel of the cell `(x₀, y₀)` of a lat-long place (which
     /// is also the cell's index).
     #[inline(always)]
-    pub fn place_texel<F: Real>(&self, x0: F, y0: F) -> usize {
+    pub(crate) fn place_texel<F: Real>(&self, x0: F, y0: F) -> usize {
         let w = self.width;
         y0.floor_index(self.height - 2) * w + x0.floor_index(w - 1)
     }
@@ -254,11 +253,11 @@ impl Image {
     }
 }
 
-/// The texel right of texel `k` of column `x₀` on a lat-long map `width`
+/// The texel right of texel `k` of column `col` on a lat-long map `width`
 /// texels wide, wrapped from the row's last column to its first.
 #[inline(always)]
-pub fn right_of<F: Real>(k: usize, x0: F, width: usize) -> usize {
-    if x0 == F::c((width - 1) as f64) {
+pub(super) fn right_of(k: usize, col: usize, width: usize) -> usize {
+    if col + 1 == width {
         k + 1 - width
     } else {
         k + 1

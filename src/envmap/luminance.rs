@@ -190,9 +190,9 @@ impl Tables<'_> {
     /// width.
     #[inline(always)]
     pub(super) fn pdf_at<F: Real>(self, k: usize, x0: F, wt: [F; 4]) -> F {
-        let right = right_of(k, x0, self.width);
+        let right = right_of(k, x0.floor_index(self.width - 1), self.width);
         let at = |table: &[f64], i: usize| F::c(table.get(i).copied().unwrap_or(0.0));
-        let y = wt[0] * at(self.lum, k) + wt[1] * at(self.lum, right);
+        let y = F::zero() + wt[0] * at(self.lum, k) + wt[1] * at(self.lum, right);
         let y = y + wt[2] * at(self.below, k) + wt[3] * at(self.below, right);
         y * at(self.scale, k)
     }
@@ -210,12 +210,7 @@ fn warp_corners(c: [f64; 4], r: [f64; 2]) -> [f64; 3] {
 /// texels `col` and the next column (wrapped) on rows `row` and `row + 1`.
 #[inline(always)]
 fn corners(lum: &[f64], width: usize, k: usize) -> [f64; 4] {
-    let col = k % width;
-    let next = if col + 1 == width {
-        k + 1 - width
-    } else {
-        k + 1
-    };
+    let next = right_of(k, k % width, width);
     [lum[k], lum[next], lum[k + width], lum[next + width]]
 }
 

@@ -289,7 +289,7 @@ impl EnvMap {
     /// ([`EnvMap::luminance_query`]) over a block at SIMD width, the
     /// cell under it ([`Image::place_texel`]), its table lines prefetched,
     /// and the density there ([`EnvMap::luminance_pdf_in`]) one block
-    /// later, at SIMD width.
+    /// later.
     #[inline(always)]
     pub(super) fn luminance_pdf<F: Real>(&self, density: &LuminanceDensity, d: V3<F>) -> F {
         let q = self.luminance_query(d);

@@ -265,22 +265,24 @@ where
 /// `columns[m][i] = kernel(rows[i])[m]` for a block of at most [`BLOCK`]
 /// rows, at full SIMD width, with the results left in columns (the rest of
 /// each column is the kernel of the first row); returns whether `valid`
-/// holds for every row. For batches whose next step reads tables at the
-/// results' indices: a loop over columns gathers at SIMD width, which a
-/// loop over rows does not. Call it inside [`dispatch`], with its level.
+/// holds for every row. For pipelines that go on from a block's results
+/// row by row later (a table read at each), which need no transpose back.
+///
+/// # Panics
+/// If `rows` has more than [`BLOCK`] rows.
 #[inline(always)]
 pub fn map_to_columns<F, T, const K: usize, const M: usize>(
     columns: &mut [[T; BLOCK]; M],
     rows: &[[F; K]],
     kernel: &impl Fn([F; K]) -> [T; M],
     valid: impl Fn(&[F; K]) -> bool,
-    level: Level,
 ) -> bool
 where
     F: Copy + Default,
     T: Copy + Default,
 {
-    debug_assert!(rows.len() <= BLOCK);
+    assert!(rows.len() <= BLOCK, "a block has at most {BLOCK} rows");
+    let level = level();
     if let Ok(block) = <&[[F; K]; BLOCK]>::try_from(rows) {
         return map_block_to_columns(columns, block, kernel, &valid, level);
     }
