@@ -218,11 +218,10 @@ where
     F: Copy + Default,
     T: Copy + Default,
 {
-    let Some(&first) = inputs.first() else {
+    let Some(padded) = padded_block(inputs) else {
         return true;
     };
     let n = inputs.len();
-    let padded: [[F; K]; BLOCK] = std::array::from_fn(|i| if i < n { inputs[i] } else { first });
     let mut rows = [[T::default(); M]; BLOCK];
     let ok = map_block(&mut rows, &padded, kernel, valid, level, false);
     out.copy_from_slice(&rows[..n]);
@@ -286,11 +285,20 @@ where
     if let Ok(block) = <&[[F; K]; BLOCK]>::try_from(rows) {
         return map_block_to_columns(columns, block, kernel, &valid, level);
     }
-    let Some(&first) = rows.first() else {
-        return true;
-    };
-    let padded: [[F; K]; BLOCK] = std::array::from_fn(|i| rows.get(i).copied().unwrap_or(first));
-    map_block_to_columns(columns, &padded, kernel, &valid, level)
+    match padded_block(rows) {
+        Some(padded) => map_block_to_columns(columns, &padded, kernel, &valid, level),
+        None => true,
+    }
+}
+
+/// The rows of a part block (fewer than [`BLOCK`]) padded to a whole one
+/// with copies of the first; `None` for no rows.
+#[inline(always)]
+fn padded_block<F: Copy, const K: usize>(rows: &[[F; K]]) -> Option<[[F; K]; BLOCK]> {
+    let &first = rows.first()?;
+    Some(std::array::from_fn(|i| {
+        rows.get(i).copied().unwrap_or(first)
+    }))
 }
 
 /// The columns of one block of [`map_rows`]: its rows transposed to
