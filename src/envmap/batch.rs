@@ -125,8 +125,9 @@ impl EnvMap {
         corners
     }
 
-    /// `out[i] = pdf(d[i])` for a batch, in `F`, in blocks of
-    /// [`simd::BLOCK`], two in flight: for the luminance density, every
+    /// `out[i] = pdf(d[i])` for a batch, in `F`. For the luminance density
+    /// and polar tables in blocks of [`simd::BLOCK`], two in flight: for
+    /// the luminance density, every
     /// direction's cell, bilinear weights and Jacobian at full SIMD width
     /// (`EnvMap::luminance_query`), then the table lines of the cell
     /// prefetched; for polar tables, every direction's cell by the
@@ -187,7 +188,7 @@ impl EnvMap {
                     ok &= valid(x);
                     *q = self.pdf_query(x.map(F::f64));
                 }
-                for (o, q) in o.iter_mut().zip(&queries) {
+                for (o, q) in o.iter_mut().zip(&queries[..x.len()]) {
                     *o = F::c(self.pdf_at(*q));
                 }
             }

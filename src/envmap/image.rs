@@ -172,13 +172,13 @@ impl Image {
 
     /// Where the lat-long point `p` (`s` in `[0, 1]`) falls among the
     /// texel centres, as a [`LatLongPlace`]: with `x = ((s − ½/W) mod 1) W`
-    /// and `y = clamp(t, 0, 1) (H − 1)`, the cell `x₀ = ⌊x⌋ ≤ W − 1`,
-    /// `y₀ = ⌊y⌋ ≤ H − 2` and the fractions `f_x = clamp(x − x₀, 0, 1)`,
+    /// and `y = clamp(t, 0, 1) (H − 1)`, the cell `x₀ = ⌊x⌋`, `y₀ = ⌊y⌋`
+    /// (clamped to `W − 1` and `H − 2` where they are read:
+    /// [`Image::place_texel`]) and the fractions `f_x = clamp(x − x₀, 0, 1)`,
     /// `f_y = y − y₀` give the weights `(1 − f_x)(1 − f_y)`, `f_x (1 − f_y)`,
     /// `(1 − f_x) f_y`, `f_x f_y` of the texels `(x₀, y₀)`, `(x₀ + 1, y₀)`
     /// (wrapped), `(x₀, y₀ + 1)`, `(x₀ + 1, y₀ + 1)`. Branch-free and
-    /// without indices, so that a batch computes it at SIMD width; the
-    /// indices follow by [`Image::placed_corners`].
+    /// without indices, so that a batch computes it at SIMD width.
     #[inline(always)]
     pub(crate) fn lat_long_place<F: Real>(&self, p: [F; 2]) -> LatLongPlace<F> {
         let (w, h) = (self.width, self.height);
@@ -187,11 +187,12 @@ impl Image {
         let x = p[0] - F::c(0.5 / w as f64);
         let x = (x + if x < zero { one } else { zero }) * F::c(w as f64);
         let y = p[1].max(zero).min(one) * F::c((h - 1) as f64);
-        // (`max` first: a NaN lands in cell 0, as `floor_index` puts it.)
-        let x0 = x.floor().max(zero).min(F::c((w - 1) as f64));
-        let y0 = y.floor().max(zero).min(F::c((h - 2) as f64));
-        let fx = (x - x0).max(zero).min(one);
-        let fy = y - y0;
+        // (The cell is kept unclamped, so that `floor_index` clamps it in
+        // integers: in `f32` the last column of a map wider than 2²⁴ has
+        // no float of its own. A NaN `x` has the weights of cell 0 there.)
+        let (x0, y0) = (x.floor(), y.floor());
+        let fx = (x - x0.min(F::c((w - 1) as f64))).max(zero).min(one);
+        let fy = y - y0.min(F::c((h - 2) as f64));
         let [w00, w10, w01, w11] = bilinear_weights(fx, fy);
         [x0, y0, w00, w10, w01, w11]
     }
@@ -351,6 +352,68 @@ mod tests {
                     (a[0] - b[0]).abs() < 1e-12,
                     "cell ({row}, {col}), r = {r:?}: {a:?} against {b:?}"
                 );
+            }
+        }
+    }
+
+    /// The lat-long arm of `corners` before the cell and weights were
+    /// found branch-free (b8c2b78), kept to show the same bits.
+    fn former_lat_long_corners<F: Real>(img: &Image, p: [F; 2]) -> Corners<F> {
+        let (w, h) = (img.width, img.height);
+        let (zero, one) = (F::zero(), F::one());
+        let x = p[0] - F::c(0.5 / w as f64);
+        let x = (x + if x < zero { one } else { zero }) * F::c(w as f64);
+        let y = p[1].max(zero).min(one) * F::c((h - 1) as f64);
+        let (x0, y0) = (x.floor_index(w - 1), y.floor_index(h - 2));
+        let fx = (x - F::c(x0 as f64)).max(zero).min(one);
+        let fy = y - F::c(y0 as f64);
+        let x1 = if x0 + 1 == w { 0 } else { x0 + 1 };
+        quad([x0, x1], [y0, y0 + 1], w, fx, fy)
+    }
+
+    #[test]
+    fn lat_long_places_give_the_former_corners() {
+        // Random points, the seam, the poles, points off the domain and
+        // NaN, on a padded 1 × 1 map and a 32 × 17 one, in f32 and f64.
+        fn check<F: Real>(img: &Image, p: [F; 2]) {
+            let (new, old) = (
+                img.corners(Mapping::LatLong, p),
+                former_lat_long_corners(img, p),
+            );
+            assert_eq!(new.0, old.0, "{p:?}");
+            let bits = |c: Corners<F>| c.1.map(|v| v.f64().to_bits());
+            assert_eq!(bits(new), bits(old), "{p:?}");
+        }
+        let mut rng = crate::rng::Rng::new(5, 2);
+        for (w, h) in [(1, 1), (32, 17)] {
+            let img = Image::new(Mapping::LatLong, w, h, &ramp(w, h)).unwrap();
+            let half = 0.5 / img.width() as f64;
+            let special = [
+                0.0,
+                -0.0,
+                1.0,
+                half,
+                half - 1e-12,
+                half + 1e-12,
+                1.0 - half,
+                -0.5,
+                1.5,
+                f64::NAN,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+            ];
+            let mut points: Vec<[f64; 2]> = (0..2000)
+                .map(|_| [rng.next_float(), rng.next_float()])
+                .collect();
+            for &s in &special {
+                points.extend(special.iter().map(|&t| [s, t]));
+            }
+            for p in points {
+                check(&img, p);
+                check(&img, p.map(|v| v as f32));
+                let (s32, next) = (p[0] as f32, f32::from_bits((p[0] as f32).to_bits() + 1));
+                check(&img, [next, p[1] as f32]);
+                check(&img, [s32, p[1] as f32]);
             }
         }
     }

@@ -97,8 +97,8 @@ impl LuminanceDensity {
     }
 
     /// Asks the CPU for the table lines that [`LuminanceDensity::place`]
-    /// and [`Tables::pdf_at`] read for the cell
-    /// whose top left texel is `k`: its two rows' luminances and its scale.
+    /// and [`Tables::pdf_at`] read for the cell whose top left texel is
+    /// `k`: its two rows' luminances and its scale.
     #[inline(always)]
     pub(super) fn prefetch(&self, k: usize) {
         simd::prefetch(&self.lum, k);
@@ -185,11 +185,12 @@ pub(super) struct Tables<'a> {
 impl Tables<'_> {
     /// `p_q` at the blend by `wt` of the texels of cell `k` (its top-left
     /// texel) of column `x₀`: texel `k`, the one right of it
-    /// ([`right_of`]) and the two below them, in `F`. A texel outside the tables reads as 0 (never for a cell of the
-    /// map), a read without a panic that a loop of these gathers at SIMD
-    /// width.
+    /// ([`right_of`]) and the two below them, in `F`, the sum from 0 as a
+    /// blend of texels starts. A texel outside the tables reads as 0
+    /// (never one of a cell of the map).
     #[inline(always)]
     pub(super) fn pdf_at<F: Real>(self, k: usize, x0: F, wt: [F; 4]) -> F {
+        debug_assert!(k < self.scale.len(), "cell {k} is not one of the map's");
         let right = right_of(k, x0.floor_index(self.width - 1), self.width);
         let at = |table: &[f64], i: usize| F::c(table.get(i).copied().unwrap_or(0.0));
         let y = F::zero() + wt[0] * at(self.lum, k) + wt[1] * at(self.lum, right);

@@ -183,9 +183,9 @@ fn batch_sampling_agrees_with_single_draws() {
 /// block they place) give the one-at-a-time values, in `f64` and `f32`.
 #[test]
 fn batch_pdfs_and_evals_agree_with_single_queries() {
-    // Lengths around the block size, so that the last block (read after the
+    // Lengths around the pipelines' blocks of `simd::BLOCK` and the other
+    // densities' of `BATCH_BLOCK`, so that the last block (read after the
     // loop) is empty, partial or whole.
-    // (Also around the luminance density's blocks of `simd::BLOCK`.)
     let mut rng = crate::rng::Rng::new(11, 1);
     let block = crate::simd::BLOCK;
     for m in all_maps() {
@@ -240,12 +240,30 @@ fn batch_pdfs_and_evals_agree_with_single_queries() {
                 );
             }
         }
-        // A direction that fails the check in the last, partial block.
-        let invalid = |x: &[f64; 3]| x != &d[3 * BATCH_BLOCK];
-        let mut out = vec![0.0; d.len()];
-        assert!(!m.pdf_into(&d, &mut out, invalid));
-        let mut radiance = vec![[0.0; 3]; d.len()];
-        assert!(!m.eval_into(&d, &mut radiance, invalid));
+        // A direction that fails the check: in the last, partial block, in
+        // a whole block, at a row past the first of a partial block.
+        for (bad, n) in [
+            (3 * BATCH_BLOCK, d.len()),
+            (block + 5, d.len()),
+            (block + 5, block + 9),
+        ] {
+            let invalid = |x: &[f64; 3]| x != &d[bad];
+            let mut out = vec![0.0; n];
+            assert!(!m.pdf_into(&d[..n], &mut out, invalid), "{bad} of {n}");
+            let mut radiance = vec![[0.0; 3]; n];
+            assert!(
+                !m.eval_into(&d[..n], &mut radiance, invalid),
+                "{bad} of {n}"
+            );
+        }
+        // Outputs longer than the directions: the rows past them untouched.
+        let n = block + 3;
+        let mut out = vec![-1.0; n + 70];
+        assert!(m.pdf_into(&d[..n], &mut out, |_| true));
+        assert!(out[n..].iter().all(|&v| v == -1.0), "{:?}", m.options());
+        let mut radiance = vec![[-1.0; 3]; n + 70];
+        assert!(m.eval_into(&d[..n], &mut radiance, |_| true));
+        assert!(radiance[n..].iter().all(|&v| v == [-1.0; 3]));
     }
 }
 

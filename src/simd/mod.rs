@@ -301,9 +301,10 @@ fn padded_block<F: Copy, const K: usize>(rows: &[[F; K]]) -> Option<[[F; K]; BLO
     }))
 }
 
-/// The columns of one block of [`map_rows`]: its rows transposed to
-/// columns (by permutes on AVX-512 where [`lanes`] handles the shape),
-/// then mapped by a loop over columns of constant length that vectorises.
+/// The columns of one block of [`map_rows`] or [`map_to_columns`]: its
+/// rows transposed to columns (by permutes on AVX-512 where [`lanes`]
+/// handles the shape), then mapped by a loop over columns of constant
+/// length that vectorises.
 #[inline(always)]
 fn map_block_to_columns<F, T, const K: usize, const M: usize>(
     results: &mut [[T; BLOCK]; M],
