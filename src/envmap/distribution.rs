@@ -73,7 +73,7 @@ fn sampling_luminance(
     mapping: Mapping,
     weights: [f64; 3],
     compensate: bool,
-) -> Result<Vec<f64>> {
+) -> Result<Buffer<f64>> {
     let mut lum = luminances(image, weights)?;
     if let Some(mean) = compensate
         .then(|| compensation_mean(&lum, image, mapping))
@@ -85,11 +85,15 @@ fn sampling_luminance(
 }
 
 /// Each texel's luminance by the coefficients `weights`.
-fn luminances(image: &Image, weights: [f64; 3]) -> Result<Vec<f64>> {
+fn luminances(image: &Image, weights: [f64; 3]) -> Result<Buffer<f64>> {
     let luminance = |t: &[f32; 3]| (0..3).map(|k| weights[k] * f64::from(t[k])).sum::<f64>();
+    let mut lum = Buffer::for_overwrite(image.texels().len(), "the luminances")?;
     parallel::install(|| {
-        alloc::par_collect(image.texels().par_iter().map(luminance), "the luminances")
-    })?
+        (lum.par_iter_mut().zip(image.texels()))
+            .with_min_len(parallel::CHUNK)
+            .for_each(|(l, t)| *l = luminance(t));
+    })?;
+    Ok(lum)
 }
 
 /// The mean of the texel luminances `lum` that compensation subtracts (for

@@ -13,6 +13,7 @@
 use super::MAX_TEXELS;
 use super::mapping::Mapping;
 use crate::alloc;
+use crate::buffer::Buffer;
 use crate::error::{Error, Result, check_at_most};
 use crate::math::{Real, luminance};
 use crate::simd;
@@ -23,7 +24,7 @@ use crate::simd;
 pub struct Image {
     width: usize,
     height: usize,
-    texels: Vec<[f32; 3]>,
+    texels: Buffer<[f32; 3]>,
 }
 
 /// The four texels around a point and their bilinear weights (all 0
@@ -89,25 +90,30 @@ impl Image {
                 value: f64::from(data[i]),
             });
         }
-        let mut texels: Vec<[f32; 3]> = alloc::copy(data.as_chunks::<3>().0, "the texels")?;
+        let texels = data.as_chunks::<3>().0;
+        if mapping != Mapping::LatLong || (width >= 2 && height >= 3) {
+            return Ok(Image {
+                width,
+                height,
+                texels: Buffer::from_slice(texels, "the texels")?,
+            });
+        }
+        // A lat-long map narrower than 2 texels or shorter than 3 (a few
+        // texels): its columns doubled, its last row repeated.
+        let mut texels: Vec<[f32; 3]> = alloc::copy(texels, "the texels")?;
         let (mut width, mut height) = (width, height);
-        if mapping == Mapping::LatLong && width < 2 {
-            let mut doubled = alloc::with_capacity(2 * texels.len(), "the texels")?;
-            doubled.extend(texels.iter().flat_map(|&t| [t, t]));
-            texels = doubled;
+        if width < 2 {
+            texels = texels.iter().flat_map(|&t| [t, t]).collect();
             width = 2;
         }
-        if mapping == Mapping::LatLong && height < 3 {
-            alloc::reserve(&mut texels, (3 - height) * width, "the texels")?;
-            for _ in height..3 {
-                texels.extend_from_within((height - 1) * width..height * width);
-            }
-            height = 3;
+        for _ in height..3 {
+            texels.extend_from_within((height - 1) * width..height * width);
         }
+        height = height.max(3);
         Ok(Image {
             width,
             height,
-            texels,
+            texels: Buffer::from_slice(&texels, "the texels")?,
         })
     }
 

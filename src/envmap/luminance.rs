@@ -6,11 +6,13 @@
 
 use super::bilinear::{bilerp, warp_bilinear};
 use super::image::right_of;
-use crate::alloc;
+use crate::buffer::Buffer;
 use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;
 use crate::math::Real;
+use crate::parallel;
 use crate::simd;
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// Below this angle (radians) [`angle_terms`] sums Taylor series
@@ -45,13 +47,13 @@ const SERIES_BELOW: f64 = 0.25;
 #[derive(Clone, Debug)]
 pub(super) struct LuminanceDensity {
     /// Each texel's sampling luminance, row-major.
-    lum: Vec<f64>,
+    lum: Buffer<f64>,
     width: usize,
     /// The cells `(row, col)`, weighted `∫∫ Y sin θ dx dy`.
     cells: Discrete2D,
     /// `P_c · WH' / Ȳ_c` of each cell (0 where `Ȳ_c = 0`): `p_q` is `Y`
     /// times this.
-    scale: Vec<f64>,
+    scale: Buffer<f64>,
 }
 
 impl LuminanceDensity {
@@ -60,29 +62,45 @@ impl LuminanceDensity {
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the tables cannot be had.
-    pub(super) fn new(lum: Vec<f64>, width: usize, height: usize) -> Result<Option<Self>> {
+    pub(super) fn new(lum: Buffer<f64>, width: usize, height: usize) -> Result<Option<Self>> {
         let delta = PI / (height - 1) as f64;
         let cell_count = width * (height - 1);
-        let mut weights = alloc::with_capacity(cell_count, "the sampling cells")?;
-        for j in 0..height - 1 {
+        // Row by row on all cores: `fill(j, row)` writes the cells of row
+        // `j`, the same values whatever the thread count.
+        let by_rows = |table: &mut [f64], fill: &(dyn Fn(usize, &mut [f64]) + Sync)| {
+            parallel::install(|| {
+                (table.par_chunks_mut(width).enumerate())
+                    .with_min_len(parallel::CHUNK.div_ceil(width))
+                    .for_each(|(j, row)| fill(j, row));
+            })
+        };
+        let mut weights = Buffer::for_overwrite(cell_count, "the sampling cells")?;
+        by_rows(&mut weights, &|j, row| {
             let (sin, cos) = (j as f64 * delta).sin_cos();
             let [i0, i1] = moments([sin.max(0.0), cos], delta);
-            for i in 0..width {
+            for (i, w) in row.iter_mut().enumerate() {
                 let [a, b, c, d] = corners(&lum, width, j * width + i);
                 let alpha = 0.5 * (a + b);
-                weights.push(alpha * i0 + (0.5 * (c + d) - alpha) * i1);
+                *w = alpha * i0 + (0.5 * (c + d) - alpha) * i1;
             }
-        }
+        })?;
         if !weights.iter().any(|&w| w > 0.0) {
             return Ok(None);
         }
         let cells = Discrete2D::with_arg("image", &weights, height - 1, width)?;
         let per_cell = cell_count as f64 / cells.sum();
-        let mut scale = alloc::with_capacity(cell_count, "the sampling cells")?;
-        scale.extend(weights.iter().enumerate().map(|(k, &w)| {
-            let mean = 0.25 * corners(&lum, width, k).iter().sum::<f64>();
-            if mean > 0.0 { w * per_cell / mean } else { 0.0 }
-        }));
+        let mut scale = Buffer::for_overwrite(cell_count, "the sampling cells")?;
+        by_rows(&mut scale, &|j, row| {
+            for (i, s) in row.iter_mut().enumerate() {
+                let k = j * width + i;
+                let mean = 0.25 * corners(&lum, width, k).iter().sum::<f64>();
+                *s = if mean > 0.0 {
+                    weights[k] * per_cell / mean
+                } else {
+                    0.0
+                };
+            }
+        })?;
         Ok(Some(LuminanceDensity {
             lum,
             width,
@@ -316,7 +334,9 @@ mod tests {
         let (w, h) = (8, 5);
         let mut lum: Vec<f64> = (0..w * h).map(|k| (k % 7) as f64).collect();
         lum[2 * w + 3] = 40.0;
-        let d = LuminanceDensity::new(lum.clone(), w, h).unwrap().unwrap();
+        let d = LuminanceDensity::new(Buffer::from_slice(&lum, "lum").unwrap(), w, h)
+            .unwrap()
+            .unwrap();
         // p_q integrates to 1 over the table (midpoint rule, exact for a
         // bilinear function), and follows Y within each cell.
         let n = 8;
@@ -341,7 +361,7 @@ mod tests {
             "{total}"
         );
         assert!(
-            LuminanceDensity::new(vec![0.0; w * h], w, h)
+            LuminanceDensity::new(Buffer::zeroed(w * h, "lum").unwrap(), w, h)
                 .unwrap()
                 .is_none()
         );
