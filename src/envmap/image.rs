@@ -12,7 +12,6 @@
 
 use super::MAX_TEXELS;
 use super::mapping::Mapping;
-use crate::alloc;
 use crate::buffer::Buffer;
 use crate::error::{Error, Result, check_at_most};
 use crate::math::{Real, luminance};
@@ -98,22 +97,18 @@ impl Image {
                 texels: Buffer::from_slice(texels, "the texels")?,
             });
         }
-        // A lat-long map narrower than 2 texels or shorter than 3 (a few
-        // texels): its columns doubled, its last row repeated.
-        let mut texels: Vec<[f32; 3]> = alloc::copy(texels, "the texels")?;
-        let (mut width, mut height) = (width, height);
-        if width < 2 {
-            texels = texels.iter().flat_map(|&t| [t, t]).collect();
-            width = 2;
+        // A lat-long map narrower than 2 texels or shorter than 3: its one
+        // column doubled, its last row repeated.
+        let (padded_width, padded_height) = (width.max(2), height.max(3));
+        let mut padded = Buffer::for_overwrite(padded_width * padded_height, "the texels")?;
+        for (k, t) in padded.iter_mut().enumerate() {
+            let (y, x) = (k / padded_width, k % padded_width);
+            *t = texels[y.min(height - 1) * width + x.min(width - 1)];
         }
-        for _ in height..3 {
-            texels.extend_from_within((height - 1) * width..height * width);
-        }
-        height = height.max(3);
         Ok(Image {
-            width,
-            height,
-            texels: Buffer::from_slice(&texels, "the texels")?,
+            width: padded_width,
+            height: padded_height,
+            texels: padded,
         })
     }
 
@@ -375,6 +370,34 @@ mod tests {
         let fy = y - F::c(y0 as f64);
         let x1 = if x0 + 1 == w { 0 } else { x0 + 1 };
         quad([x0, x1], [y0, y0 + 1], w, fx, fy)
+    }
+
+    /// Lat-long maps under 2 × 3 texels: each texel of a one-column map
+    /// doubled, then the last row repeated up to 3 rows (the former
+    /// padding, written out); other maps and mappings kept as they are.
+    #[test]
+    fn tiny_lat_long_maps_are_padded_as_before() {
+        for (w, h) in [(1, 1), (1, 2), (1, 5), (2, 1), (3, 2), (2, 3), (4, 4)] {
+            let data: Vec<f32> = (0..3 * w * h).map(|i| i as f32).collect();
+            let mut former: Vec<[f32; 3]> = data.as_chunks::<3>().0.to_vec();
+            let mut width = w;
+            if w < 2 {
+                former = former.iter().flat_map(|&t| [t, t]).collect();
+                width = 2;
+            }
+            for _ in h..3 {
+                former.extend_from_within((h - 1) * width..h * width);
+            }
+            let image = Image::new(Mapping::LatLong, w, h, &data).unwrap();
+            assert_eq!(
+                (image.width(), image.height()),
+                (width, h.max(3)),
+                "{w} × {h}"
+            );
+            assert_eq!(image.texels(), &former[..], "{w} × {h}");
+        }
+        let cube = Image::new(Mapping::Cube, 1, 6, &[0.5; 18]).unwrap();
+        assert_eq!((cube.width(), cube.height()), (1, 6));
     }
 
     #[test]

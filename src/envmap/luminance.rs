@@ -58,11 +58,13 @@ pub(super) struct LuminanceDensity {
 
 impl LuminanceDensity {
     /// The density of the row-major `width × height` texel luminances
-    /// `lum` (non-negative; `height >= 2`), or `None` when they are all 0.
+    /// `lum` (non-negative; `width >= 1`, `height >= 2`), or `None` when
+    /// they are all 0.
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the tables cannot be had.
     pub(super) fn new(lum: Buffer<f64>, width: usize, height: usize) -> Result<Option<Self>> {
+        debug_assert!(width >= 1 && height >= 2 && lum.len() == width * height);
         let delta = PI / (height - 1) as f64;
         let cell_count = width * (height - 1);
         // Row by row on all cores: `fill(j, row)` writes the cells of row
