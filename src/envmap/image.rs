@@ -52,12 +52,13 @@ impl Image {
             expected: expected.into(),
             got: format!("({height}, {width}, 3)"),
         };
-        if width == 0 || height == 0 || data.len() != width * height * 3 {
+        let values = width.checked_mul(height).and_then(|n| n.checked_mul(3));
+        if width == 0 || height == 0 || values != Some(data.len()) {
             return Err(shape_error("(H, W, 3) with H, W >= 1"));
         }
         match mapping {
             Mapping::Angular if width != height => return Err(shape_error("(R, R, 3): square")),
-            Mapping::Cube if height != 6 * width => {
+            Mapping::Cube if width.checked_mul(6) != Some(height) => {
                 return Err(Error::Shape {
                     arg: "image",
                     expected: "(6, R, R, 3)".into(),
@@ -97,8 +98,8 @@ impl Image {
                 texels: Buffer::from_slice(texels, "the texels")?,
             });
         }
-        // A lat-long map narrower than 2 texels or shorter than 3: its one
-        // column doubled, its last row repeated.
+        // A lat-long map narrower than 2 texels or shorter than 3: a
+        // one-column map's column doubled, the last row repeated.
         let (padded_width, padded_height) = (width.max(2), height.max(3));
         let mut padded = Buffer::for_overwrite(padded_width * padded_height, "the texels")?;
         for (k, t) in padded.iter_mut().enumerate() {
@@ -398,6 +399,19 @@ mod tests {
         }
         let cube = Image::new(Mapping::Cube, 1, 6, &[0.5; 18]).unwrap();
         assert_eq!((cube.width(), cube.height()), (1, 6));
+        assert_eq!(cube.texels(), &[[0.5; 3]; 6][..]);
+        let angular = Image::new(Mapping::Angular, 1, 1, &[1.0, 2.0, 3.0]).unwrap();
+        assert_eq!((angular.width(), angular.height()), (1, 1));
+        assert_eq!(angular.texels(), &[[1.0, 2.0, 3.0]][..]);
+    }
+
+    /// Sizes whose product overflows are a shape error, not a wrap.
+    #[test]
+    fn overflowing_sizes_are_shape_errors() {
+        let huge = Image::new(Mapping::LatLong, 1 << 62, 8, &[]);
+        assert!(matches!(huge, Err(Error::Shape { .. })), "{huge:?}");
+        let cube = Image::new(Mapping::Cube, usize::MAX / 3, 1, &[]);
+        assert!(matches!(cube, Err(Error::Shape { .. })), "{cube:?}");
     }
 
     #[test]
