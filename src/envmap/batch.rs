@@ -147,20 +147,22 @@ impl EnvMap {
                 #[inline(always)]
                 |x: [F; 3]| self.luminance_query(x)
             };
+            let tables = density.tables();
             let locate = {
                 #[inline(always)]
                 |q: &[F; 7]| {
                     let k = self.image.place_texel(q[0], q[1]);
-                    density.prefetch(k);
+                    F::prefetch_luminance(tables, k);
                     k
                 }
             };
-            let tables = density.tables();
             let read = {
                 #[inline(always)]
-                move |q: &[F; 7], &k: &usize| EnvMap::luminance_pdf_in(tables, q, k)
+                move |q: &Columns<F, 7>, k: &[usize; simd::BLOCK], o: &mut [F]| {
+                    F::luminance_block(tables, q, k, o)
+                }
             };
-            pipelined(d, out, &query, valid, locate, read)
+            blockwise(d, out, &query, valid, each_row(locate), read)
         } else if let Some(table) = &self.polar {
             let densities = F::densities(table);
             let query = {
@@ -426,13 +428,8 @@ enum Cells<'a> {
     Piecewise(&'a PiecewiseConstant2D),
 }
 
-/// `out[i] = read(q, locate(q))` with `q = query(d[i])`, in blocks of
-/// [`simd::BLOCK`] with two in flight: each block's queries at full SIMD
-/// width into columns ([`simd::map_to_columns`], which checks `valid` in
-/// the same pass), then their table entries located (`locate` prefetches
-/// them), then the block before read, its entries by now in the caches:
-/// the table reads overlap the next block's arithmetic instead of waiting
-/// on it. Returns whether `valid` held for every direction.
+/// `out[i] = read(q, locate(q))` with `q = query(d[i])`: [`blockwise`]
+/// with `locate` and `read` called for each direction of a block.
 #[inline(always)]
 fn pipelined<F: Real, T, C: Copy + Default, const K: usize>(
     d: &[[F; 3]],
@@ -442,15 +439,60 @@ fn pipelined<F: Real, T, C: Copy + Default, const K: usize>(
     locate: impl Fn(&[F; K]) -> C,
     read: impl Fn(&[F; K], &C) -> T,
 ) -> bool {
+    let read_block = {
+        #[inline(always)]
+        |q: &Columns<F, K>, c: &[C; simd::BLOCK], o: &mut [T]| {
+            for (i, (o, c)) in o.iter_mut().zip(c).enumerate() {
+                *o = read(&row(q, i), c);
+            }
+        }
+    };
+    blockwise(d, out, query, valid, each_row(locate), read_block)
+}
+
+/// `locate` of each of a block's first `rows` queries, for [`blockwise`].
+#[inline(always)]
+fn each_row<F: Copy, C, const K: usize>(
+    locate: impl Fn(&[F; K]) -> C,
+) -> impl Fn(&Columns<F, K>, &mut [C; simd::BLOCK], usize) {
+    #[inline(always)]
+    move |q: &Columns<F, K>, c: &mut [C; simd::BLOCK], rows: usize| {
+        for (i, c) in c[..rows].iter_mut().enumerate() {
+            *c = locate(&row(q, i));
+        }
+    }
+}
+
+/// A block's queries, one column per component.
+type Columns<F, const K: usize> = [[F; simd::BLOCK]; K];
+
+/// Row `i` of the columns `q`.
+#[inline(always)]
+fn row<F: Copy, const K: usize>(q: &Columns<F, K>, i: usize) -> [F; K] {
+    std::array::from_fn(|m| q[m][i])
+}
+
+/// `out[i] = read(q, locate(q))` with `q = query(d[i])`, in blocks of
+/// [`simd::BLOCK`] with two in flight: each block's queries at full SIMD
+/// width into columns ([`simd::map_to_columns`], which checks `valid` in
+/// the same pass), then their table entries located (`locate` of the
+/// columns and the number of rows prefetches them), then the block before
+/// read (`read` of its columns and entries into its outputs), its entries
+/// by now in the caches: the table reads overlap the next block's
+/// arithmetic instead of waiting on it. Returns whether `valid` held for
+/// every direction.
+#[inline(always)]
+fn blockwise<F: Real, T, C: Copy + Default, const K: usize>(
+    d: &[[F; 3]],
+    out: &mut [T],
+    query: &impl Fn([F; 3]) -> [F; K],
+    valid: impl Fn(&[F; 3]) -> bool,
+    locate: impl Fn(&Columns<F, K>, &mut [C; simd::BLOCK], usize),
+    read: impl Fn(&Columns<F, K>, &[C; simd::BLOCK], &mut [T]),
+) -> bool {
     const B: usize = simd::BLOCK;
     let mut queries = [[[F::zero(); B]; K]; 2];
     let mut entries = [[C::default(); B]; 2];
-    let row = |q: &[[F; B]; K], i: usize| -> [F; K] { std::array::from_fn(|m| q[m][i]) };
-    let read_block = |o: &mut [T], q: &[[F; B]; K], c: &[C; B]| {
-        for (i, (o, c)) in o.iter_mut().zip(c).enumerate() {
-            *o = read(&row(q, i), c);
-        }
-    };
     simd::dispatch(
         #[inline(always)]
         |_| {
@@ -461,16 +503,14 @@ fn pipelined<F: Real, T, C: Copy + Default, const K: usize>(
             for (b, (o, x)) in out.chunks_mut(B).zip(d.chunks(B)).enumerate() {
                 let (q, c) = (&mut queries[b % 2], &mut entries[b % 2]);
                 ok &= simd::map_to_columns(q, x, query, &valid);
-                for (i, c) in c[..x.len()].iter_mut().enumerate() {
-                    *c = locate(&row(q, i));
-                }
+                locate(q, c, x.len());
                 let rows = x.len().min(o.len());
                 if let Some((p, o)) = previous.replace((b % 2, &mut o[..rows])) {
-                    read_block(o, &queries[p], &entries[p]);
+                    read(&queries[p], &entries[p], o);
                 }
             }
             if let Some((p, o)) = previous {
-                read_block(o, &queries[p], &entries[p]);
+                read(&queries[p], &entries[p], o);
             }
             ok
         },

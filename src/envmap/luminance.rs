@@ -11,7 +11,7 @@ use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;
 use crate::math::Real;
 use crate::parallel;
-use crate::simd;
+use crate::simd::{self, BLOCK};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -54,6 +54,12 @@ pub(super) struct LuminanceDensity {
     /// `P_c · WH' / Ȳ_c` of each cell (0 where `Ȳ_c = 0`): `p_q` is `Y`
     /// times this.
     scale: Buffer<f64>,
+    /// Each cell's corners `[a, b, c, d]` times its scale, rounded to
+    /// `f32`: `p_q` of a query in `f32` is their blend, read from one
+    /// 16-byte entry (one cache line) instead of three lines of `f64`.
+    /// Each is at most `4 P_c WH'` (a corner is at most `4 Ȳ_c`), so none
+    /// overflows.
+    single: Buffer<[f32; 4]>,
 }
 
 impl LuminanceDensity {
@@ -67,17 +73,8 @@ impl LuminanceDensity {
         debug_assert!(width >= 1 && height >= 2 && lum.len() == width * height);
         let delta = PI / (height - 1) as f64;
         let cell_count = width * (height - 1);
-        // Row by row on all cores: `fill(j, row)` writes the cells of row
-        // `j`, the same values whatever the thread count.
-        let by_rows = |table: &mut [f64], fill: &(dyn Fn(usize, &mut [f64]) + Sync)| {
-            parallel::install(|| {
-                (table.par_chunks_mut(width).enumerate())
-                    .with_min_len(parallel::CHUNK.div_ceil(width))
-                    .for_each(|(j, row)| fill(j, row));
-            })
-        };
         let mut weights = Buffer::for_overwrite(cell_count, "the sampling cells")?;
-        by_rows(&mut weights, &|j, row| {
+        by_rows(weights.par_chunks_mut(width), width, |j, row| {
             let (sin, cos) = (j as f64 * delta).sin_cos();
             let [i0, i1] = moments([sin.max(0.0), cos], delta);
             for (i, w) in row.iter_mut().enumerate() {
@@ -92,15 +89,19 @@ impl LuminanceDensity {
         let cells = Discrete2D::with_arg("image", &weights, height - 1, width)?;
         let per_cell = cell_count as f64 / cells.sum();
         let mut scale = Buffer::for_overwrite(cell_count, "the sampling cells")?;
-        by_rows(&mut scale, &|j, row| {
-            for (i, s) in row.iter_mut().enumerate() {
+        let mut single = Buffer::for_overwrite(cell_count, "the sampling cells")?;
+        let rows = (scale.par_chunks_mut(width)).zip(single.par_chunks_mut(width));
+        by_rows(rows, width, |j, (scale, single)| {
+            for (i, (s, c)) in scale.iter_mut().zip(single).enumerate() {
                 let k = j * width + i;
-                let mean = 0.25 * corners(&lum, width, k).iter().sum::<f64>();
+                let corners = corners(&lum, width, k);
+                let mean = 0.25 * corners.iter().sum::<f64>();
                 *s = if mean > 0.0 {
                     weights[k] * per_cell / mean
                 } else {
                     0.0
                 };
+                *c = corners.map(|y| (y * *s) as f32);
             }
         })?;
         Ok(Some(LuminanceDensity {
@@ -108,6 +109,7 @@ impl LuminanceDensity {
             width,
             cells,
             scale,
+            single,
         }))
     }
 
@@ -117,19 +119,10 @@ impl LuminanceDensity {
     }
 
     /// Asks the CPU for the table lines that [`LuminanceDensity::place`]
-    /// and [`Tables::pdf_at`] read for the cell whose top left texel is
-    /// `k`: its two rows' luminances and its scale.
-    #[inline(always)]
-    pub(super) fn prefetch(&self, k: usize) {
-        simd::prefetch(&self.lum, k);
-        simd::prefetch(&self.lum, k + self.width);
-        simd::prefetch(&self.scale, k);
-    }
-
-    /// [`LuminanceDensity::prefetch`] of cell `(row, col)`.
+    /// reads for cell `(row, col)` ([`Tables::prefetch`]).
     #[inline(always)]
     pub(super) fn prefetch_cell(&self, (row, col): (usize, usize)) {
-        self.prefetch(row * self.width + col);
+        self.tables().prefetch(row * self.width + col);
     }
 
     /// The point of cell `(row, col)` that the fractions `r` in `[0, 1]²`
@@ -176,7 +169,8 @@ impl LuminanceDensity {
         bilerp(corners(&self.lum, self.width, k), x, y) * self.scale[k]
     }
 
-    /// The tables that [`Tables::pdf_at`] reads.
+    /// The tables that [`Tables::pdf_at`] and [`Tables::single_pdf_at`]
+    /// read.
     #[inline(always)]
     pub(super) fn tables(&self) -> Tables<'_> {
         Tables {
@@ -184,14 +178,33 @@ impl LuminanceDensity {
             lum: &self.lum,
             below: &self.lum[self.width..],
             scale: &self.scale,
+            single: &self.single,
         }
     }
+}
+
+/// Fills tables of `width` values a row, row by row on all cores: `fill(j,
+/// row)` writes row `j` of each (`rows` yields them, one item a row), the
+/// same values whatever the thread count.
+///
+/// # Errors
+/// As [`parallel::install`].
+fn by_rows<R: IndexedParallelIterator>(
+    rows: R,
+    width: usize,
+    fill: impl Fn(usize, R::Item) + Sync + Send,
+) -> Result<()> {
+    parallel::install(|| {
+        (rows.enumerate())
+            .with_min_len(parallel::CHUNK.div_ceil(width))
+            .for_each(|(j, row)| fill(j, row));
+    })
 }
 
 /// The tables of a [`LuminanceDensity`] that its density reads, as slices
 /// that a batch takes out of its loop.
 #[derive(Clone, Copy)]
-pub(super) struct Tables<'a> {
+pub struct Tables<'a> {
     /// The map's width in texels.
     width: usize,
     /// The texels' luminances.
@@ -200,9 +213,76 @@ pub(super) struct Tables<'a> {
     below: &'a [f64],
     /// The cells' `P_c · WH' / Ȳ_c`.
     scale: &'a [f64],
+    /// The cells' corners times their scale, in `f32`.
+    single: &'a [[f32; 4]],
 }
 
 impl Tables<'_> {
+    /// Asks the CPU for the lines that [`Tables::pdf_at`] (and
+    /// [`LuminanceDensity::place`]) read for cell `k` (its top-left texel):
+    /// its two rows' luminances and its scale.
+    #[inline(always)]
+    pub(super) fn prefetch(self, k: usize) {
+        simd::prefetch(self.lum, k);
+        simd::prefetch(self.below, k);
+        simd::prefetch(self.scale, k);
+    }
+
+    /// Asks the CPU for the line that [`Tables::single_pdf_at`] reads for
+    /// cell `k`.
+    #[inline(always)]
+    pub(super) fn prefetch_single(self, k: usize) {
+        simd::prefetch(self.single, k);
+    }
+
+    /// `p_q` at the blend by `wt` of cell `k`'s corners times its scale,
+    /// as rounded to `f32` ([`LuminanceDensity`]'s `single`), in `f32`. A
+    /// cell past the table reads as the last (callers pass none), as
+    /// [`simd::gather_columns`] reads it.
+    #[inline(always)]
+    pub(super) fn single_pdf_at(self, k: usize, wt: [f32; 4]) -> f32 {
+        debug_assert!(k < self.single.len(), "cell {k} is not one of the map's");
+        blend(wt, self.single[k.min(self.single.len() - 1)])
+    }
+
+    /// `out[i]` = the density per steradian of the query in row `i` of the
+    /// columns `q` ([`EnvMap::luminance_query`]) in the cell `cells[i]`,
+    /// in `F`: [`Tables::pdf_at`] times `1/(dω/dq)`.
+    ///
+    /// [`EnvMap::luminance_query`]: super::EnvMap::luminance_query
+    #[inline(always)]
+    pub(super) fn block_pdfs<F: Real>(
+        self,
+        q: &[[F; BLOCK]; 7],
+        cells: &[usize; BLOCK],
+        out: &mut [F],
+    ) {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = self.pdf_at(cells[i], q[0][i], [q[2][i], q[3][i], q[4][i], q[5][i]]) * q[6][i];
+        }
+    }
+
+    /// [`Tables::block_pdfs`] in `f32` from the premultiplied corners:
+    /// [`Tables::single_pdf_at`] times `1/(dω/dq)` for each row, the
+    /// corners read by gathers and blended at SIMD width (the same bits).
+    #[inline(always)]
+    pub(super) fn single_block_pdfs(
+        self,
+        q: &[[f32; BLOCK]; 7],
+        cells: &[usize; BLOCK],
+        out: &mut [f32],
+    ) {
+        let mut corners = [[0.0; BLOCK]; 4];
+        simd::gather_columns(self.single, cells, &mut corners);
+        let mut pdf = [0.0; BLOCK];
+        for (i, p) in pdf.iter_mut().enumerate() {
+            let wt = [q[2][i], q[3][i], q[4][i], q[5][i]];
+            let c = [corners[0][i], corners[1][i], corners[2][i], corners[3][i]];
+            *p = blend(wt, c) * q[6][i];
+        }
+        out.copy_from_slice(&pdf[..out.len()]);
+    }
+
     /// `p_q` at the blend by `wt` of the texels of cell `k` (its top-left
     /// texel) of column `x₀`: texel `k`, the one right of it
     /// ([`right_of`]) and the two below them, in `F`, the sum from 0 as a
@@ -217,6 +297,13 @@ impl Tables<'_> {
         let y = y + wt[2] * at(self.below, k) + wt[3] * at(self.below, right);
         y * at(self.scale, k)
     }
+}
+
+/// `Σ wt[m]·c[m]` in `f32`, summed in order from 0 as a blend of texels
+/// starts.
+#[inline(always)]
+fn blend(wt: [f32; 4], c: [f32; 4]) -> f32 {
+    0.0 + wt[0] * c[0] + wt[1] * c[1] + wt[2] * c[2] + wt[3] * c[3]
 }
 
 /// `[x, y, bilerp(c, x, y)]`: the point of the unit square that `r` places

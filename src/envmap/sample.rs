@@ -12,7 +12,7 @@ use super::distribution::Distribution;
 use super::image::Corners;
 use super::luminance::{LuminanceDensity, Tables};
 use super::mapping::{Mapping, normalized, polar_angle};
-use super::polar::{SIN_FLOOR, polar_jacobian};
+use super::polar::{SIN_FLOOR, TableFloat, polar_jacobian};
 use crate::distr::PiecewiseConstant2D;
 use crate::math::{Real, atan2, sin_cos_turn};
 use crate::warp::{self, V3};
@@ -291,7 +291,7 @@ impl EnvMap {
     /// and the density there ([`EnvMap::luminance_pdf_in`]) one block
     /// later.
     #[inline(always)]
-    pub(super) fn luminance_pdf<F: Real>(&self, density: &LuminanceDensity, d: V3<F>) -> F {
+    pub(super) fn luminance_pdf<F: TableFloat>(&self, density: &LuminanceDensity, d: V3<F>) -> F {
         let q = self.luminance_query(d);
         Self::luminance_pdf_in(density.tables(), &q, self.image.place_texel(q[0], q[1]))
     }
@@ -300,8 +300,8 @@ impl EnvMap {
     /// cell (its top-left texel) is `k`, from the `tables` of this map's
     /// luminance density.
     #[inline(always)]
-    pub(super) fn luminance_pdf_in<F: Real>(tables: Tables<'_>, q: &[F; 7], k: usize) -> F {
-        tables.pdf_at(k, q[0], [q[2], q[3], q[4], q[5]]) * q[6]
+    pub(super) fn luminance_pdf_in<F: TableFloat>(tables: Tables<'_>, q: &[F; 7], k: usize) -> F {
+        F::luminance_pdf(tables, k, q[0], [q[2], q[3], q[4], q[5]]) * q[6]
     }
 
     /// The place on a lat-long map of the world direction `d` and

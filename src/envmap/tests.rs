@@ -298,6 +298,41 @@ fn polar_tables_give_the_table_pdf() {
 }
 
 #[test]
+fn luminance_pdfs_in_f32_follow_f64s() {
+    // The f32 batch reads each cell's corners premultiplied in f32; the f64
+    // density at the same (f32) direction is the reference. Directions
+    // uniform on the sphere and drawn from the map (its bright spot).
+    let m = map(Mapping::LatLong, Sampling::Luminance, true);
+    let mut rng = crate::rng::Rng::new(5, 1);
+    let n = 20_000;
+    let d: Vec<[f32; 3]> = (0..n)
+        .map(|k| {
+            let u = [rng.next_float::<f64>(), rng.next_float::<f64>()];
+            let d = if k % 2 == 0 {
+                warp::square_to_uniform_sphere(u)
+            } else {
+                m.sample(u).direction
+            };
+            d.map(|x| x as f32)
+        })
+        .collect();
+    let mut ours = vec![-1.0f32; n];
+    assert!(m.pdf_into(&d, &mut ours, |_| true));
+    let errors: Vec<f64> = d
+        .iter()
+        .zip(&ours)
+        .map(|(x, &o)| {
+            let expected = m.pdf(x.map(f64::from));
+            (o as f64 - expected).abs() / expected
+        })
+        .collect();
+    let worst = errors.iter().fold(0.0f64, |a, &e| a.max(e));
+    let misses = errors.iter().filter(|&&e| e > 1e-5).count();
+    // Only directions within a few ulps of a cell edge may move cell.
+    assert!(misses < n / 1000, "{misses} of {n} (worst {worst:e})");
+}
+
+#[test]
 fn uv_round_trips_through_to_world() {
     for m in all_maps() {
         for i in 0..50 {

@@ -10,8 +10,11 @@
 //! hints. Results do not depend on the path taken: no floating-point
 //! contraction is enabled, so each operation rounds the same way.
 
+mod gather;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
+
+pub use gather::gather_columns;
 
 /// Name of the environment variable that caps the instruction set batch
 /// loops use: `avx512`, `avx2` or `baseline` (for tests and debugging;
