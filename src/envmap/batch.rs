@@ -158,11 +158,11 @@ impl EnvMap {
             };
             let read = {
                 #[inline(always)]
-                move |q: &Columns<F, 7>, k: &[usize; simd::BLOCK], o: &mut [F]| {
-                    F::luminance_block(tables, q, k, o)
+                move |q: &Columns<F, 7>, cells: &[usize; simd::BLOCK], o: &mut [F]| {
+                    F::luminance_block(tables, q, cells, o)
                 }
             };
-            blockwise(d, out, &query, valid, each_row(locate), read)
+            pipelined_blocks(d, out, &query, valid, each_row(locate), read)
         } else if let Some(table) = &self.polar {
             let densities = F::densities(table);
             let query = {
@@ -428,7 +428,7 @@ enum Cells<'a> {
     Piecewise(&'a PiecewiseConstant2D),
 }
 
-/// `out[i] = read(q, locate(q))` with `q = query(d[i])`: [`blockwise`]
+/// `out[i] = read(q, locate(q))` with `q = query(d[i])`: [`pipelined_blocks`]
 /// with `locate` and `read` called for each direction of a block.
 #[inline(always)]
 fn pipelined<F: Real, T, C: Copy + Default, const K: usize>(
@@ -447,10 +447,10 @@ fn pipelined<F: Real, T, C: Copy + Default, const K: usize>(
             }
         }
     };
-    blockwise(d, out, query, valid, each_row(locate), read_block)
+    pipelined_blocks(d, out, query, valid, each_row(locate), read_block)
 }
 
-/// `locate` of each of a block's first `rows` queries, for [`blockwise`].
+/// `locate` of each of a block's first `rows` queries, for [`pipelined_blocks`].
 #[inline(always)]
 fn each_row<F: Copy, C, const K: usize>(
     locate: impl Fn(&[F; K]) -> C,
@@ -482,7 +482,7 @@ fn row<F: Copy, const K: usize>(q: &Columns<F, K>, i: usize) -> [F; K] {
 /// arithmetic instead of waiting on it. Returns whether `valid` held for
 /// every direction.
 #[inline(always)]
-fn blockwise<F: Real, T, C: Copy + Default, const K: usize>(
+fn pipelined_blocks<F: Real, T, C: Copy + Default, const K: usize>(
     d: &[[F; 3]],
     out: &mut [T],
     query: &impl Fn([F; 3]) -> [F; K],

@@ -56,10 +56,12 @@ pub(super) struct LuminanceDensity {
     scale: Buffer<f64>,
     /// Each cell's corners `[a, b, c, d]` times its scale, rounded to
     /// `f32`: `p_q` of a query in `f32` is their blend, read from one
-    /// 16-byte entry (one cache line) instead of three lines of `f64`.
-    /// Each is at most `4 P_c WH'` (a corner is at most `4 Ȳ_c`), so none
-    /// overflows.
-    single: Buffer<[f32; 4]>,
+    /// 16-byte entry (one cache line where the buffer starts on 16 bytes,
+    /// as heap and mapped buffers do) instead of three lines of `f64`. Each
+    /// is at most `4 P_c WH'` (a corner is at most `4 Ȳ_c`), so none
+    /// overflows; a cell dark beside the map's brightest may round to a
+    /// subnormal or 0, as its own `f32` density would.
+    scaled_corners: Buffer<[f32; 4]>,
 }
 
 impl LuminanceDensity {
@@ -89,10 +91,10 @@ impl LuminanceDensity {
         let cells = Discrete2D::with_arg("image", &weights, height - 1, width)?;
         let per_cell = cell_count as f64 / cells.sum();
         let mut scale = Buffer::for_overwrite(cell_count, "the sampling cells")?;
-        let mut single = Buffer::for_overwrite(cell_count, "the sampling cells")?;
-        let rows = (scale.par_chunks_mut(width)).zip(single.par_chunks_mut(width));
-        by_rows(rows, width, |j, (scale, single)| {
-            for (i, (s, c)) in scale.iter_mut().zip(single).enumerate() {
+        let mut scaled_corners = Buffer::for_overwrite(cell_count, "the sampling cells")?;
+        let rows = (scale.par_chunks_mut(width)).zip(scaled_corners.par_chunks_mut(width));
+        by_rows(rows, width, |j, (scale, scaled)| {
+            for (i, (s, c)) in scale.iter_mut().zip(scaled).enumerate() {
                 let k = j * width + i;
                 let corners = corners(&lum, width, k);
                 let mean = 0.25 * corners.iter().sum::<f64>();
@@ -109,7 +111,7 @@ impl LuminanceDensity {
             width,
             cells,
             scale,
-            single,
+            scaled_corners,
         }))
     }
 
@@ -169,7 +171,7 @@ impl LuminanceDensity {
         bilerp(corners(&self.lum, self.width, k), x, y) * self.scale[k]
     }
 
-    /// The tables that [`Tables::pdf_at`] and [`Tables::single_pdf_at`]
+    /// The tables that [`Tables::pdf_at`] and [`Tables::pdf_at_f32`]
     /// read.
     #[inline(always)]
     pub(super) fn tables(&self) -> Tables<'_> {
@@ -178,7 +180,7 @@ impl LuminanceDensity {
             lum: &self.lum,
             below: &self.lum[self.width..],
             scale: &self.scale,
-            single: &self.single,
+            scaled_corners: &self.scaled_corners,
         }
     }
 }
@@ -214,7 +216,7 @@ pub struct Tables<'a> {
     /// The cells' `P_c · WH' / Ȳ_c`.
     scale: &'a [f64],
     /// The cells' corners times their scale, in `f32`.
-    single: &'a [[f32; 4]],
+    scaled_corners: &'a [[f32; 4]],
 }
 
 impl Tables<'_> {
@@ -228,52 +230,48 @@ impl Tables<'_> {
         simd::prefetch(self.scale, k);
     }
 
-    /// Asks the CPU for the line that [`Tables::single_pdf_at`] reads for
+    /// Asks the CPU for the line that [`Tables::pdf_at_f32`] reads for
     /// cell `k`.
     #[inline(always)]
-    pub(super) fn prefetch_single(self, k: usize) {
-        simd::prefetch(self.single, k);
+    pub(super) fn prefetch_f32(self, k: usize) {
+        simd::prefetch(self.scaled_corners, k);
     }
 
     /// `p_q` at the blend by `wt` of cell `k`'s corners times its scale,
-    /// as rounded to `f32` ([`LuminanceDensity`]'s `single`), in `f32`. A
-    /// cell past the table reads as the last (callers pass none), as
-    /// [`simd::gather_columns`] reads it.
+    /// as rounded to `f32` ([`LuminanceDensity`]'s `scaled_corners`), in
+    /// `f32`. A cell past the table reads as the last, as
+    /// [`simd::gather_columns`] reads it (callers pass none).
     #[inline(always)]
-    pub(super) fn single_pdf_at(self, k: usize, wt: [f32; 4]) -> f32 {
-        debug_assert!(k < self.single.len(), "cell {k} is not one of the map's");
-        blend(wt, self.single[k.min(self.single.len() - 1)])
+    pub(super) fn pdf_at_f32(self, k: usize, wt: [f32; 4]) -> f32 {
+        debug_assert!(
+            k < self.scaled_corners.len(),
+            "cell {k} is not one of the map's"
+        );
+        blend(
+            wt,
+            self.scaled_corners[k.min(self.scaled_corners.len() - 1)],
+        )
     }
 
     /// `out[i]` = the density per steradian of the query in row `i` of the
-    /// columns `q` ([`EnvMap::luminance_query`]) in the cell `cells[i]`,
-    /// in `F`: [`Tables::pdf_at`] times `1/(dω/dq)`.
-    ///
-    /// [`EnvMap::luminance_query`]: super::EnvMap::luminance_query
+    /// columns `q` (`EnvMap::luminance_query`'s) in the cell `cells[i]`, in
+    /// `f64`: [`Tables::pdf_at`] times `1/(dω/dq)`.
     #[inline(always)]
-    pub(super) fn block_pdfs<F: Real>(
-        self,
-        q: &[[F; BLOCK]; 7],
-        cells: &[usize; BLOCK],
-        out: &mut [F],
-    ) {
+    fn block_pdfs(self, q: &[[f64; BLOCK]; 7], cells: &[usize; BLOCK], out: &mut [f64]) {
+        debug_assert!(out.len() <= BLOCK);
         for (i, o) in out.iter_mut().enumerate() {
             *o = self.pdf_at(cells[i], q[0][i], [q[2][i], q[3][i], q[4][i], q[5][i]]) * q[6][i];
         }
     }
 
     /// [`Tables::block_pdfs`] in `f32` from the premultiplied corners:
-    /// [`Tables::single_pdf_at`] times `1/(dω/dq)` for each row, the
-    /// corners read by gathers and blended at SIMD width (the same bits).
+    /// [`Tables::pdf_at_f32`] times `1/(dω/dq)` for each row, the corners
+    /// read by gathers and blended at SIMD width (the same bits).
     #[inline(always)]
-    pub(super) fn single_block_pdfs(
-        self,
-        q: &[[f32; BLOCK]; 7],
-        cells: &[usize; BLOCK],
-        out: &mut [f32],
-    ) {
+    fn block_pdfs_f32(self, q: &[[f32; BLOCK]; 7], cells: &[usize; BLOCK], out: &mut [f32]) {
+        debug_assert!(out.len() <= BLOCK);
         let mut corners = [[0.0; BLOCK]; 4];
-        simd::gather_columns(self.single, cells, &mut corners);
+        simd::gather_columns(self.scaled_corners, cells, &mut corners);
         let mut pdf = [0.0; BLOCK];
         for (i, p) in pdf.iter_mut().enumerate() {
             let wt = [q[2][i], q[3][i], q[4][i], q[5][i]];
@@ -296,6 +294,71 @@ impl Tables<'_> {
         let y = F::zero() + wt[0] * at(self.lum, k) + wt[1] * at(self.lum, right);
         let y = y + wt[2] * at(self.below, k) + wt[3] * at(self.below, right);
         y * at(self.scale, k)
+    }
+}
+
+/// The float types in which a [`LuminanceDensity`] is read: each from
+/// its own tables (`f64` from the luminances and scales, `f32` from the
+/// premultiplied corners). The crate's own (it seals
+/// [`super::TableFloat`]).
+pub trait LuminanceFloat: Real {
+    /// Asks the CPU for the lines of `tables` that
+    /// [`LuminanceFloat::luminance_pdf`] reads for cell `k`.
+    fn prefetch_luminance(tables: Tables<'_>, k: usize);
+
+    /// The luminance density `p_q` at the blend by `wt` of cell `k`'s
+    /// corners (`k` its top-left texel, of column `x₀`).
+    fn luminance_pdf(tables: Tables<'_>, k: usize, x0: Self, wt: [Self; 4]) -> Self;
+
+    /// The luminance density per steradian of a block of queries
+    /// (`EnvMap::luminance_query`'s, in columns) in their `cells`, into
+    /// `out` (at most a block): each what
+    /// [`LuminanceFloat::luminance_pdf`] times `1/(dω/dq)` gives.
+    fn luminance_block(
+        tables: Tables<'_>,
+        q: &[[Self; BLOCK]; 7],
+        cells: &[usize; BLOCK],
+        out: &mut [Self],
+    );
+}
+
+impl LuminanceFloat for f32 {
+    #[inline(always)]
+    fn prefetch_luminance(tables: Tables<'_>, k: usize) {
+        tables.prefetch_f32(k);
+    }
+    #[inline(always)]
+    fn luminance_pdf(tables: Tables<'_>, k: usize, _x0: f32, wt: [f32; 4]) -> f32 {
+        tables.pdf_at_f32(k, wt)
+    }
+    #[inline(always)]
+    fn luminance_block(
+        tables: Tables<'_>,
+        q: &[[f32; BLOCK]; 7],
+        cells: &[usize; BLOCK],
+        out: &mut [f32],
+    ) {
+        tables.block_pdfs_f32(q, cells, out);
+    }
+}
+
+impl LuminanceFloat for f64 {
+    #[inline(always)]
+    fn prefetch_luminance(tables: Tables<'_>, k: usize) {
+        tables.prefetch(k);
+    }
+    #[inline(always)]
+    fn luminance_pdf(tables: Tables<'_>, k: usize, x0: f64, wt: [f64; 4]) -> f64 {
+        tables.pdf_at(k, x0, wt)
+    }
+    #[inline(always)]
+    fn luminance_block(
+        tables: Tables<'_>,
+        q: &[[f64; BLOCK]; 7],
+        cells: &[usize; BLOCK],
+        out: &mut [f64],
+    ) {
+        tables.block_pdfs(q, cells, out);
     }
 }
 

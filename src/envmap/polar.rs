@@ -4,14 +4,13 @@
 
 use super::distribution::Distribution;
 use super::image::Image;
-use super::luminance::Tables;
+use super::luminance::LuminanceFloat;
 use super::mapping::Mapping;
 use super::{EnvMap, Matrix3, Options};
 use crate::buffer::Buffer;
 use crate::error::Result;
 use crate::math::{Real, atan2};
 use crate::parallel;
-use crate::simd::BLOCK;
 use crate::warp::V3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -47,76 +46,22 @@ pub struct PolarTable {
 
 /// The float types in which [`EnvMap::pdf_into`] reads a [`PolarTable`]'s
 /// densities and the luminance density's tables: each from its own copy
-/// of the table.
-pub trait TableFloat: Real {
+/// of the table. Sealed: its supertrait holds the luminance density's
+/// reads and is the crate's own.
+pub trait TableFloat: LuminanceFloat {
     /// The densities of `table` in this type.
     fn densities(table: &PolarTable) -> &[Self];
-
-    /// Asks the CPU for the lines of `tables` that
-    /// [`TableFloat::luminance_pdf`] reads for cell `k`.
-    fn prefetch_luminance(tables: Tables<'_>, k: usize);
-
-    /// The luminance density `p_q` at the blend by `wt` of cell `k`'s
-    /// corners (`k` its top-left texel, of column `x₀`).
-    fn luminance_pdf(tables: Tables<'_>, k: usize, x0: Self, wt: [Self; 4]) -> Self;
-
-    /// The luminance density per steradian of a block of queries
-    /// (`EnvMap::luminance_query`'s, in columns) in their `cells`, into
-    /// `out` (at most a block): each what [`TableFloat::luminance_pdf`]
-    /// times `1/(dω/dq)` gives.
-    fn luminance_block(
-        tables: Tables<'_>,
-        q: &[[Self; BLOCK]; 7],
-        cells: &[usize; BLOCK],
-        out: &mut [Self],
-    );
 }
 
-/// In `f32`, the luminance density from its corners premultiplied in `f32`.
 impl TableFloat for f32 {
     fn densities(table: &PolarTable) -> &[f32] {
         &table.density_f32
     }
-    #[inline(always)]
-    fn prefetch_luminance(tables: Tables<'_>, k: usize) {
-        tables.prefetch_single(k);
-    }
-    #[inline(always)]
-    fn luminance_pdf(tables: Tables<'_>, k: usize, _x0: f32, wt: [f32; 4]) -> f32 {
-        tables.single_pdf_at(k, wt)
-    }
-    #[inline(always)]
-    fn luminance_block(
-        tables: Tables<'_>,
-        q: &[[f32; BLOCK]; 7],
-        cells: &[usize; BLOCK],
-        out: &mut [f32],
-    ) {
-        tables.single_block_pdfs(q, cells, out);
-    }
 }
 
-/// In `f64`, the luminance density from the luminances and scales.
 impl TableFloat for f64 {
     fn densities(table: &PolarTable) -> &[f64] {
         &table.density
-    }
-    #[inline(always)]
-    fn prefetch_luminance(tables: Tables<'_>, k: usize) {
-        tables.prefetch(k);
-    }
-    #[inline(always)]
-    fn luminance_pdf(tables: Tables<'_>, k: usize, x0: f64, wt: [f64; 4]) -> f64 {
-        tables.pdf_at(k, x0, wt)
-    }
-    #[inline(always)]
-    fn luminance_block(
-        tables: Tables<'_>,
-        q: &[[f64; BLOCK]; 7],
-        cells: &[usize; BLOCK],
-        out: &mut [f64],
-    ) {
-        tables.block_pdfs(q, cells, out);
     }
 }
 

@@ -10,9 +10,9 @@
 use super::EnvMap;
 use super::distribution::Distribution;
 use super::image::Corners;
-use super::luminance::{LuminanceDensity, Tables};
+use super::luminance::{LuminanceDensity, LuminanceFloat};
 use super::mapping::{Mapping, normalized, polar_angle};
-use super::polar::{SIN_FLOOR, TableFloat, polar_jacobian};
+use super::polar::{SIN_FLOOR, polar_jacobian};
 use crate::distr::PiecewiseConstant2D;
 use crate::math::{Real, atan2, sin_cos_turn};
 use crate::warp::{self, V3};
@@ -283,25 +283,23 @@ impl EnvMap {
 
     /// The density of the luminance `density` (this map's) along the world
     /// direction `d`, per steradian, computed in `F` from the texels
-    /// [`EnvMap::eval`] reads there and `1/(dω/dq)`, as
+    /// [`EnvMap::eval`] reads there (in `f32`, from the cell's corners
+    /// premultiplied by its scale) and `1/(dω/dq)`, as
     /// [`PolarTable::query`] finds it without normalising `d` (0 for
     /// `d = 0`). Batches run its three steps apart: the query
     /// ([`EnvMap::luminance_query`]) over a block at SIMD width, the
     /// cell under it ([`Image::place_texel`]), its table lines prefetched,
-    /// and the density there ([`EnvMap::luminance_pdf_in`]) one block
-    /// later.
+    /// and one block later the densities of the block
+    /// ([`LuminanceFloat::luminance_block`]).
     #[inline(always)]
-    pub(super) fn luminance_pdf<F: TableFloat>(&self, density: &LuminanceDensity, d: V3<F>) -> F {
+    pub(super) fn luminance_pdf<F: LuminanceFloat>(
+        &self,
+        density: &LuminanceDensity,
+        d: V3<F>,
+    ) -> F {
         let q = self.luminance_query(d);
-        Self::luminance_pdf_in(density.tables(), &q, self.image.place_texel(q[0], q[1]))
-    }
-
-    /// The density at the query `q` ([`EnvMap::luminance_query`]), whose
-    /// cell (its top-left texel) is `k`, from the `tables` of this map's
-    /// luminance density.
-    #[inline(always)]
-    pub(super) fn luminance_pdf_in<F: TableFloat>(tables: Tables<'_>, q: &[F; 7], k: usize) -> F {
-        F::luminance_pdf(tables, k, q[0], [q[2], q[3], q[4], q[5]]) * q[6]
+        let k = self.image.place_texel(q[0], q[1]);
+        F::luminance_pdf(density.tables(), k, q[0], [q[2], q[3], q[4], q[5]]) * q[6]
     }
 
     /// The place on a lat-long map of the world direction `d` and

@@ -9,7 +9,9 @@ use super::{BLOCK, Level, detected, level};
 /// on AVX-512 one gather instruction per component and 16 indices, on
 /// AVX2 per 8, else one read at a time (the same values on every path).
 /// An index past the table reads its last entry (callers pass none); an
-/// empty table leaves `columns` as they are.
+/// empty table leaves `columns` as they are. A table of more than
+/// `i32::MAX` values (offsets a gather cannot hold) is read one entry at
+/// a time.
 #[inline(always)]
 pub fn gather_columns<const C: usize>(
     table: &[[f32; C]],
@@ -81,6 +83,7 @@ macro_rules! gather_with {
         ) {
             use std::arch::x86_64::{$add, $gather, $index, $load, $set1, $store};
             const LANES: usize = $lanes;
+            const { assert!(BLOCK.is_multiple_of(LANES)) };
             let $base = flat.as_ptr();
             for g in (0..BLOCK).step_by(LANES) {
                 // SAFETY: lanes `g..g + LANES` of the block (BLOCK is a
@@ -126,30 +129,41 @@ gather_with!(
 mod tests {
     use super::*;
 
-    #[test]
-    fn gathers_are_the_entries() {
-        // Entries whose every component differs; indices in any order,
-        // repeated, first and last, and past the end (read as the last).
-        let table: Vec<[f32; 4]> = (0..1000)
+    /// Every path this CPU has (the wider ones capped to it) against the
+    /// entries themselves, for a table of `len` entries of `C` components.
+    fn check<const C: usize>(len: usize) {
+        let table: Vec<[f32; C]> = (0..len)
             .map(|k| std::array::from_fn(|c| (10 * k + c) as f32))
             .collect();
+        // Indices in any order, repeated, first and last, and past the end
+        // (read as the last).
         let index: [usize; BLOCK] = std::array::from_fn(|i| match i {
             0 => 0,
-            1 => 999,
-            2 => 1000,
+            1 => len - 1,
+            2 => len,
             3 => usize::MAX,
-            _ => (i * 7919) % 1000,
+            _ => (i * 7919) % len,
         });
-        // Every path this CPU has.
         for level in [Level::Baseline, Level::Avx2, Level::Avx512] {
-            let mut columns = [[-1.0; BLOCK]; 4];
+            let mut columns = [[-1.0; BLOCK]; C];
             gather_at(level, &table, &index, &mut columns);
             for (i, &k) in index.iter().enumerate() {
                 for (c, column) in columns.iter().enumerate() {
-                    let expected = table[k.min(999)][c];
+                    let expected = table[k.min(len - 1)][c];
                     assert_eq!(column[i], expected, "{level:?}: index {k}, component {c}");
                 }
             }
         }
+    }
+
+    #[test]
+    fn gathers_are_the_entries() {
+        check::<4>(1000);
+        check::<3>(1000);
+        check::<1>(1);
+        // An empty table leaves the columns as they were.
+        let mut columns = [[-1.0; BLOCK]; 2];
+        gather_columns::<2>(&[], &[0; BLOCK], &mut columns);
+        assert_eq!(columns, [[-1.0; BLOCK]; 2]);
     }
 }

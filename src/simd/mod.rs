@@ -5,9 +5,9 @@
 //!
 //! This module holds the crate's only `unsafe`: calling a function compiled
 //! for an instruction set, which is sound because the CPU was just checked
-//! to have it, the non-temporal stores of large outputs (raw-pointer
-//! intrinsics, bounds and alignment argued at each use), and cache prefetch
-//! hints. Results do not depend on the path taken: no floating-point
+//! to have it, the non-temporal stores of large outputs and the gathers of
+//! table entries (raw-pointer intrinsics, bounds and alignment argued at
+//! each use), and cache prefetch hints. Results do not depend on the path taken: no floating-point
 //! contraction is enabled, so each operation rounds the same way.
 
 mod gather;
