@@ -77,10 +77,18 @@ pub trait Real: Float + FloatConst + Debug + Default + Send + Sync + 'static {
     /// too).
     fn ln_positive(x: Self) -> Self;
 
-    /// `⌊x⌋` as an index clamped to `[0, last]` (0 for NaN), for `last`
-    /// below 2³²: the float is converted to `u32` (saturating), which takes
-    /// fewer instructions than a conversion to `usize`.
-    fn floor_index(self, last: usize) -> usize;
+    /// `⌊x⌋` as an index clamped to `[0, last]` (0 for NaN; in `f32` at
+    /// most `2³¹ − 128`, the largest `f32` below 2³¹), in `u32`, which
+    /// takes fewer instructions than `usize`; in `f32` clamped as a float
+    /// and then converted, so that a loop of it vectorises.
+    fn floor_u32(self, last: u32) -> u32;
+
+    /// [`Real::floor_u32`] as a `usize`, for `last` below 2³² (a larger
+    /// one is taken as `u32::MAX`).
+    #[inline(always)]
+    fn floor_index(self, last: usize) -> usize {
+        self.floor_u32(u32::try_from(last).unwrap_or(u32::MAX)) as usize
+    }
 }
 
 /// The first `N` Taylor coefficients of `atan r / r` in powers of `r²`:
@@ -435,8 +443,17 @@ impl Real for f32 {
         self as f64
     }
     #[inline(always)]
-    fn floor_index(self, last: usize) -> usize {
-        (self as u32 as usize).min(last)
+    fn floor_u32(self, last: u32) -> u32 {
+        // Clamped in floats first (`max` takes NaN to 0), so that the
+        // conversion needs no saturation: one instruction at SIMD width,
+        // where the saturating `as` is scalar. The clamp's bound is at most
+        // the largest `f32` below 2³¹, and the result is clamped to `last`
+        // again (`last as f32` may round up).
+        let x = self.max(0.0).min((last as f32).min(2_147_483_520.0));
+        #[allow(unsafe_code)]
+        // SAFETY: `x` is finite and in `[0, 2³¹)`, which `i32` holds.
+        let i = unsafe { x.to_int_unchecked::<i32>() };
+        (i as u32).min(last)
     }
     #[inline(always)]
     fn from_random_bits(bits: u32) -> f32 {
@@ -477,8 +494,8 @@ impl Real for f64 {
         self
     }
     #[inline(always)]
-    fn floor_index(self, last: usize) -> usize {
-        (self as u32 as usize).min(last)
+    fn floor_u32(self, last: u32) -> u32 {
+        (self as u32).min(last)
     }
     #[inline(always)]
     fn from_random_bits(bits: u32) -> f64 {

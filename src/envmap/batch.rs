@@ -150,19 +150,20 @@ impl EnvMap {
             let tables = density.tables();
             let locate = {
                 #[inline(always)]
-                |q: &[F; 7]| {
-                    let k = self.image.place_texel(q[0], q[1]);
-                    F::prefetch_luminance(tables, k);
-                    k
+                |q: &Columns<F, 7>, cells: &mut [u32; simd::BLOCK], rows: usize| {
+                    self.image.place_texels(&q[0], &q[1], cells);
+                    for &k in &cells[..rows] {
+                        F::prefetch_luminance(tables, k as usize);
+                    }
                 }
             };
             let read = {
                 #[inline(always)]
-                move |q: &Columns<F, 7>, cells: &[usize; simd::BLOCK], o: &mut [F]| {
+                move |q: &Columns<F, 7>, cells: &[u32; simd::BLOCK], o: &mut [F]| {
                     F::luminance_block(tables, q, cells, o)
                 }
             };
-            pipelined_blocks(d, out, &query, valid, each_row(locate), read)
+            pipelined_blocks(d, out, &query, valid, locate, read)
         } else if let Some(table) = &self.polar {
             let densities = F::densities(table);
             let query = {

@@ -214,8 +214,30 @@ impl Image {
     /// is also the cell's index).
     #[inline(always)]
     pub(crate) fn place_texel<F: Real>(&self, x0: F, y0: F) -> usize {
-        let w = self.width;
-        y0.floor_index(self.height - 2) * w + x0.floor_index(w - 1)
+        self.place_texel_u32(x0, y0) as usize
+    }
+
+    /// [`Image::place_texel`] of each of a block's places (their columns
+    /// `x₀` and `y₀`) into `cells`, in a loop that vectorises.
+    #[inline(always)]
+    pub(crate) fn place_texels<F: Real>(
+        &self,
+        x0: &[F; simd::BLOCK],
+        y0: &[F; simd::BLOCK],
+        cells: &mut [u32; simd::BLOCK],
+    ) {
+        for ((c, &x), &y) in cells.iter_mut().zip(x0).zip(y0) {
+            *c = self.place_texel_u32(x, y);
+        }
+    }
+
+    /// [`Image::place_texel`] in `u32` arithmetic, which holds every texel
+    /// index (at most [`MAX_TEXELS`], twice that padded).
+    #[inline(always)]
+    fn place_texel_u32<F: Real>(&self, x0: F, y0: F) -> u32 {
+        const { assert!(2 * MAX_TEXELS <= u32::MAX as usize) };
+        let (w, h) = (self.width as u32, self.height as u32);
+        y0.floor_u32(h - 2) * w + x0.floor_u32(w - 1)
     }
 
     /// The texels of a lat-long map's table cell `(row, col)` (the patch

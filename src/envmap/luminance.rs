@@ -54,14 +54,18 @@ pub(super) struct LuminanceDensity {
     /// `P_c · WH' / Ȳ_c` of each cell (0 where `Ȳ_c = 0`): `p_q` is `Y`
     /// times this.
     scale: Buffer<f64>,
-    /// Each cell's corners `[a, b, c, d]` times its scale, rounded to
-    /// `f32`: `p_q` of a query in `f32` is their blend, read from one
-    /// 16-byte entry (one cache line where the buffer starts on 16 bytes,
-    /// as heap and mapped buffers do) instead of three lines of `f64`. Each
-    /// is at most `4 P_c WH'` (a corner is at most `4 Ȳ_c`), so none
-    /// overflows; a cell dark beside the map's brightest may round to a
-    /// subnormal or 0, as its own `f32` density would.
-    scaled_corners: Buffer<[f32; 4]>,
+    /// Each texel's luminance times `WH'/Σw` (`L = Y·WH'/Σw`), rounded to
+    /// `f32`, from which a query in `f32` computes `p_q` (see
+    /// [`density_f32`]): 4 bytes a texel, so that a 1024 × 512 map's
+    /// (2 MiB) stays in a core's cache. A texel adds at least `Y·Δ/12` to
+    /// the weight of a cell it is a corner of (the least at a pole), so
+    /// `L` is at most `12 WH'/Δ` and never overflows; a texel dark beside
+    /// the map's brightest may round to a subnormal or 0, as its own `f32`
+    /// density would.
+    lum_f32: Buffer<f32>,
+    /// Each row's `[I₀, I₁]` (the cells' weights are `α·I₀ + β·I₁`), in
+    /// `f32`.
+    moments_f32: Buffer<[f32; 2]>,
 }
 
 impl LuminanceDensity {
@@ -76,9 +80,12 @@ impl LuminanceDensity {
         let delta = PI / (height - 1) as f64;
         let cell_count = width * (height - 1);
         let mut weights = Buffer::for_overwrite(cell_count, "the sampling cells")?;
-        by_rows(weights.par_chunks_mut(width), width, |j, row| {
+        let mut moments_f32 = Buffer::for_overwrite(height - 1, "the sampling cells")?;
+        let rows = (weights.par_chunks_mut(width)).zip(moments_f32.par_iter_mut());
+        by_rows(rows, width, |j, (row, m)| {
             let (sin, cos) = (j as f64 * delta).sin_cos();
             let [i0, i1] = moments([sin.max(0.0), cos], delta);
+            *m = [i0 as f32, i1 as f32];
             for (i, w) in row.iter_mut().enumerate() {
                 let [a, b, c, d] = corners(&lum, width, j * width + i);
                 let alpha = 0.5 * (a + b);
@@ -91,19 +98,22 @@ impl LuminanceDensity {
         let cells = Discrete2D::with_arg("image", &weights, height - 1, width)?;
         let per_cell = cell_count as f64 / cells.sum();
         let mut scale = Buffer::for_overwrite(cell_count, "the sampling cells")?;
-        let mut scaled_corners = Buffer::for_overwrite(cell_count, "the sampling cells")?;
-        let rows = (scale.par_chunks_mut(width)).zip(scaled_corners.par_chunks_mut(width));
-        by_rows(rows, width, |j, (scale, scaled)| {
-            for (i, (s, c)) in scale.iter_mut().zip(scaled).enumerate() {
+        by_rows(scale.par_chunks_mut(width), width, |j, scale| {
+            for (i, s) in scale.iter_mut().enumerate() {
                 let k = j * width + i;
-                let corners = corners(&lum, width, k);
-                let mean = 0.25 * corners.iter().sum::<f64>();
+                let mean = 0.25 * corners(&lum, width, k).iter().sum::<f64>();
                 *s = if mean > 0.0 {
                     weights[k] * per_cell / mean
                 } else {
                     0.0
                 };
-                *c = corners.map(|y| (y * *s) as f32);
+            }
+        })?;
+        let mut lum_f32 = Buffer::for_overwrite(lum.len(), "the sampling cells")?;
+        let rows = (lum_f32.par_chunks_mut(width)).zip(lum.par_chunks(width));
+        by_rows(rows, width, |_, (l, y)| {
+            for (l, &y) in l.iter_mut().zip(y) {
+                *l = (y * per_cell) as f32;
             }
         })?;
         Ok(Some(LuminanceDensity {
@@ -111,7 +121,8 @@ impl LuminanceDensity {
             width,
             cells,
             scale,
-            scaled_corners,
+            lum_f32,
+            moments_f32,
         }))
     }
 
@@ -180,7 +191,8 @@ impl LuminanceDensity {
             lum: &self.lum,
             below: &self.lum[self.width..],
             scale: &self.scale,
-            scaled_corners: &self.scaled_corners,
+            lum_f32: &self.lum_f32,
+            moments_f32: &self.moments_f32,
         }
     }
 }
@@ -215,8 +227,10 @@ pub struct Tables<'a> {
     below: &'a [f64],
     /// The cells' `P_c · WH' / Ȳ_c`.
     scale: &'a [f64],
-    /// The cells' corners times their scale, in `f32`.
-    scaled_corners: &'a [[f32; 4]],
+    /// The texels' `L = Y·WH'/Σw`, in `f32`.
+    lum_f32: &'a [f32],
+    /// The rows' `[I₀, I₁]`, in `f32`.
+    moments_f32: &'a [[f32; 2]],
 }
 
 impl Tables<'_> {
@@ -230,53 +244,85 @@ impl Tables<'_> {
         simd::prefetch(self.scale, k);
     }
 
-    /// Asks the CPU for the line that [`Tables::pdf_at_f32`] reads for
-    /// cell `k`.
+    /// Asks the CPU for the lines that [`Tables::pdf_at_f32`] reads for
+    /// cell `k`: its two rows' `L`.
     #[inline(always)]
     pub(super) fn prefetch_f32(self, k: usize) {
-        simd::prefetch(self.scaled_corners, k);
+        simd::prefetch(self.lum_f32, k);
+        simd::prefetch(self.lum_f32, k + self.width);
     }
 
-    /// `p_q` at the blend by `wt` of cell `k`'s corners times its scale,
-    /// as rounded to `f32` ([`LuminanceDensity`]'s `scaled_corners`), in
-    /// `f32`. A cell past the table reads as the last, as
-    /// [`simd::gather_columns`] reads it (callers pass none).
+    /// The texels `[a, b, c, d]` of cell `k` (its top-left texel) of the
+    /// lat-long place `(x₀, y₀)`, as [`right_of`] and
+    /// `Image::place_texel` find them, and its row: in `u32` arithmetic
+    /// that vectorises.
     #[inline(always)]
-    pub(super) fn pdf_at_f32(self, k: usize, wt: [f32; 4]) -> f32 {
-        debug_assert!(
-            k < self.scaled_corners.len(),
-            "cell {k} is not one of the map's"
-        );
-        blend(
-            wt,
-            self.scaled_corners[k.min(self.scaled_corners.len() - 1)],
-        )
+    fn cell_texels_f32(self, k: u32, x0: f32, y0: f32) -> ([u32; 4], u32) {
+        let w = self.width as u32;
+        let col = x0.floor_u32(w - 1);
+        let right = if col + 1 == w { k + 1 - w } else { k + 1 };
+        let last_row = self.moments_f32.len() as u32 - 1;
+        ([k, right, k + w, right + w], y0.floor_u32(last_row))
+    }
+
+    /// `p_q` in `f32` at the blend by `wt` of cell `k` (its top-left
+    /// texel) of the lat-long place `(x₀, y₀)` ([`density_f32`] of its
+    /// `L` and its row's moments). A texel past the table reads as the
+    /// last, as [`simd::gather_columns`] reads it (callers pass none).
+    #[inline(always)]
+    pub(super) fn pdf_at_f32(self, k: usize, x0: f32, y0: f32, wt: [f32; 4]) -> f32 {
+        debug_assert!(k < self.scale.len(), "cell {k} is not one of the map's");
+        let (texels, row) = self.cell_texels_f32(k as u32, x0, y0);
+        let last = self.lum_f32.len() - 1;
+        let corners = texels.map(|t| self.lum_f32[(t as usize).min(last)]);
+        density_f32(corners, self.moments_f32[row as usize], wt)
     }
 
     /// `out[i]` = the density per steradian of the query in row `i` of the
     /// columns `q` (`EnvMap::luminance_query`'s) in the cell `cells[i]`, in
     /// `f64`: [`Tables::pdf_at`] times `1/(dω/dq)`.
     #[inline(always)]
-    fn block_pdfs(self, q: &[[f64; BLOCK]; 7], cells: &[usize; BLOCK], out: &mut [f64]) {
+    fn block_pdfs(self, q: &[[f64; BLOCK]; 7], cells: &[u32; BLOCK], out: &mut [f64]) {
         debug_assert!(out.len() <= BLOCK);
         for (i, o) in out.iter_mut().enumerate() {
-            *o = self.pdf_at(cells[i], q[0][i], [q[2][i], q[3][i], q[4][i], q[5][i]]) * q[6][i];
+            *o = self.pdf_at(
+                cells[i] as usize,
+                q[0][i],
+                [q[2][i], q[3][i], q[4][i], q[5][i]],
+            ) * q[6][i];
         }
     }
 
-    /// [`Tables::block_pdfs`] in `f32` from the premultiplied corners:
-    /// [`Tables::pdf_at_f32`] times `1/(dω/dq)` for each row, the corners
-    /// read by gathers and blended at SIMD width (the same bits).
+    /// [`Tables::block_pdfs`] in `f32`: [`Tables::pdf_at_f32`] times
+    /// `1/(dω/dq)` for each row (the same bits), the texels and rows found
+    /// at SIMD width, their `L` and moments read by gathers, the densities
+    /// computed at SIMD width.
     #[inline(always)]
-    fn block_pdfs_f32(self, q: &[[f32; BLOCK]; 7], cells: &[usize; BLOCK], out: &mut [f32]) {
+    fn block_pdfs_f32(self, q: &[[f32; BLOCK]; 7], cells: &[u32; BLOCK], out: &mut [f32]) {
         debug_assert!(out.len() <= BLOCK);
+        let (mut texels, mut rows) = ([[0; BLOCK]; 4], [0; BLOCK]);
+        for i in 0..BLOCK {
+            let (t, row) = self.cell_texels_f32(cells[i], q[0][i], q[1][i]);
+            for (column, t) in texels.iter_mut().zip(t) {
+                column[i] = t;
+            }
+            rows[i] = row;
+        }
         let mut corners = [[0.0; BLOCK]; 4];
-        simd::gather_columns(self.scaled_corners, cells, &mut corners);
+        for (column, texels) in corners.iter_mut().zip(&texels) {
+            simd::gather_columns(
+                self.lum_f32.as_chunks().0,
+                texels,
+                std::array::from_mut(column),
+            );
+        }
+        let mut moments = [[0.0; BLOCK]; 2];
+        simd::gather_columns(self.moments_f32, &rows, &mut moments);
         let mut pdf = [0.0; BLOCK];
         for (i, p) in pdf.iter_mut().enumerate() {
             let wt = [q[2][i], q[3][i], q[4][i], q[5][i]];
             let c = [corners[0][i], corners[1][i], corners[2][i], corners[3][i]];
-            *p = blend(wt, c) * q[6][i];
+            *p = density_f32(c, [moments[0][i], moments[1][i]], wt) * q[6][i];
         }
         out.copy_from_slice(&pdf[..out.len()]);
     }
@@ -299,7 +345,7 @@ impl Tables<'_> {
 
 /// The float types in which a [`LuminanceDensity`] is read: each from
 /// its own tables (`f64` from the luminances and scales, `f32` from the
-/// premultiplied corners). The crate's own (it seals
+/// texels' `L` and the rows' moments). The crate's own (it seals
 /// [`super::TableFloat`]).
 pub trait LuminanceFloat: Real {
     /// Asks the CPU for the lines of `tables` that
@@ -307,8 +353,8 @@ pub trait LuminanceFloat: Real {
     fn prefetch_luminance(tables: Tables<'_>, k: usize);
 
     /// The luminance density `p_q` at the blend by `wt` of cell `k`'s
-    /// corners (`k` its top-left texel, of column `x₀`).
-    fn luminance_pdf(tables: Tables<'_>, k: usize, x0: Self, wt: [Self; 4]) -> Self;
+    /// corners (`k` its top-left texel, at the lat-long place `[x₀, y₀]`).
+    fn luminance_pdf(tables: Tables<'_>, k: usize, place: [Self; 2], wt: [Self; 4]) -> Self;
 
     /// The luminance density per steradian of a block of queries
     /// (`EnvMap::luminance_query`'s, in columns) in their `cells`, into
@@ -317,7 +363,7 @@ pub trait LuminanceFloat: Real {
     fn luminance_block(
         tables: Tables<'_>,
         q: &[[Self; BLOCK]; 7],
-        cells: &[usize; BLOCK],
+        cells: &[u32; BLOCK],
         out: &mut [Self],
     );
 }
@@ -328,14 +374,14 @@ impl LuminanceFloat for f32 {
         tables.prefetch_f32(k);
     }
     #[inline(always)]
-    fn luminance_pdf(tables: Tables<'_>, k: usize, _x0: f32, wt: [f32; 4]) -> f32 {
-        tables.pdf_at_f32(k, wt)
+    fn luminance_pdf(tables: Tables<'_>, k: usize, [x0, y0]: [f32; 2], wt: [f32; 4]) -> f32 {
+        tables.pdf_at_f32(k, x0, y0, wt)
     }
     #[inline(always)]
     fn luminance_block(
         tables: Tables<'_>,
         q: &[[f32; BLOCK]; 7],
-        cells: &[usize; BLOCK],
+        cells: &[u32; BLOCK],
         out: &mut [f32],
     ) {
         tables.block_pdfs_f32(q, cells, out);
@@ -348,25 +394,42 @@ impl LuminanceFloat for f64 {
         tables.prefetch(k);
     }
     #[inline(always)]
-    fn luminance_pdf(tables: Tables<'_>, k: usize, x0: f64, wt: [f64; 4]) -> f64 {
+    fn luminance_pdf(tables: Tables<'_>, k: usize, [x0, _]: [f64; 2], wt: [f64; 4]) -> f64 {
         tables.pdf_at(k, x0, wt)
     }
     #[inline(always)]
     fn luminance_block(
         tables: Tables<'_>,
         q: &[[f64; BLOCK]; 7],
-        cells: &[usize; BLOCK],
+        cells: &[u32; BLOCK],
         out: &mut [f64],
     ) {
         tables.block_pdfs(q, cells, out);
     }
 }
 
-/// `Σ wt[m]·c[m]` in `f32`, summed in order from 0 as a blend of texels
-/// starts.
+/// `p_q` in `f32` at the blend by `wt` of a cell's corners `c = [a, b,
+/// c, d]` of `L = Y·WH'/Σw`, its row's moments `[I₀, I₁]`:
+///
+/// ```text
+/// p_q = L(x, y) · w_c / L̄_c,   w_c = α I₀ + β I₁,   α = (a + b)/2,   β = (c + d)/2 − α
+/// ```
+///
+/// with `L̄_c = (a + b + c + d)/4` (0 where `L̄_c = 0`): `Y · P_c WH'/Ȳ_c`,
+/// as the `f64` tables give it, since `w_c/L̄_c` is the same for any
+/// multiple of `Y`. Branch-free, so that a block computes it at SIMD
+/// width; the blend is summed from 0 as a blend of texels starts.
 #[inline(always)]
-fn blend(wt: [f32; 4], c: [f32; 4]) -> f32 {
-    0.0 + wt[0] * c[0] + wt[1] * c[1] + wt[2] * c[2] + wt[3] * c[3]
+fn density_f32(c: [f32; 4], [i0, i1]: [f32; 2], wt: [f32; 4]) -> f32 {
+    let alpha = 0.5 * (c[0] + c[1]);
+    let weight = alpha * i0 + (0.5 * (c[2] + c[3]) - alpha) * i1;
+    let mean = 0.25 * (c[0] + c[1] + c[2] + c[3]);
+    let blend = 0.0 + wt[0] * c[0] + wt[1] * c[1] + wt[2] * c[2] + wt[3] * c[3];
+    if mean > 0.0 {
+        blend * (weight / mean)
+    } else {
+        0.0
+    }
 }
 
 /// `[x, y, bilerp(c, x, y)]`: the point of the unit square that `r` places

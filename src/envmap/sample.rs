@@ -283,8 +283,8 @@ impl EnvMap {
 
     /// The density of the luminance `density` (this map's) along the world
     /// direction `d`, per steradian, computed in `F` from the texels
-    /// [`EnvMap::eval`] reads there (in `f32`, from the cell's corners
-    /// premultiplied by its scale) and `1/(dω/dq)`, as
+    /// [`EnvMap::eval`] reads there (in `f32`, from their `f32` table and
+    /// the row's moments: `density_f32`) and `1/(dω/dq)`, as
     /// [`PolarTable::query`] finds it without normalising `d` (0 for
     /// `d = 0`). Batches run its three steps apart: the query
     /// ([`EnvMap::luminance_query`]) over a block at SIMD width, the
@@ -299,7 +299,7 @@ impl EnvMap {
     ) -> F {
         let q = self.luminance_query(d);
         let k = self.image.place_texel(q[0], q[1]);
-        F::luminance_pdf(density.tables(), k, q[0], [q[2], q[3], q[4], q[5]]) * q[6]
+        F::luminance_pdf(density.tables(), k, [q[0], q[1]], [q[2], q[3], q[4], q[5]]) * q[6]
     }
 
     /// The place on a lat-long map of the world direction `d` and

@@ -299,7 +299,8 @@ fn polar_tables_give_the_table_pdf() {
 
 #[test]
 fn luminance_pdfs_in_f32_follow_f64s() {
-    // The f32 batch reads each cell's corners premultiplied in f32; the f64
+    // The f32 batch computes p_q from the texels' L and the rows' moments in
+    // f32 (and the one-at-a-time f32 density the same bits); the f64
     // density at the same (f32) direction is the reference. Directions
     // along the seam and at the poles (where cells wrap and clamp), then
     // uniform on the sphere and drawn from the map (its bright spot).

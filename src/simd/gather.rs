@@ -15,7 +15,7 @@ use super::{BLOCK, Level, detected, level};
 #[inline(always)]
 pub fn gather_columns<const C: usize>(
     table: &[[f32; C]],
-    index: &[usize; BLOCK],
+    index: &[u32; BLOCK],
     columns: &mut [[f32; BLOCK]; C],
 ) {
     gather_at(level(), table, index, columns);
@@ -27,7 +27,7 @@ pub fn gather_columns<const C: usize>(
 fn gather_at<const C: usize>(
     level: Level,
     table: &[[f32; C]],
-    index: &[usize; BLOCK],
+    index: &[u32; BLOCK],
     columns: &mut [[f32; BLOCK]; C],
 ) {
     let Some(last) = table.len().checked_sub(1) else {
@@ -37,10 +37,10 @@ fn gather_at<const C: usize>(
     #[cfg(target_arch = "x86_64")]
     if C * table.len() <= i32::MAX as usize && level >= Level::Avx2 {
         // Each entry's first offset in `f32`s: at most `C·last`, which fits
-        // in an `i32` (checked above).
+        // in an `i32` (checked above), as `last` does in a `u32`.
         let mut offsets = [0i32; BLOCK];
         for (o, &i) in offsets.iter_mut().zip(index) {
-            *o = (C * i.min(last)) as i32;
+            *o = (C as u32 * i.min(last as u32)) as i32;
         }
         let flat = table.as_flattened();
         #[allow(unsafe_code)]
@@ -57,7 +57,7 @@ fn gather_at<const C: usize>(
         return;
     }
     for (i, &k) in index.iter().enumerate() {
-        let entry = table[k.min(last)];
+        let entry = table[(k as usize).min(last)];
         for (column, value) in columns.iter_mut().zip(entry) {
             column[i] = value;
         }
@@ -137,19 +137,19 @@ mod tests {
             .collect();
         // Indices in any order, repeated, first and last, and past the end
         // (read as the last).
-        let index: [usize; BLOCK] = std::array::from_fn(|i| match i {
+        let index: [u32; BLOCK] = std::array::from_fn(|i| match i {
             0 => 0,
-            1 => len - 1,
-            2 => len,
-            3 => usize::MAX,
-            _ => (i * 7919) % len,
+            1 => len as u32 - 1,
+            2 => len as u32,
+            3 => u32::MAX,
+            _ => ((i * 7919) % len) as u32,
         });
         for level in [Level::Baseline, Level::Avx2, Level::Avx512] {
             let mut columns = [[-1.0; BLOCK]; C];
             gather_at(level, &table, &index, &mut columns);
             for (i, &k) in index.iter().enumerate() {
                 for (c, column) in columns.iter().enumerate() {
-                    let expected = table[k.min(len - 1)][c];
+                    let expected = table[(k as usize).min(len - 1)][c];
                     assert_eq!(column[i], expected, "{level:?}: index {k}, component {c}");
                 }
             }
