@@ -444,12 +444,13 @@ impl Real for f32 {
     }
     #[inline(always)]
     fn floor_u32(self, last: u32) -> u32 {
-        // Clamped in floats first (`max` takes NaN to 0), so that the
-        // conversion needs no saturation: one instruction at SIMD width,
-        // where the saturating `as` is scalar. The clamp's bound is at most
-        // the largest `f32` below 2³¹, and the result is clamped to `last`
-        // again (`last as f32` may round up).
-        let x = self.max(0.0).min((last as f32).min(2_147_483_520.0));
+        // Clamped in floats first (`max` takes NaN to 0) to the largest
+        // `f32` below 2³¹, so that the conversion needs no saturation: one
+        // instruction at SIMD width, where the saturating `as` is scalar;
+        // then to `last` in integers (`last as f32` would round). (Not
+        // `clamp`, which keeps NaN.)
+        #[allow(clippy::manual_clamp)]
+        let x = self.max(0.0).min(2_147_483_520.0);
         #[allow(unsafe_code)]
         // SAFETY: `x` is finite and in `[0, 2³¹)`, which `i32` holds.
         let i = unsafe { x.to_int_unchecked::<i32>() };

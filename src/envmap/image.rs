@@ -232,10 +232,10 @@ impl Image {
     }
 
     /// [`Image::place_texel`] in `u32` arithmetic, which holds every texel
-    /// index (at most [`MAX_TEXELS`], twice that padded).
+    /// index (at most [`MAX_TEXELS`], three times that padded).
     #[inline(always)]
     fn place_texel_u32<F: Real>(&self, x0: F, y0: F) -> u32 {
-        const { assert!(2 * MAX_TEXELS <= u32::MAX as usize) };
+        const { assert!(3 * MAX_TEXELS <= u32::MAX as usize) };
         let (w, h) = (self.width as u32, self.height as u32);
         y0.floor_u32(h - 2) * w + x0.floor_u32(w - 1)
     }

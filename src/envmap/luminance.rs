@@ -57,9 +57,10 @@ pub(super) struct LuminanceDensity {
     /// Each texel's luminance times `WH'/Σw` (`L = Y·WH'/Σw`), rounded to
     /// `f32`, from which a query in `f32` computes `p_q` (see
     /// [`density_f32`]): 4 bytes a texel, so that a 1024 × 512 map's
-    /// (2 MiB) stays in a core's cache. A texel adds at least `Y·Δ/12` to
-    /// the weight of a cell it is a corner of (the least at a pole), so
-    /// `L` is at most `12 WH'/Δ` and never overflows; a texel dark beside
+    /// (2 MiB) stays in a core's cache. A texel adds at least
+    /// `Y(Δ − sin Δ)/Δ² ≥ 0.88·YΔ/6` to the weights of the two cells of
+    /// its row it is a corner of (the least at a pole), so `L` is at most
+    /// `7 WH'/Δ` and never overflows; a texel dark beside
     /// the map's brightest may round to a subnormal or 0, as its own `f32`
     /// density would.
     lum_f32: Buffer<f32>,
@@ -80,7 +81,7 @@ impl LuminanceDensity {
         let delta = PI / (height - 1) as f64;
         let cell_count = width * (height - 1);
         let mut weights = Buffer::for_overwrite(cell_count, "the sampling cells")?;
-        let mut moments_f32 = Buffer::for_overwrite(height - 1, "the sampling cells")?;
+        let mut moments_f32 = Buffer::for_overwrite(height - 1, "the sampling rows")?;
         let rows = (weights.par_chunks_mut(width)).zip(moments_f32.par_iter_mut());
         by_rows(rows, width, |j, (row, m)| {
             let (sin, cos) = (j as f64 * delta).sin_cos();
@@ -109,7 +110,7 @@ impl LuminanceDensity {
                 };
             }
         })?;
-        let mut lum_f32 = Buffer::for_overwrite(lum.len(), "the sampling cells")?;
+        let mut lum_f32 = Buffer::for_overwrite(lum.len(), "the sampling texels")?;
         let rows = (lum_f32.par_chunks_mut(width)).zip(lum.par_chunks(width));
         by_rows(rows, width, |_, (l, y)| {
             for (l, &y) in l.iter_mut().zip(y) {

@@ -288,7 +288,8 @@ impl EnvMap {
     /// [`PolarTable::query`] finds it without normalising `d` (0 for
     /// `d = 0`). Batches run its three steps apart: the query
     /// ([`EnvMap::luminance_query`]) over a block at SIMD width, the
-    /// cell under it ([`Image::place_texel`]), its table lines prefetched,
+    /// cells under them ([`Image::place_texels`], at SIMD width) and their
+    /// table lines prefetched,
     /// and one block later the densities of the block
     /// ([`LuminanceFloat::luminance_block`]).
     #[inline(always)]

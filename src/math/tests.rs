@@ -186,4 +186,15 @@ fn floor_index_floors_and_clamps() {
             assert_eq!((x as f32).floor_index(last), want, "{x} in f32");
         }
     }
+    // In f32, a last index with no float of its own (2²⁴ + 1 rounds to
+    // 2²⁴) is still reached, and nothing passes it.
+    let last = (1 << 24) + 1;
+    for (x, want) in [
+        (16_777_218.0f32, last),
+        (16_777_216.0, 1 << 24),
+        (1e30, last),
+    ] {
+        assert_eq!(x.floor_index(last), want, "{x} in f32");
+        assert_eq!(x.floor_u32(last as u32), want as u32, "{x} in f32");
+    }
 }
