@@ -6,7 +6,7 @@
 
 use super::cell_sampler::CellSampler;
 use super::distribution::Distribution;
-use super::image::{Corners, LatLongPlace};
+use super::image::Corners;
 use super::luminance::LuminanceDensity;
 use super::mapping::Mapping;
 use super::polar::TableFloat;
@@ -87,9 +87,24 @@ impl EnvMap {
                 };
                 let locate = {
                     #[inline(always)]
-                    |q: &LatLongPlace<F>| self.prefetched(self.image.placed_corners(q))
+                    |q: &Columns<F, 6>, cells: &mut [u32; simd::BLOCK], rows: usize| {
+                        self.image.place_texels(&q[0], &q[1], cells);
+                        for &k in &cells[..rows] {
+                            self.image.prefetch_cell(k as usize);
+                        }
+                    }
                 };
-                pipelined(d, out, &place, valid, locate, |_, c| self.radiance_of(c))
+                let read = {
+                    #[inline(always)]
+                    |q: &Columns<F, 6>, cells: &[u32; simd::BLOCK], o: &mut [[F; 3]]| {
+                        let rgb = self.image.blend_places(q, cells);
+                        let scale = F::c(self.options.scale);
+                        for (i, o) in o.iter_mut().enumerate() {
+                            *o = [0, 1, 2].map(|c| rgb[c][i] * scale);
+                        }
+                    }
+                };
+                pipelined_blocks(d, out, &place, valid, locate, read)
             }
             Mapping::Angular => self.eval_by_corners(d, out, valid, Mapping::Angular),
             Mapping::Cube => self.eval_by_corners(d, out, valid, Mapping::Cube),

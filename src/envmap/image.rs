@@ -16,6 +16,7 @@ use crate::buffer::Buffer;
 use crate::error::{Error, Result, check_at_most};
 use crate::math::{Real, luminance};
 use crate::simd;
+use std::ops::{Add, Sub};
 
 /// RGB texels, row-major, row 0 at the top; a cube map stores its six
 /// `R × R` faces one below the other (`height = 6R`).
@@ -236,8 +237,51 @@ impl Image {
     #[inline(always)]
     fn place_texel_u32<F: Real>(&self, x0: F, y0: F) -> u32 {
         const { assert!(3 * MAX_TEXELS <= u32::MAX as usize) };
-        let (w, h) = (self.width as u32, self.height as u32);
-        y0.floor_u32(h - 2) * w + x0.floor_u32(w - 1)
+        let w = self.width as u32;
+        let [col, row] = cell_u32(x0, y0, w, self.height as u32 - 1);
+        row * w + col
+    }
+
+    /// Asks the CPU for the texels of cell `k` (its top-left texel) of a
+    /// lat-long place: texels `k`, `k + 1` and the two below (the right
+    /// neighbour wrapped at the seam is left to the read).
+    #[inline(always)]
+    pub(crate) fn prefetch_cell(&self, k: usize) {
+        self.prefetch(&[k, k + 1, k + self.width, k + self.width + 1]);
+    }
+
+    /// [`Image::blend`] of the corners of each of a block's lat-long places
+    /// (the columns `q` of [`Image::lat_long_place`]s, whose top-left
+    /// texels [`Image::place_texels`] put in `cells`), one column per RGB
+    /// channel: the four texels of each found at SIMD width (as
+    /// [`Image::placed_corners`] finds them), read by gathers and blended at
+    /// SIMD width, in the same order as `blend` (the same bits).
+    #[inline(always)]
+    pub(crate) fn blend_places<F: Real>(
+        &self,
+        q: &[[F; simd::BLOCK]; 6],
+        cells: &[u32; simd::BLOCK],
+    ) -> [[F; simd::BLOCK]; 3] {
+        let (w, rows) = (self.width as u32, self.height as u32 - 1);
+        let mut texels = [[0; simd::BLOCK]; 4];
+        for (i, &k) in cells.iter().enumerate() {
+            let [col, _] = cell_u32(q[0][i], q[1][i], w, rows);
+            let right = right_of(k, col, w);
+            for (column, t) in texels.iter_mut().zip([k, right, k + w, right + w]) {
+                column[i] = t;
+            }
+        }
+        let mut rgb = [[F::zero(); simd::BLOCK]; 3];
+        for (j, texels) in texels.iter().enumerate() {
+            let mut t = [[0.0; simd::BLOCK]; 3];
+            simd::gather_columns(&self.texels, texels, &mut t);
+            for (rgb, t) in rgb.iter_mut().zip(&t) {
+                for i in 0..simd::BLOCK {
+                    rgb[i] = rgb[i] + q[2 + j][i] * F::c(f64::from(t[i]));
+                }
+            }
+        }
+        rgb
     }
 
     /// The texels of a lat-long map's table cell `(row, col)` (the patch
@@ -278,14 +322,28 @@ impl Image {
     }
 }
 
-/// The texel right of texel `k` of column `col` on a lat-long map `width`
-/// texels wide, wrapped from the row's last column to its first.
+/// The cell `[column, row]` of the lat-long place `(x₀, y₀)` on a map
+/// `width` texels wide whose table has `rows` rows of cells (one fewer than
+/// the map's rows of texels): `⌊x₀⌋` and `⌊y₀⌋`, each clamped to the last,
+/// in `u32` arithmetic that vectorises.
 #[inline(always)]
-pub(super) fn right_of(k: usize, col: usize, width: usize) -> usize {
-    if col + 1 == width {
-        k + 1 - width
+pub(super) fn cell_u32<F: Real>(x0: F, y0: F, width: u32, rows: u32) -> [u32; 2] {
+    [x0.floor_u32(width - 1), y0.floor_u32(rows - 1)]
+}
+
+/// The texel right of texel `k` of column `col` on a lat-long map `width`
+/// texels wide, wrapped from the row's last column to its first (in
+/// `usize`, or in `u32` where a loop is to vectorise).
+#[inline(always)]
+pub(super) fn right_of<I>(k: I, col: I, width: I) -> I
+where
+    I: Copy + PartialEq + Add<Output = I> + Sub<Output = I> + From<u8>,
+{
+    let one = I::from(1);
+    if col + one == width {
+        k + one - width
     } else {
-        k + 1
+        k + one
     }
 }
 
