@@ -1,8 +1,8 @@
 //! The batch pipelines of an [`EnvMap`]: `eval`, `pdf` and `sample` over
 //! many directions or numbers at once, in blocks whose steps run at SIMD
 //! width and whose table and texel reads are prefetched so that their
-//! cache misses overlap. Each computes what its one-at-a-time method does,
-//! with the same functions.
+//! cache misses overlap. Each computes what its one-at-a-time method does:
+//! the same bits.
 
 use super::cell_sampler::CellSampler;
 use super::distribution::Distribution;
@@ -70,7 +70,9 @@ impl EnvMap {
     /// `out[i] = eval(d[i])` for a batch, in `F`: every direction's place on
     /// the map by one loop at SIMD width (for lat-long maps its cell and
     /// weights too), then its texels located and prefetched, and read one
-    /// block behind (two blocks in flight).
+    /// block behind (two blocks in flight); a lat-long map's cells are
+    /// found, and their texels read (by gathers) and blended, at SIMD width
+    /// (`Image::blend_places`).
     /// Returns whether `valid` held for every direction (it is checked in
     /// the same pass).
     pub fn eval_into<F: Real>(
@@ -532,3 +534,6 @@ fn pipelined_blocks<F: Real, T, C: Copy + Default, const K: usize>(
         },
     )
 }
+
+#[cfg(test)]
+mod tests;

@@ -190,8 +190,8 @@ impl Image {
         let x = p[0] - F::c(0.5 / w as f64);
         let x = (x + if x < zero { one } else { zero }) * F::c(w as f64);
         let y = p[1].max(zero).min(one) * F::c((h - 1) as f64);
-        // (The cell is kept unclamped, so that `floor_index` clamps it in
-        // integers: in `f32` the last column of a map wider than 2²⁴ has
+        // (The cell is kept unclamped, so that `floor_u32` clamps it in
+        // integers ([`cell_u32`]): in `f32` the last column of a map wider than 2²⁴ has
         // no float of its own. A NaN `x` has the weights of cell 0 there.)
         let (x0, y0) = (x.floor(), y.floor());
         let fx = (x - x0.min(F::c((w - 1) as f64))).max(zero).min(one);
@@ -203,10 +203,10 @@ impl Image {
     /// The texels and weights of a lat-long place ([`Image::lat_long_place`]).
     #[inline(always)]
     pub(crate) fn placed_corners<F: Real>(&self, place: &LatLongPlace<F>) -> Corners<F> {
-        let (w, k) = (self.width, self.place_texel(place[0], place[1]));
-        let right = right_of(k, place[0].floor_index(w - 1), w);
+        let (w, k) = (self.width as u32, self.place_texel_u32(place[0], place[1]));
+        let texels = cell_texels(k, place[0].floor_u32(w - 1), w);
         (
-            [k, right, k + w, right + w],
+            texels.map(|t| t as usize),
             [place[2], place[3], place[4], place[5]],
         )
     }
@@ -251,23 +251,24 @@ impl Image {
     }
 
     /// [`Image::blend`] of the corners of each of a block's lat-long places
-    /// (the columns `q` of [`Image::lat_long_place`]s, whose top-left
-    /// texels [`Image::place_texels`] put in `cells`), one column per RGB
-    /// channel: the four texels of each found at SIMD width (as
-    /// [`Image::placed_corners`] finds them), read by gathers and blended at
-    /// SIMD width, in the same order as `blend` (the same bits).
+    /// (the columns `q` of [`Image::lat_long_place`]s; `cells` must be
+    /// their top-left texels, as [`Image::place_texels`] of the same `q`
+    /// puts them), one column per RGB channel: the four texels of each
+    /// found at SIMD width (as [`Image::placed_corners`] finds them), read
+    /// by gathers and blended at SIMD width, in the same order as `blend`
+    /// (the same bits).
     #[inline(always)]
     pub(crate) fn blend_places<F: Real>(
         &self,
         q: &[[F; simd::BLOCK]; 6],
         cells: &[u32; simd::BLOCK],
     ) -> [[F; simd::BLOCK]; 3] {
-        let (w, rows) = (self.width as u32, self.height as u32 - 1);
+        let w = self.width as u32;
         let mut texels = [[0; simd::BLOCK]; 4];
         for (i, &k) in cells.iter().enumerate() {
-            let [col, _] = cell_u32(q[0][i], q[1][i], w, rows);
-            let right = right_of(k, col, w);
-            for (column, t) in texels.iter_mut().zip([k, right, k + w, right + w]) {
+            let col = q[0][i].floor_u32(w - 1);
+            debug_assert_eq!(k % w, col, "a cell that is not its place's");
+            for (column, t) in texels.iter_mut().zip(cell_texels(k, col, w)) {
                 column[i] = t;
             }
         }
@@ -324,11 +325,21 @@ impl Image {
 
 /// The cell `[column, row]` of the lat-long place `(x₀, y₀)` on a map
 /// `width` texels wide whose table has `rows` rows of cells (one fewer than
-/// the map's rows of texels): `⌊x₀⌋` and `⌊y₀⌋`, each clamped to the last,
-/// in `u32` arithmetic that vectorises.
+/// the map's rows of texels): `⌊x₀⌋` and `⌊y₀⌋`, each clamped to `[0,
+/// last]` (NaN to 0; [`Real::floor_u32`]), in `u32` arithmetic that
+/// vectorises.
 #[inline(always)]
 pub(super) fn cell_u32<F: Real>(x0: F, y0: F, width: u32, rows: u32) -> [u32; 2] {
     [x0.floor_u32(width - 1), y0.floor_u32(rows - 1)]
+}
+
+/// The texels `[a, b, c, d]` of the lat-long cell whose top-left texel is
+/// `k`, of column `col`, on a map `width` texels wide: `k`, the texel right
+/// of it ([`right_of`]), and the two below them.
+#[inline(always)]
+pub(super) fn cell_texels(k: u32, col: u32, width: u32) -> [u32; 4] {
+    let right = right_of(k, col, width);
+    [k, right, k + width, right + width]
 }
 
 /// The texel right of texel `k` of column `col` on a lat-long map `width`

@@ -5,7 +5,7 @@
 //! [`Sampling::Luminance`]: super::Sampling::Luminance
 
 use super::bilinear::{bilerp, warp_bilinear};
-use super::image::{cell_u32, right_of};
+use super::image::{cell_texels, cell_u32, right_of};
 use crate::buffer::Buffer;
 use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;
@@ -254,14 +254,13 @@ impl Tables<'_> {
     }
 
     /// The texels `[a, b, c, d]` of cell `k` (its top-left texel) of the
-    /// lat-long place `(x₀, y₀)` ([`cell_u32`] and [`right_of`]), and its
-    /// row: in `u32` arithmetic that vectorises.
+    /// lat-long place `(x₀, y₀)` ([`cell_u32`] and [`cell_texels`]), and
+    /// its row: in `u32` arithmetic that vectorises.
     #[inline(always)]
     fn cell_texels_f32(self, k: u32, x0: f32, y0: f32) -> ([u32; 4], u32) {
         let w = self.width as u32;
         let [col, row] = cell_u32(x0, y0, w, self.moments_f32.len() as u32);
-        let right = right_of(k, col, w);
-        ([k, right, k + w, right + w], row)
+        (cell_texels(k, col, w), row)
     }
 
     /// `p_q` in `f32` at the blend by `wt` of cell `k` (its top-left
