@@ -191,8 +191,9 @@ impl Image {
         let x = (x + if x < zero { one } else { zero }) * F::c(w as f64);
         let y = p[1].max(zero).min(one) * F::c((h - 1) as f64);
         // (The cell is kept unclamped, so that `floor_u32` clamps it in
-        // integers ([`cell_u32`]): in `f32` the last column of a map wider than 2²⁴ has
-        // no float of its own. A NaN `x` has the weights of cell 0 there.)
+        // integers ([`cell_u32`]): in `f32` the last column of a map wider
+        // than 2²⁴ has no float of its own. A NaN `x` has the weights of
+        // cell 0 there.)
         let (x0, y0) = (x.floor(), y.floor());
         let fx = (x - x0.min(F::c((w - 1) as f64))).max(zero).min(one);
         let fy = y - y0.min(F::c((h - 2) as f64));

@@ -75,6 +75,24 @@ fn batch_sampling_agrees_with_single_draws() {
     }
 }
 
+/// Asserts that `m.eval_into(d)` gives, direction by direction, the bits
+/// of `m.eval` (compared as `f64`, which holds every `f32` and its NaN
+/// payload).
+fn same_bits_as_single_evals<F: Real>(m: &EnvMap, d: &[[F; 3]]) {
+    let mut out = vec![[-F::one(); 3]; d.len()];
+    m.eval_into(d, &mut out, |_| true);
+    let bits = |v: [F; 3]| v.map(|x| x.f64().to_bits());
+    for (x, o) in d.iter().zip(&out) {
+        assert_eq!(
+            bits(*o),
+            bits(m.eval(*x)),
+            "{} x {}: {x:?}",
+            m.image.width(),
+            m.image.height()
+        );
+    }
+}
+
 /// A lat-long map's batch `eval` (its texels read by gathers) gives the
 /// one-at-a-time values bit for bit, on padded maps and at NaN and
 /// infinite directions too.
@@ -108,26 +126,8 @@ fn lat_long_evals_in_blocks_are_the_single_ones_on_small_maps_and_odd_directions
             compensate: false,
         };
         let m = EnvMap::new(w, h, &test_image(Mapping::LatLong, w, h), options).unwrap();
-        let mut out = vec![[-1.0; 3]; d.len()];
-        m.eval_into(&d, &mut out, |_| true);
-        for (x, o) in d.iter().zip(&out) {
-            let single = m.eval(*x);
-            assert_eq!(
-                o.map(f64::to_bits),
-                single.map(f64::to_bits),
-                "{w} x {h}: {x:?}"
-            );
-        }
-        let mut out32 = vec![[-1.0f32; 3]; d32.len()];
-        m.eval_into(&d32, &mut out32, |_| true);
-        for (x, o) in d32.iter().zip(&out32) {
-            let single = m.eval(*x);
-            assert_eq!(
-                o.map(f32::to_bits),
-                single.map(f32::to_bits),
-                "{w} x {h}: {x:?}"
-            );
-        }
+        same_bits_as_single_evals(&m, &d);
+        same_bits_as_single_evals(&m, &d32);
     }
 }
 
