@@ -8,6 +8,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
 
+# Each stage's start, seconds into the run, for the log.
+stage() { echo "== ${SECONDS} s: $*"; }
+
 # A libLLVM >= 16 lets Mitsuba 3 run its llvm_ad_rgb variant (Dr.Jit finds
 # it by itself); without one the suite falls back to scalar_rgb. Embree 3
 # traces mcsample's meshes when it loads (the suite checks both tracers,
@@ -22,8 +25,10 @@ if ! { dpkg -s libllvm19 && dpkg -s libembree3-3; } >/dev/null 2>&1 \
   $SUDO apt-get install -y -qq libllvm19 $EMBREE >/dev/null
 fi
 
+stage "pip, maturin"
 python -m pip install --quiet --upgrade pip "maturin>=1.7,<2"
 
+stage "wheel"
 # The wheel users install: abi3 (one wheel for CPython 3.9+), stripped.
 rm -rf target/wheels
 maturin build --release --quiet
@@ -34,6 +39,7 @@ ls -l "$WHEEL"
 # (the PATH entries holding cargo or rustc left out), by this Python and by
 # 3.9 and 3.13 where pyenv has them: a smoke test, run outside the source
 # tree.
+stage "smoke tests"
 NO_RUST_PATH=""
 IFS=: read -ra entries <<<"$PATH"
 for dir in "${entries[@]}"; do
@@ -56,17 +62,21 @@ done
 # any earlier install (pip keeps one of the same version otherwise; the
 # distribution was called "mcsample" before: that name on the package
 # index is another project's).
+stage "test dependencies"
 python -m pip uninstall --quiet -y mcsample mcsample-toolkit 2>/dev/null || true
 python -m pip install --quiet "$WHEEL[test,mitsuba,plot,distributed]"
 
+stage "Rust checks"
 rustup component add rustfmt clippy >/dev/null 2>&1 || true
 cargo fmt --check
 cargo clippy --all-targets --all-features --quiet -- -D warnings
+stage "cargo test"
 cargo test --quiet
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
 python -m mypy.stubtest mcsample._core --allowlist scripts/stubtest-allowlist.txt
 
+stage "pytest"
 # Run pytest from outside the source tree so it imports the installed
 # package, not python/mcsample without its compiled core. --nbmake also
 # executes every notebook top to bottom and fails on any error.
-cd tests && python -m pytest -q -p no:cacheprovider --nbmake . ../notebooks "$@"
+cd tests && python -m pytest -q -p no:cacheprovider --durations=20 --nbmake . ../notebooks "$@"

@@ -43,6 +43,46 @@ def test_non_contiguous_input():
                           warp.square_to_uniform_sphere(big[:, :2].copy()))
 
 
+def _views(a: np.ndarray) -> list[np.ndarray]:
+    """Non-contiguous views with the values of ``a`` (C-ordered): strided,
+    reversed, a transposed view of a larger array and, for two axes or
+    more, Fortran-ordered."""
+    wide = np.ascontiguousarray(np.stack([a, a], axis=-1))  # (..., K, 2)
+    views = [np.repeat(a, 2, axis=0)[::2], np.ascontiguousarray(a[::-1])[::-1],
+             np.moveaxis(wide, -1, 0)[0], np.asfortranarray(a)]
+    views = views if a.ndim > 1 else views[:3]
+    assert all(not v.flags.c_contiguous and np.array_equal(v, a) for v in views)
+    return views
+
+
+@pytest.mark.parametrize("batch", [(), (7,), (1000,), (5, 4), (3, 2, 4), (2, 3, 2, 5)])
+def test_non_contiguous_inputs_of_every_rank_read_as_their_copies(batch):
+    """Every binding that copies a non-contiguous input into C order (by
+    its number of axes: 1 to 4 and more) reads the same values as from
+    the C-ordered copy: points of any batch rank, broadcast points, a
+    2D table and envmap images (lat-long and cube)."""
+    u = mcs.uniform(int(np.prod(batch)) or 1, 2, seed=9).reshape(batch + (2,) if batch else (2,))
+    ref = warp.square_to_uniform_sphere(u)
+    for view in _views(u):
+        assert np.array_equal(warp.square_to_uniform_sphere(view), ref)
+    one = np.broadcast_to(u.reshape(-1, 2)[0], batch + (2,))
+    assert np.array_equal(warp.square_to_uniform_sphere(one),
+                          warp.square_to_uniform_sphere(one.copy()))
+    if len(batch) == 2:
+        table = mcs.uniform(batch[0] * batch[1], 1, seed=4).reshape(batch) + 0.1
+        ref = mcs.Discrete2D(table).sample(mcs.uniform(100, 2, seed=5))
+        for view in _views(table):
+            assert np.array_equal(mcs.Discrete2D(view).sample(mcs.uniform(100, 2, seed=5)), ref)
+    d = warp.square_to_uniform_sphere(mcs.uniform(200, 2, seed=6))
+    for mapping, shape in [("latlong", (4, 8, 3)), ("cube", (6, 4, 4, 3))]:
+        image = mcs.uniform(int(np.prod(shape)), 1, seed=7).reshape(shape)
+        ref = mcs.EnvMap(image, mapping=mapping)
+        for view in _views(image):
+            env = mcs.EnvMap(view, mapping=mapping)
+            assert np.array_equal(env.eval(d), ref.eval(d))
+            assert np.array_equal(env.pdf(d), ref.pdf(d))
+
+
 def test_single_points_come_back_unbatched():
     d = warp.square_to_uniform_sphere([0.25, 0.5])
     assert d.shape == (3,)

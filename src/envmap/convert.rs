@@ -1,10 +1,13 @@
 //! Resampling an [`EnvMap`] into another mapping or resolution, and where
 //! each texel of an image sits in its mapping's domain.
 
+use super::image::Image;
 use super::mapping::Mapping;
 use super::{EnvMap, Options, Sampling};
-use crate::alloc;
+use crate::buffer::Buffer;
 use crate::error::Result;
+use crate::parallel;
+use rayon::prelude::*;
 
 impl EnvMap {
     /// The same light resampled into `mapping` at `width × height` texels
@@ -13,12 +16,18 @@ impl EnvMap {
     /// `compensate` are kept; the sampling mode too where the new mapping
     /// has it (else [`Sampling::default_for`] the new mapping).
     ///
+    /// The shape is checked and the new texels' memory had before any is
+    /// computed; rows are resampled on all cores, straight into the new
+    /// map's texels.
+    ///
     /// # Errors
-    /// As [`EnvMap::new`] for the new shape.
+    /// As [`EnvMap::new`] for the new shape; [`crate::Error::ThreadPool`]
+    /// when the thread pool cannot start.
     pub fn convert(&self, mapping: Mapping, width: usize, height: usize) -> Result<EnvMap> {
-        let mut data = alloc::with_capacity(width * height * 3, "the resampled texels")?;
-        for y in 0..height {
-            for x in 0..width {
+        let n = Image::check_shape(mapping, width, height)?;
+        let mut texels = Buffer::for_overwrite(n, "the resampled texels")?;
+        let resample_row = |(y, row): (usize, &mut [[f32; 3]])| {
+            for (x, texel) in row.iter_mut().enumerate() {
                 let p = texel_centre(mapping, width, height, x, y);
                 let lit = mapping.jacobian(p) > 0.0 || mapping != Mapping::Angular;
                 let rgb = if lit {
@@ -28,18 +37,22 @@ impl EnvMap {
                 } else {
                     [0.0; 3]
                 };
-                data.extend(rgb.map(|v| v as f32));
+                *texel = rgb.map(|v| v as f32);
             }
-        }
+        };
+        parallel::install(|| {
+            texels
+                .par_chunks_mut(width)
+                .enumerate()
+                .for_each(resample_row)
+        })?;
         let sampling = if self.options.sampling.supports(mapping) {
             self.options.sampling
         } else {
             Sampling::default_for(mapping)
         };
-        EnvMap::new(
-            width,
-            height,
-            &data,
+        EnvMap::from_image(
+            Image::from_texels(mapping, width, height, texels)?,
             Options {
                 mapping,
                 sampling,

@@ -35,6 +35,15 @@ pub type Corners<F> = ([usize; 4], [F; 4]);
 /// ([`Image::lat_long_place`]).
 pub type LatLongPlace<F> = [F; 6];
 
+/// The shape error of an image of `width × height` texels.
+fn shape_error(width: usize, height: usize, expected: &str) -> Error {
+    Error::Shape {
+        arg: "image",
+        expected: expected.into(),
+        got: format!("({height}, {width}, 3)"),
+    }
+}
+
 impl Image {
     /// An image of `width × height` RGB texels (`data` row-major, 3 floats
     /// a texel) for `mapping`, checked to be finite and `>= 0`. Lat-long
@@ -48,27 +57,10 @@ impl Image {
     /// `image[y, x, c]` (`image[face, y, x, c]` for cube maps);
     /// [`Error::Memory`] when the texels' memory cannot be had.
     pub fn new(mapping: Mapping, width: usize, height: usize, data: &[f32]) -> Result<Self> {
-        let shape_error = |expected: &str| Error::Shape {
-            arg: "image",
-            expected: expected.into(),
-            got: format!("({height}, {width}, 3)"),
-        };
-        let values = width.checked_mul(height).and_then(|n| n.checked_mul(3));
-        if width == 0 || height == 0 || values != Some(data.len()) {
-            return Err(shape_error("(H, W, 3) with H, W >= 1"));
+        let texels = Self::check_shape(mapping, width, height)?;
+        if texels.checked_mul(3) != Some(data.len()) {
+            return Err(shape_error(width, height, "(H, W, 3) with H, W >= 1"));
         }
-        match mapping {
-            Mapping::Angular if width != height => return Err(shape_error("(R, R, 3): square")),
-            Mapping::Cube if width.checked_mul(6) != Some(height) => {
-                return Err(Error::Shape {
-                    arg: "image",
-                    expected: "(6, R, R, 3)".into(),
-                    got: format!("({}, {width}, {width}, 3)", height as f64 / width as f64),
-                });
-            }
-            _ => {}
-        }
-        check_at_most("image", width * height, MAX_TEXELS)?;
         // One branch-free pass for the common case (NaN fails both
         // comparisons); find the index only on failure.
         let valid = |v: f32| (0.0..=f32::MAX).contains(&v);
@@ -91,12 +83,57 @@ impl Image {
                 value: f64::from(data[i]),
             });
         }
-        let texels = data.as_chunks::<3>().0;
+        let texels = Buffer::from_slice(data.as_chunks::<3>().0, "the texels")?;
+        Self::from_texels(mapping, width, height, texels)
+    }
+
+    /// The number of texels of a `width × height` image of `mapping`, or
+    /// the error [`Image::new`] gives for that shape (not its data's).
+    ///
+    /// # Errors
+    /// [`Error::Shape`] for an empty image, a non-square angular map or
+    /// cube face; [`Error::TooLarge`] above [`MAX_TEXELS`] texels.
+    pub(super) fn check_shape(mapping: Mapping, width: usize, height: usize) -> Result<usize> {
+        let Some(texels) = width.checked_mul(height).filter(|&n| n > 0) else {
+            return Err(shape_error(width, height, "(H, W, 3) with H, W >= 1"));
+        };
+        match mapping {
+            Mapping::Angular if width != height => {
+                return Err(shape_error(width, height, "(R, R, 3): square"));
+            }
+            Mapping::Cube if width.checked_mul(6) != Some(height) => {
+                return Err(Error::Shape {
+                    arg: "image",
+                    expected: "(6, R, R, 3)".into(),
+                    got: format!("({}, {width}, {width}, 3)", height as f64 / width as f64),
+                });
+            }
+            _ => {}
+        }
+        check_at_most("image", texels, MAX_TEXELS)?;
+        Ok(texels)
+    }
+
+    /// The image of `texels` (row-major, finite and `>= 0`, of a shape that
+    /// [`Image::check_shape`] passes), padded as [`Image::new`] pads.
+    ///
+    /// # Errors
+    /// As [`Image::check_shape`]; [`Error::Memory`] when a padded copy's
+    /// memory cannot be had.
+    pub(super) fn from_texels(
+        mapping: Mapping,
+        width: usize,
+        height: usize,
+        texels: Buffer<[f32; 3]>,
+    ) -> Result<Self> {
+        if Self::check_shape(mapping, width, height)? != texels.len() {
+            return Err(shape_error(width, height, "(H, W, 3) with H, W >= 1"));
+        }
         if mapping != Mapping::LatLong || (width >= 2 && height >= 3) {
             return Ok(Image {
                 width,
                 height,
-                texels: Buffer::from_slice(texels, "the texels")?,
+                texels,
             });
         }
         // A lat-long map narrower than 2 texels or shorter than 3: a

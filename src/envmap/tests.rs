@@ -316,6 +316,32 @@ fn convert_round_trip_keeps_the_light() {
     }
 }
 
+/// `convert` checks the new shape before it asks for memory (a shape too
+/// large is `TooLarge`, a wrong one `Shape`, neither a memory error), and
+/// pads a tiny lat-long target as `EnvMap::new` pads one.
+#[test]
+fn convert_checks_the_shape_first_and_pads_tiny_maps() {
+    let m = map(Mapping::LatLong, Sampling::Piecewise, true);
+    let too_large = m.convert(Mapping::LatLong, 1 << 20, 1 << 20).unwrap_err();
+    assert!(matches!(too_large, Error::TooLarge { .. }), "{too_large:?}");
+    for (mapping, w, h) in [
+        (Mapping::Cube, 4, 20),
+        (Mapping::Angular, 4, 5),
+        (Mapping::LatLong, 0, 3),
+    ] {
+        let e = m.convert(mapping, w, h).unwrap_err();
+        assert!(
+            matches!(e, Error::Shape { .. }),
+            "{mapping:?} {w}x{h}: {e:?}"
+        );
+    }
+    let tiny = m.convert(Mapping::LatLong, 1, 1).unwrap();
+    let texel = tiny.image().texels()[0];
+    let direct = EnvMap::new(1, 1, &texel, *m.options()).unwrap();
+    assert_eq!((tiny.image().width(), tiny.image().height()), (2, 3));
+    assert_eq!(tiny.image().texels(), direct.image().texels());
+}
+
 #[test]
 fn bad_options_are_errors() {
     let data = [1.0f32; 36];

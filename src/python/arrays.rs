@@ -12,6 +12,7 @@
 //!   [`fresh`]), or the caller's `out` ([`output`]).
 
 use super::args::type_name;
+use super::c_order;
 use crate::alloc;
 use crate::error::{Error, shape_str};
 use crate::math::Real;
@@ -216,10 +217,7 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
         let owned = if array.is_c_contiguous() {
             None
         } else {
-            Some(alloc::collect(
-                array.as_array().iter().copied(),
-                "a copy of the points",
-            )?)
+            Some(c_order::copy(array.as_array(), "a copy of the points")?)
         };
         Ok(Points {
             array,
@@ -580,10 +578,7 @@ impl<'py> Table<'py> {
         }
         let owned = match array.is_c_contiguous() {
             true => None,
-            false => Some(alloc::collect(
-                array.as_array().iter().copied(),
-                "a copy of the table",
-            )?),
+            false => Some(c_order::copy(array.as_array(), "a copy of the table")?),
         };
         Ok(Table {
             array,

@@ -2,8 +2,8 @@
 //! arrays `(H, W, 3)` (or `(H, W, 4)` for an EXR with alpha); failures raise
 //! `OSError` naming the path, wrong arrays `ValueError`.
 
+use super::c_order;
 use super::parallel::detached;
-use crate::alloc;
 use crate::error::{Error, shape_str};
 use crate::io::{self, Raster};
 use crate::python::Obj;
@@ -26,7 +26,7 @@ fn from_numpy(image: &Obj<'_>) -> PyResult<Raster> {
             width,
             height,
             channels,
-            data: alloc::collect(array.as_array().iter().copied(), "a copy of image")?,
+            data: c_order::copy(array.as_array(), "a copy of image")?,
         }),
         _ => Err(Error::Shape {
             arg: "image",

@@ -5,6 +5,7 @@
 mod args;
 mod arrays;
 mod batch;
+mod c_order;
 mod distr;
 mod envmap;
 mod error;

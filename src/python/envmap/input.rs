@@ -53,11 +53,12 @@ pub fn to_world_arg(ob: Option<&Obj<'_>>) -> PyResult<Matrix3> {
         })?;
     let array: PyArrayLikeDyn<'_, f64, AllowTypeChange> = array.extract()?;
     let shape = array.shape().to_vec();
-    let flat: Vec<f64> = array.as_array().iter().copied().collect();
     // A Mitsuba JIT transform's matrix has a trailing axis of width 1.
-    let n = match (flat.len(), shape.as_slice()) {
-        (9, [3, 3] | [3, 3, 1]) => 3,
-        (16, [4, 4] | [4, 4, 1]) => 4,
+    // (The shape is checked before its values are read: a huge array is a
+    // shape error, not an allocation.)
+    let n = match shape.as_slice() {
+        [3, 3] | [3, 3, 1] => 3,
+        [4, 4] | [4, 4, 1] => 4,
         _ => {
             return Err(Error::Shape {
                 arg: "to_world",
@@ -67,6 +68,7 @@ pub fn to_world_arg(ob: Option<&Obj<'_>>) -> PyResult<Matrix3> {
             .into());
         }
     };
+    let flat: Vec<f64> = array.as_array().iter().copied().collect();
     if let Some(i) = flat.iter().position(|v| !v.is_finite()) {
         return Err(Error::Element {
             arg: "to_world",

@@ -7,6 +7,7 @@ use super::args::index_arg;
 use super::arrays::{Check, Points, PyFloat, output, tuple_outputs, with_precision};
 use super::arrays::{writable, zeros};
 use super::batch::{map_each, map_into};
+use super::c_order;
 use super::parallel::{detached, run_batch};
 use super::pickle::reduce;
 use super::records::record;
@@ -249,7 +250,7 @@ impl PyEnvMap {
         match array.as_slice().ok().filter(|_| array.is_c_contiguous()) {
             Some(data) => Self::build(py, w, h, data, options),
             None => {
-                let data = alloc::collect(array.as_array().iter().copied(), "a copy of image")?;
+                let data = c_order::copy(array.as_array(), "a copy of image")?;
                 Self::build(py, w, h, &data, options)
             }
         }
