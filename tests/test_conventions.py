@@ -56,11 +56,12 @@ def _views(a: np.ndarray) -> list[np.ndarray]:
 
 
 @pytest.mark.parametrize("batch", [(), (7,), (1000,), (5, 4), (3, 2, 4), (2, 3, 2, 5)])
-def test_non_contiguous_inputs_of_every_rank_read_as_their_copies(batch):
+def test_non_contiguous_inputs_of_every_rank_read_as_their_copies(batch, tmp_path):
     """Every binding that copies a non-contiguous input into C order (by
     its number of axes: 1 to 4 and more) reads the same values as from
     the C-ordered copy: points of any batch rank, broadcast points, a
-    2D table and envmap images (lat-long and cube)."""
+    2D table, envmap images (lat-long and cube) and an image written to
+    an EXR file."""
     u = mcs.uniform(int(np.prod(batch)) or 1, 2, seed=9).reshape(batch + (2,) if batch else (2,))
     ref = warp.square_to_uniform_sphere(u)
     for view in _views(u):
@@ -75,12 +76,18 @@ def test_non_contiguous_inputs_of_every_rank_read_as_their_copies(batch):
             assert np.array_equal(mcs.Discrete2D(view).sample(mcs.uniform(100, 2, seed=5)), ref)
     d = warp.square_to_uniform_sphere(mcs.uniform(200, 2, seed=6))
     for mapping, shape in [("latlong", (4, 8, 3)), ("cube", (6, 4, 4, 3))]:
-        image = mcs.uniform(int(np.prod(shape)), 1, seed=7).reshape(shape)
+        # float32, which is read as it is (float64 would be cast, and the
+        # cast made C-ordered, before the copy).
+        image = mcs.uniform(int(np.prod(shape)), 1, seed=7).reshape(shape).astype(np.float32)
         ref = mcs.EnvMap(image, mapping=mapping)
         for view in _views(image):
             env = mcs.EnvMap(view, mapping=mapping)
             assert np.array_equal(env.eval(d), ref.eval(d))
             assert np.array_equal(env.pdf(d), ref.pdf(d))
+            if mapping == "latlong":
+                path = tmp_path / "view.exr"
+                mcs.io.write_exr(path, view)
+                assert np.array_equal(mcs.io.read_exr(path), image)
 
 
 def test_single_points_come_back_unbatched():

@@ -92,7 +92,8 @@ GROUPS: dict[str, list[str]] = {
         "mcs.EnvMap(np.ones((8192, 16384, 3), np.float32))",
         "mcs.EnvMap(big((8192, 32769, 3)))",  # beyond 2**28: ValueError
         "mcs.EnvMap(np.ones((8, 16, 3), np.float32)).convert('latlong', (16384, 16384))",
-        # Faces of 6600²: 3.1 GB of texels, asked for before any is computed.
+        # Faces of 6600²: 3.1 GB of texels, asked for before any is computed
+        # (beyond the limit with the process's own address space).
         "mcs.EnvMap(np.ones((8, 16, 3), np.float32)).convert('cube', 6600)",
         "mcs.EnvMap.load(write_hdr(16384, 16384))",
         "mcs.EnvMap.load(write_hdr(40000, 40000))",  # beyond 2**28: ValueError

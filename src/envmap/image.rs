@@ -35,6 +35,9 @@ pub type Corners<F> = ([usize; 4], [F; 4]);
 /// ([`Image::lat_long_place`]).
 pub type LatLongPlace<F> = [F; 6];
 
+/// What an image's shape must be, in general.
+const ANY_SHAPE: &str = "(H, W, 3) with H, W >= 1";
+
 /// The shape error of an image of `width × height` texels.
 fn shape_error(width: usize, height: usize, expected: &str) -> Error {
     Error::Shape {
@@ -59,7 +62,7 @@ impl Image {
     pub fn new(mapping: Mapping, width: usize, height: usize, data: &[f32]) -> Result<Self> {
         let texels = Self::check_shape(mapping, width, height)?;
         if texels.checked_mul(3) != Some(data.len()) {
-            return Err(shape_error(width, height, "(H, W, 3) with H, W >= 1"));
+            return Err(shape_error(width, height, ANY_SHAPE));
         }
         // One branch-free pass for the common case (NaN fails both
         // comparisons); find the index only on failure.
@@ -95,7 +98,7 @@ impl Image {
     /// cube face; [`Error::TooLarge`] above [`MAX_TEXELS`] texels.
     pub(super) fn check_shape(mapping: Mapping, width: usize, height: usize) -> Result<usize> {
         let Some(texels) = width.checked_mul(height).filter(|&n| n > 0) else {
-            return Err(shape_error(width, height, "(H, W, 3) with H, W >= 1"));
+            return Err(shape_error(width, height, ANY_SHAPE));
         };
         match mapping {
             Mapping::Angular if width != height => {
@@ -115,19 +118,26 @@ impl Image {
     }
 
     /// The image of `texels` (row-major, finite and `>= 0`, of a shape that
-    /// [`Image::check_shape`] passes), padded as [`Image::new`] pads.
+    /// [`Image::check_shape`] passed), padded as [`Image::new`] pads.
     ///
     /// # Errors
-    /// As [`Image::check_shape`]; [`Error::Memory`] when a padded copy's
-    /// memory cannot be had.
+    /// [`Error::Shape`] when there are not `width × height` texels;
+    /// [`Error::Memory`] when a padded copy's memory cannot be had.
     pub(super) fn from_texels(
         mapping: Mapping,
         width: usize,
         height: usize,
         texels: Buffer<[f32; 3]>,
     ) -> Result<Self> {
-        if Self::check_shape(mapping, width, height)? != texels.len() {
-            return Err(shape_error(width, height, "(H, W, 3) with H, W >= 1"));
+        debug_assert!(Self::check_shape(mapping, width, height).is_ok());
+        debug_assert!(
+            texels
+                .iter()
+                .flatten()
+                .all(|&v| (0.0..=f32::MAX).contains(&v))
+        );
+        if width.checked_mul(height) != Some(texels.len()) {
+            return Err(shape_error(width, height, ANY_SHAPE));
         }
         if mapping != Mapping::LatLong || (width >= 2 && height >= 3) {
             return Ok(Image {
