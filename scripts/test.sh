@@ -2,8 +2,10 @@
 # Installs everything the test suite needs on a fresh Debian machine
 # (libLLVM for Mitsuba's llvm variant, Python packages), builds this
 # package's abi3 wheel and smoke-tests it in fresh virtual environments
-# without Rust, installs it, and runs the whole suite: Rust format / lint /
-# unit tests / docs, stub check, then pytest.
+# without Rust, installs it, and runs the whole suite: pytest (two worker
+# processes), and beside it Rust format / lint / unit tests / docs and the
+# stub check. Prints when each stage starts; exits non-zero if any part
+# failed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -28,6 +30,28 @@ fi
 stage "pip, maturin"
 python -m pip install --quiet --upgrade pip "maturin>=1.7,<2"
 
+# What the suite needs from the package index (the package's dependencies
+# and its test, mitsuba, plot and distributed extras, read from
+# pyproject.toml) downloads while the wheel compiles.
+LOGS=$(mktemp -d)
+trap 'rm -rf "$LOGS"' EXIT
+python - >"$LOGS/requirements.txt" <<'PY'
+try:
+    import tomllib
+except ModuleNotFoundError:     # Python < 3.11: the wheel's install below fetches them
+    raise SystemExit(0)
+project = tomllib.load(open("pyproject.toml", "rb"))["project"]
+extras = project["optional-dependencies"]
+for requirement in project["dependencies"] + [r for e in ("test", "mitsuba", "plot", "distributed")
+                                              for r in extras[e]]:
+    print(requirement)
+PY
+REQUIREMENTS=""
+if [ -s "$LOGS/requirements.txt" ]; then
+  python -m pip install --quiet -r "$LOGS/requirements.txt" >"$LOGS/requirements.log" 2>&1 &
+  REQUIREMENTS=$!
+fi
+
 stage "wheel"
 # The wheel users install: abi3 (one wheel for CPython 3.9+), stripped.
 rm -rf target/wheels
@@ -38,45 +62,74 @@ ls -l "$WHEEL"
 # Installed into fresh virtual environments with no Rust toolchain on PATH
 # (the PATH entries holding cargo or rustc left out), by this Python and by
 # 3.9 and 3.13 where pyenv has them: a smoke test, run outside the source
-# tree.
-stage "smoke tests"
-NO_RUST_PATH=""
-IFS=: read -ra entries <<<"$PATH"
-for dir in "${entries[@]}"; do
-  [ -x "$dir/cargo" ] || [ -x "$dir/rustc" ] || NO_RUST_PATH="${NO_RUST_PATH:+$NO_RUST_PATH:}$dir"
-done
-SMOKE=$(mktemp -d)
-trap 'rm -rf "$SMOKE"' EXIT
-i=0
-for py in python "$HOME"/.pyenv/versions/3.9.[0-9]*/bin/python \
-    "$HOME"/.pyenv/versions/3.13.[0-9]*/bin/python; do
-  command -v "$py" >/dev/null || { echo "smoke test: no $py here"; continue; }
-  i=$((i + 1))
-  "$py" -m venv "$SMOKE/venv$i"
-  (cd "$SMOKE" && export PATH="$NO_RUST_PATH" &&
-    "$SMOKE/venv$i/bin/python" -m pip install --quiet "$WHEEL" &&
-    "$SMOKE/venv$i/bin/python" "$ROOT/scripts/smoke.py")
-done
+# tree. It waits mostly on the package index, so it runs while the Rust
+# checks compile; its log is printed (and its status checked) before pytest.
+smoke_tests() {
+  local no_rust_path="" dir py i=0
+  IFS=: read -ra entries <<<"$PATH"
+  for dir in "${entries[@]}"; do
+    [ -x "$dir/cargo" ] || [ -x "$dir/rustc" ] || no_rust_path="${no_rust_path:+$no_rust_path:}$dir"
+  done
+  for py in python "$HOME"/.pyenv/versions/3.9.[0-9]*/bin/python \
+      "$HOME"/.pyenv/versions/3.13.[0-9]*/bin/python; do
+    command -v "$py" >/dev/null || { echo "smoke test: no $py here"; continue; }
+    i=$((i + 1))
+    "$py" -m venv "$LOGS/venv$i"
+    (cd "$LOGS" && export PATH="$no_rust_path" &&
+      "$LOGS/venv$i/bin/python" -m pip install --quiet "$WHEEL" &&
+      "$LOGS/venv$i/bin/python" "$ROOT/scripts/smoke.py")
+  done
+}
+stage "smoke tests (in the background)"
+smoke_tests >"$LOGS/smoke.log" 2>&1 &
+SMOKE=$!
 
 # The same wheel, with what the suite needs, into this Python, in place of
 # any earlier install (pip keeps one of the same version otherwise; the
 # distribution was called "mcsample" before: that name on the package
 # index is another project's).
 stage "test dependencies"
+[ -z "$REQUIREMENTS" ] || wait "$REQUIREMENTS" || { cat "$LOGS/requirements.log"; exit 1; }
 python -m pip uninstall --quiet -y mcsample mcsample-toolkit 2>/dev/null || true
 python -m pip install --quiet "$WHEEL[test,mitsuba,plot,distributed]"
 
-stage "Rust checks"
-rustup component add rustfmt clippy >/dev/null 2>&1 || true
-cargo fmt --check
-cargo clippy --all-targets --all-features --quiet -- -D warnings
-stage "cargo test"
-cargo test --quiet
-RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
-python -m mypy.stubtest mcsample._core --allowlist scripts/stubtest-allowlist.txt
+# Rust format, lint, unit tests and docs, and the stub check, run beside
+# pytest: the compiler's one-threaded phases and pytest's one-threaded
+# Python fill each other's idle core. Their log is printed after pytest.
+rust_checks() {
+  rustup component add rustfmt clippy >/dev/null 2>&1 || true
+  stage "cargo fmt, cargo clippy"
+  cargo fmt --check
+  cargo clippy --all-targets --all-features --quiet -- -D warnings
+  stage "cargo test"
+  cargo test --lib --quiet
+  stage "cargo doc, stubtest"
+  RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
+  python -m mypy.stubtest mcsample._core --allowlist scripts/stubtest-allowlist.txt
+  stage "Rust checks done"
+}
+stage "Rust checks (in the background)"
+rust_checks >"$LOGS/rust.log" 2>&1 &
+RUST=$!
 
 stage "pytest"
 # Run pytest from outside the source tree so it imports the installed
 # package, not python/mcsample without its compiled core. --nbmake also
-# executes every notebook top to bottom and fails on any error.
-cd tests && python -m pytest -q -p no:cacheprovider --durations=20 --nbmake . ../notebooks "$@"
+# executes every notebook top to bottom and fails on any error. Two worker
+# processes (pytest-xdist): half the suite's time is one-threaded Python
+# (statistics, notebooks, setup), which the other worker's renders overlap.
+failed=""
+(cd tests && python -m pytest -q -p no:cacheprovider -n 2 --durations=20 --nbmake . ../notebooks \
+  "$@") || failed="$failed pytest"
+
+stage "Rust checks' results"
+wait "$RUST" || failed="$failed rust-checks"
+cat "$LOGS/rust.log"
+stage "smoke tests' results"
+wait "$SMOKE" || failed="$failed smoke-tests"
+cat "$LOGS/smoke.log"
+if [ -n "$failed" ]; then
+  echo "FAILED:$failed"
+  exit 1
+fi
+stage "all passed"

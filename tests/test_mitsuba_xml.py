@@ -394,14 +394,14 @@ def test_mitsubas_cornell_box_renders_as_in_mitsuba(mi):
     skip_scalar(mi)
     d = mi.cornell_box()
     assert d["sensor"]["film"]["rfilter"]["type"] == "gaussian"
-    ours = mcs.render(mcs.Scene.from_mitsuba(d), 256, seed=1)
+    ours = mcs.render(mcs.Scene.from_mitsuba(d), 64, seed=1)
     reference = mcs.mitsuba.render_runs(mi.load_dict(d), 16)
     result = stats.render_ztest(ours, reference)
     assert result.passed, result
     # Power: the light 5 % brighter is seen.
     light = d["light"]["emitter"]["radiance"]
     light["value"] = [1.05 * v for v in light["value"]]
-    brighter = mcs.render(mcs.Scene.from_mitsuba(d), 256, seed=1)
+    brighter = mcs.render(mcs.Scene.from_mitsuba(d), 64, seed=1)
     assert not stats.render_ztest(brighter, reference).passed
     d["sensor"]["film"]["component_format"] = "float16"
     with pytest.raises(ValueError, match="component_format must be 'float32'"):

@@ -7,11 +7,15 @@ BSDF sampling only, emitter sampling only and MIS, and by Mitsuba's
 ``direct`` integrator (its MIS: a valid reference for each unbiased
 strategy alone); and a closed room lit through its ceiling, by paths of
 three segments or more. Emitters seen from the camera are hidden, so the
-statistics look at the light the floor reflects. Each of mcsample's
-samplers renders every case but BSDF sampling of a far light (131072 spp)
-and of the room (24576 spp): those the independent sampler only (the Rust
-tests check every sampler on that geometry, and in a glowing room, against
-closed forms).
+statistics look at the light the floor reflects.
+
+The independent sampler renders every case. The other five samplers take
+turns (:func:`_cases`): each renders a fifth of the floor's cases, chosen so
+that it still meets every shape, every place and every strategy, and every
+(place, strategy) pair; and two of the room's cases. BSDF sampling of a far
+light (131072 spp) and of the room (24576 spp) is rendered by the
+independent sampler only. (The Rust tests check every sampler on the same
+geometry, and in a glowing room, against closed forms.)
 
 ``stats.render_ztest`` compares the whole-image mean luminance and the
 means of 8×8 blocks, each in standard errors. The sample counts give the
@@ -32,7 +36,9 @@ from scenes import LIGHT_PLACES, LIGHT_SHAPES, area_lit_floor, lit_room
 pytestmark = pytest.mark.mitsuba
 
 STRATEGIES = ("emitter", "bsdf", "mis")
-SAMPLERS = ("independent", "stratified", "multijitter", "sobol", "ldsampler", "zsobol")
+#: The sampler of every case, and the five that take turns.
+INDEPENDENT = "independent"
+OTHERS = ("stratified", "multijitter", "sobol", "ldsampler", "zsobol")
 
 #: Samples per pixel of mcsample's renders: BSDF sampling finds a small,
 #: distant light rarely, so it takes many more.
@@ -42,9 +48,45 @@ BSDF_FAR_SPP = 131072
 #: error of 0.4 % at 16384 spp.
 ROOM_BSDF_SPP = 24576
 REFERENCE_SPP = 4096
-TESTS = len(SAMPLERS) * (len(LIGHT_SHAPES) * len(LIGHT_PLACES) * len(STRATEGIES)
-                         + 2 * len(STRATEGIES))
-ALPHA = 1e-3 / TESTS
+ROOM_LIGHTS = ("rectangle", "sphere")
+
+
+def _floor_cases() -> list[tuple[str, str, str, str]]:
+    """(sampler, shape, place, strategy) of every floor test.
+
+    Case (shape i, place j, strategy k) is rendered by the independent
+    sampler and by ``OTHERS[(i + j + k) % 5]``. For a fixed place and
+    strategy the five shapes give the five samplers, so each sampler meets
+    every (place, strategy) pair once, and, since ``j + k`` takes all five
+    values, every shape. BSDF sampling of a far light (131072 spp) is left
+    to the independent sampler."""
+    cases = []
+    for i, shape in enumerate(LIGHT_SHAPES):
+        for j, place in enumerate(LIGHT_PLACES):
+            for k, strategy in enumerate(STRATEGIES):
+                cases.append((INDEPENDENT, shape, place, strategy))
+                if (strategy, place) != ("bsdf", "far"):
+                    cases.append((OTHERS[(i + j + k) % len(OTHERS)], shape, place, strategy))
+    return cases
+
+
+def _room_cases() -> list[tuple[str, str, str]]:
+    """(sampler, light, strategy) of every room test: the independent sampler
+    on each, and two of the others on each emitter and MIS case (case ``c``
+    of the four: ``OTHERS[c]`` and ``OTHERS[(c + 2) % 5]``, so that each
+    sampler renders the room at least once). BSDF sampling (24576 spp) is
+    left to the independent sampler."""
+    cases = [(INDEPENDENT, light, strategy) for light in ROOM_LIGHTS for strategy in STRATEGIES]
+    turns = [(light, s) for light in ROOM_LIGHTS for s in STRATEGIES if s != "bsdf"]
+    for c, (light, strategy) in enumerate(turns):
+        for turn in (c, c + 2):
+            cases.append((OTHERS[turn % len(OTHERS)], light, strategy))
+    return cases
+
+
+FLOOR_CASES = _floor_cases()
+ROOM_CASES = _room_cases()
+ALPHA = 1e-3 / (len(FLOOR_CASES) + len(ROOM_CASES))
 
 _references: dict = {}
 
@@ -55,13 +97,8 @@ def _reference(key, scene: mcs.Scene, spp: int = REFERENCE_SPP) -> mcs.RenderRes
     return _references[key]
 
 
-@pytest.mark.parametrize("strategy", STRATEGIES)
-@pytest.mark.parametrize("place", list(LIGHT_PLACES))
-@pytest.mark.parametrize("shape", LIGHT_SHAPES)
-@pytest.mark.parametrize("sampler", SAMPLERS)
+@pytest.mark.parametrize(("sampler", "shape", "place", "strategy"), FLOOR_CASES)
 def test_area_light_strategy_matches_mitsuba(mi, shape, place, strategy, sampler):
-    if (strategy, place) == ("bsdf", "far") and sampler != "independent":
-        pytest.skip("131072 spp: the independent sampler only")
     d = area_lit_floor(shape, place)
     d["integrator"] = {"type": "direct", "hide_emitters": True}
     scene = mcs.Scene.from_mitsuba(d)
@@ -74,13 +111,24 @@ def test_area_light_strategy_matches_mitsuba(mi, shape, place, strategy, sampler
     assert t.relative_se < 0.004, "too few samples to find a 2 % bias"
 
 
+def test_every_sampler_meets_every_shape_place_and_strategy():
+    """The turns of :func:`_floor_cases` and :func:`_room_cases` cover what
+    their docstrings say."""
+    for sampler in OTHERS:
+        floor = [c[1:] for c in FLOOR_CASES if c[0] == sampler]
+        assert {shape for shape, _, _ in floor} == set(LIGHT_SHAPES)
+        pairs = {(place, strategy) for _, place, strategy in floor}
+        assert pairs == {(p, s) for p in LIGHT_PLACES for s in STRATEGIES} - {("far", "bsdf")}
+        assert any(c[0] == sampler for c in ROOM_CASES)
+    every = {(shape, place, s) for shape in LIGHT_SHAPES for place in LIGHT_PLACES
+             for s in STRATEGIES}
+    assert {c[1:] for c in FLOOR_CASES if c[0] == INDEPENDENT} == every
+    assert len(set(FLOOR_CASES)) == len(FLOOR_CASES) == 45 + 40
+    assert len(set(ROOM_CASES)) == len(ROOM_CASES) == 6 + 8
 
-@pytest.mark.parametrize("strategy", STRATEGIES)
-@pytest.mark.parametrize("light", ["rectangle", "sphere"])
-@pytest.mark.parametrize("sampler", SAMPLERS)
+
+@pytest.mark.parametrize(("sampler", "light", "strategy"), ROOM_CASES)
 def test_room_lit_through_its_ceiling_matches_mitsuba(mi, light, strategy, sampler):
-    if strategy == "bsdf" and sampler != "independent":
-        pytest.skip("24576 spp: the independent sampler only")
     scene = mcs.Scene.from_mitsuba(lit_room(light))
     ref = _reference(("room", light), scene)
     spp = ROOM_BSDF_SPP if strategy == "bsdf" else SPP[strategy]
