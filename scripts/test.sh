@@ -5,7 +5,8 @@
 # without Rust, installs it, and runs the whole suite: pytest (two worker
 # processes), and beside it Rust format / lint / unit tests / docs and the
 # stub check. Prints when each stage starts; exits non-zero if any part
-# failed.
+# failed. Arguments go to pytest (`-n 0` runs it in one process, as
+# `--pdb` needs).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -34,7 +35,15 @@ python -m pip install --quiet --upgrade pip "maturin>=1.7,<2"
 # and its test, mitsuba, plot and distributed extras, read from
 # pyproject.toml) downloads while the wheel compiles.
 LOGS=$(mktemp -d)
-trap 'rm -rf "$LOGS"' EXIT
+# On an early exit, the background jobs (and their children) are stopped.
+stop_jobs() {
+  local p
+  for p in $(jobs -p); do
+    pkill -TERM -P "$p" 2>/dev/null || true
+    kill "$p" 2>/dev/null || true
+  done
+}
+trap 'stop_jobs; rm -rf "$LOGS"' EXIT
 python - >"$LOGS/requirements.txt" <<'PY'
 try:
     import tomllib
@@ -62,8 +71,8 @@ ls -l "$WHEEL"
 # Installed into fresh virtual environments with no Rust toolchain on PATH
 # (the PATH entries holding cargo or rustc left out), by this Python and by
 # 3.9 and 3.13 where pyenv has them: a smoke test, run outside the source
-# tree. It waits mostly on the package index, so it runs while the Rust
-# checks compile; its log is printed (and its status checked) before pytest.
+# tree. It waits mostly on the package index, so it runs in the background,
+# beside what follows; its log is printed and its status checked at the end.
 smoke_tests() {
   local no_rust_path="" dir py i=0
   IFS=: read -ra entries <<<"$PATH"
@@ -84,6 +93,25 @@ stage "smoke tests (in the background)"
 smoke_tests >"$LOGS/smoke.log" 2>&1 &
 SMOKE=$!
 
+# Rust format, lint, unit tests and docs run in the background, beside the
+# install, the stub check and pytest: the compiler's one-threaded phases and
+# pytest's one-threaded Python fill each other's idle core. Their log is
+# printed after pytest.
+rust_checks() {
+  rustup component add rustfmt clippy >/dev/null 2>&1 || true
+  stage "cargo fmt, cargo clippy"
+  cargo fmt --check
+  cargo clippy --all-targets --all-features --quiet -- -D warnings
+  stage "cargo test"
+  cargo test --lib --quiet
+  stage "cargo doc"
+  RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
+  stage "Rust checks done"
+}
+stage "Rust checks (in the background)"
+rust_checks >"$LOGS/rust.log" 2>&1 &
+RUST=$!
+
 # The same wheel, with what the suite needs, into this Python, in place of
 # any earlier install (pip keeps one of the same version otherwise; the
 # distribution was called "mcsample" before: that name on the package
@@ -93,24 +121,10 @@ stage "test dependencies"
 python -m pip uninstall --quiet -y mcsample mcsample-toolkit 2>/dev/null || true
 python -m pip install --quiet "$WHEEL[test,mitsuba,plot,distributed]"
 
-# Rust format, lint, unit tests and docs, and the stub check, run beside
-# pytest: the compiler's one-threaded phases and pytest's one-threaded
-# Python fill each other's idle core. Their log is printed after pytest.
-rust_checks() {
-  rustup component add rustfmt clippy >/dev/null 2>&1 || true
-  stage "cargo fmt, cargo clippy"
-  cargo fmt --check
-  cargo clippy --all-targets --all-features --quiet -- -D warnings
-  stage "cargo test"
-  cargo test --lib --quiet
-  stage "cargo doc, stubtest"
-  RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
-  python -m mypy.stubtest mcsample._core --allowlist scripts/stubtest-allowlist.txt
-  stage "Rust checks done"
-}
-stage "Rust checks (in the background)"
-rust_checks >"$LOGS/rust.log" 2>&1 &
-RUST=$!
+failed=""
+stage "stub check"
+python -m mypy.stubtest mcsample._core --allowlist scripts/stubtest-allowlist.txt \
+  || failed="$failed stubtest"
 
 stage "pytest"
 # Run pytest from outside the source tree so it imports the installed
@@ -118,9 +132,9 @@ stage "pytest"
 # executes every notebook top to bottom and fails on any error. Two worker
 # processes (pytest-xdist): half the suite's time is one-threaded Python
 # (statistics, notebooks, setup), which the other worker's renders overlap.
-failed=""
-(cd tests && python -m pytest -q -p no:cacheprovider -n 2 --durations=20 --nbmake . ../notebooks \
-  "$@") || failed="$failed pytest"
+# (--dist loadgroup: the tests of a Dask cluster share one worker.)
+(cd tests && python -m pytest -q -p no:cacheprovider -n 2 --dist loadgroup --durations=20 \
+  --nbmake . ../notebooks "$@") || failed="$failed pytest"
 
 stage "Rust checks' results"
 wait "$RUST" || failed="$failed rust-checks"

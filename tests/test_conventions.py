@@ -55,13 +55,15 @@ def _views(a: np.ndarray) -> list[np.ndarray]:
     return views
 
 
-@pytest.mark.parametrize("batch", [(), (7,), (1000,), (5, 4), (3, 2, 4), (2, 3, 2, 5)])
+@pytest.mark.parametrize("batch", [(), (7,), (1000,), (5, 4), (3, 2, 4), (2, 3, 2, 5),
+                                   (100_003,), (301, 7, 40), (300, 600)])
 def test_non_contiguous_inputs_of_every_rank_read_as_their_copies(batch, tmp_path):
     """Every binding that copies a non-contiguous input into C order (by
     its number of axes: 1 to 4 and more) reads the same values as from
     the C-ordered copy: points of any batch rank, broadcast points, a
     2D table, envmap images (lat-long and cube) and an image written to
-    an EXR file."""
+    an EXR file. The last three batches are large enough (65536 values
+    and more) to be copied in blocks on several threads."""
     u = mcs.uniform(int(np.prod(batch)) or 1, 2, seed=9).reshape(batch + (2,) if batch else (2,))
     ref = warp.square_to_uniform_sphere(u)
     for view in _views(u):
@@ -88,6 +90,20 @@ def test_non_contiguous_inputs_of_every_rank_read_as_their_copies(batch, tmp_pat
                 path = tmp_path / "view.exr"
                 mcs.io.write_exr(path, view)
                 assert np.array_equal(mcs.io.read_exr(path), image)
+
+
+@pytest.mark.parametrize("threads", [1, 2, 3])
+def test_large_non_contiguous_images_read_the_same_on_any_thread_count(threads):
+    """A lat-long image of 393216 values, in each non-contiguous layout,
+    copied in blocks on ``threads`` threads: the same map as from C order."""
+    mcs.set_num_threads(threads)
+    image = mcs.uniform(256 * 512 * 3, 1, seed=8).reshape(256, 512, 3).astype(np.float32)
+    d = warp.square_to_uniform_sphere(mcs.uniform(500, 2, seed=6))
+    ref = mcs.EnvMap(image)
+    for view in _views(image):
+        env = mcs.EnvMap(view)
+        assert np.array_equal(env.eval(d), ref.eval(d))
+        assert np.array_equal(env.pdf(d), ref.pdf(d))
 
 
 def test_single_points_come_back_unbatched():

@@ -16,6 +16,10 @@ from mcsample.demo import demo_scene
 
 distributed = pytest.importorskip("distributed")
 
+#: One cluster: under pytest-xdist's ``--dist loadgroup`` (scripts/test.sh)
+#: this file's tests run in one worker.
+pytestmark = pytest.mark.xdist_group("dask cluster")
+
 FIELDS = ("image", "variance", "luminance_variance")
 
 

@@ -10,9 +10,10 @@ three segments or more. Emitters seen from the camera are hidden, so the
 statistics look at the light the floor reflects.
 
 The independent sampler renders every case. The other five samplers take
-turns (:func:`_cases`): each renders a fifth of the floor's cases, chosen so
-that it still meets every shape, every place and every strategy, and every
-(place, strategy) pair; and two of the room's cases. BSDF sampling of a far
+turns (:func:`_floor_cases`, :func:`_room_cases`): each renders 8 of the
+floor's 45 cases, chosen so that it still meets every shape, every place,
+every strategy and every (place, strategy) pair, and one or two of the
+room's cases. BSDF sampling of a far
 light (131072 spp) and of the room (24576 spp) is rendered by the
 independent sampler only. (The Rust tests check every sampler on the same
 geometry, and in a glowing room, against closed forms.)
@@ -124,6 +125,7 @@ def test_every_sampler_meets_every_shape_place_and_strategy():
              for s in STRATEGIES}
     assert {c[1:] for c in FLOOR_CASES if c[0] == INDEPENDENT} == every
     assert len(set(FLOOR_CASES)) == len(FLOOR_CASES) == 45 + 40
+    assert all(c[0] == INDEPENDENT for c in ROOM_CASES if c[2] == "bsdf")
     assert len(set(ROOM_CASES)) == len(ROOM_CASES) == 6 + 8
 
 

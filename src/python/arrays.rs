@@ -14,6 +14,7 @@
 use super::args::type_name;
 use super::c_order;
 use crate::alloc;
+use crate::buffer::Buffer;
 use crate::error::{Error, shape_str};
 use crate::math::Real;
 use crate::python::{Obj, Out};
@@ -193,10 +194,10 @@ pub fn broadcast(
 /// A batch of `K`-vectors read from an array-like: `(N, K)`, `(..., K)`
 /// (any leading axes, as numpy's ufuncs) or `(K,)`, or for `K = 1`, `(N,)`
 /// or a scalar.
-pub struct Points<'py, F: Element, const K: usize> {
+pub struct Points<'py, F: Element + bytemuck::Pod, const K: usize> {
     array: PyArrayLikeDyn<'py, F, AllowTypeChange>,
     /// A C-ordered copy when the input is not contiguous.
-    owned: Option<Vec<F>>,
+    owned: Option<Buffer<F>>,
     /// Number of points.
     pub n: usize,
     /// The batch shape: the input's shape without its last axis (`(N,)`
@@ -217,7 +218,10 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
         let owned = if array.is_c_contiguous() {
             None
         } else {
-            Some(c_order::copy(array.as_array(), "a copy of the points")?)
+            Some(c_order::copy_to_buffer(
+                array.as_array(),
+                "a copy of the points",
+            )?)
         };
         Ok(Points {
             array,
@@ -231,7 +235,7 @@ impl<'py, F: PyFloat, const K: usize> Points<'py, F, K> {
     /// The points, one `[F; K]` each.
     pub fn rows(&self) -> &[[F; K]] {
         let flat = match &self.owned {
-            Some(v) => v.as_slice(),
+            Some(v) => v,
             None => self.array.as_slice().unwrap_or_default(),
         };
         flat.as_chunks::<K>().0
@@ -553,7 +557,7 @@ fn not_integers(arg: &str, dtype: &Obj<'_>) -> PyErr {
 /// are checked by the core constructors.
 pub struct Table<'py> {
     array: PyArrayLikeDyn<'py, f64, AllowTypeChange>,
-    owned: Option<Vec<f64>>,
+    owned: Option<Buffer<f64>>,
     /// The table's shape.
     pub shape: Vec<usize>,
 }
@@ -578,7 +582,10 @@ impl<'py> Table<'py> {
         }
         let owned = match array.is_c_contiguous() {
             true => None,
-            false => Some(c_order::copy(array.as_array(), "a copy of the table")?),
+            false => Some(c_order::copy_to_buffer(
+                array.as_array(),
+                "a copy of the table",
+            )?),
         };
         Ok(Table {
             array,

@@ -182,7 +182,7 @@ where
 }
 
 /// The batch shape of a pair of inputs (see [`broadcast`]).
-pub fn pair_shape<F: Element, const KA: usize, const KB: usize>(
+pub fn pair_shape<F: Element + bytemuck::Pod, const KA: usize, const KB: usize>(
     a: &Points<'_, F, KA>,
     b: &Points<'_, F, KB>,
 ) -> PyResult<Vec<usize>> {

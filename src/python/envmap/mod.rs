@@ -250,7 +250,7 @@ impl PyEnvMap {
         match array.as_slice().ok().filter(|_| array.is_c_contiguous()) {
             Some(data) => Self::build(py, w, h, data, options),
             None => {
-                let data = c_order::copy(array.as_array(), "a copy of image")?;
+                let data = c_order::copy_to_buffer(array.as_array(), "a copy of image")?;
                 Self::build(py, w, h, &data, options)
             }
         }
