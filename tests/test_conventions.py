@@ -62,8 +62,9 @@ def test_non_contiguous_inputs_of_every_rank_read_as_their_copies(batch, tmp_pat
     its number of axes: 1 to 4 and more) reads the same values as from
     the C-ordered copy: points of any batch rank, broadcast points, a
     2D table, envmap images (lat-long and cube) and an image written to
-    an EXR file. The last three batches are large enough (65536 values
-    and more) to be copied in blocks on several threads."""
+    an EXR file. The points of the last three batches, and the table of
+    the last, are large enough (65536 values and more) to be copied in
+    blocks on mcsample's threads (large images: the next test)."""
     u = mcs.uniform(int(np.prod(batch)) or 1, 2, seed=9).reshape(batch + (2,) if batch else (2,))
     ref = warp.square_to_uniform_sphere(u)
     for view in _views(u):
@@ -95,13 +96,21 @@ def test_non_contiguous_inputs_of_every_rank_read_as_their_copies(batch, tmp_pat
 @pytest.mark.parametrize("threads", [1, 2, 3])
 def test_large_non_contiguous_images_read_the_same_on_any_thread_count(threads):
     """A lat-long image of 393216 values, in each non-contiguous layout,
-    copied in blocks on ``threads`` threads: the same map as from C order."""
+    copied in blocks on ``threads`` threads: the same texels and map as
+    from C order. Before each copy, a dropped batch output of the copy's
+    size (other values) leaves a recycled memory map for it, so that a
+    texel the copy missed cannot hold the right value by chance."""
     mcs.set_num_threads(threads)
     image = mcs.uniform(256 * 512 * 3, 1, seed=8).reshape(256, 512, 3).astype(np.float32)
     d = warp.square_to_uniform_sphere(mcs.uniform(500, 2, seed=6))
     ref = mcs.EnvMap(image)
-    for view in _views(image):
+    for k, view in enumerate(_views(image)):
+        other = warp.square_to_uniform_sphere(mcs.uniform(256 * 512, 2, seed=20 + k)
+                                              .astype(np.float32))
+        assert other.nbytes == image.nbytes
+        del other
         env = mcs.EnvMap(view)
+        assert np.array_equal(env.image, image)
         assert np.array_equal(env.eval(d), ref.eval(d))
         assert np.array_equal(env.pdf(d), ref.pdf(d))
 

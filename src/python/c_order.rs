@@ -6,9 +6,10 @@
 //! on a dynamic shape) steps an index through every axis for each value:
 //! a transposed `(10⁷, 2)` float32 batch took about 680 ms to copy that
 //! way, 67 times the warp it fed. Here the view is given its static number
-//! of axes (up to 4) and copied by `assign`, whose loops run along the
-//! last axis at its stride; a large view is cut along its first axis into
-//! blocks that mcsample's threads copy at once.
+//! of axes (up to 4) and copied by `assign`, its axes (and the output's)
+//! put in an order whose innermost loop runs along the input's smallest
+//! stride; a view of [`PARALLEL_MIN`] values or more is cut along its
+//! first axis into blocks that mcsample's threads copy at once.
 
 use crate::alloc;
 use crate::buffer::Buffer;
@@ -25,17 +26,20 @@ const PARALLEL_MIN: usize = 1 << 16;
 /// (`what` names it in a [`crate::Error::Memory`]).
 ///
 /// # Errors
-/// [`crate::Error::Memory`] when the copy's memory cannot be had;
-/// [`crate::Error::Integer`] only if `MCSAMPLE_NUM_THREADS` is malformed
-/// (see [`parallel::num_threads`]).
+/// [`crate::Error::Memory`] when the copy's memory cannot be had; for a
+/// copy on several threads, [`crate::Error::Integer`] if
+/// `MCSAMPLE_NUM_THREADS` is malformed (see [`parallel::num_threads`]) and
+/// [`crate::Error::ThreadPool`] if the pool cannot be made.
 pub fn copy<T: Pod + Send + Sync>(a: ArrayViewD<'_, T>, what: &'static str) -> Result<Vec<T>> {
     let mut out = alloc::filled(a.len(), T::zeroed(), what)?;
     fill(&mut out, a)?;
     Ok(out)
 }
 
-/// [`copy`] into a [`Buffer`]: a large copy reuses a recycled memory map
-/// as it is (no page faults, no zeroing), as the batch outputs do.
+/// [`copy`] into a [`Buffer`] made by [`Buffer::for_overwrite`]: a copy
+/// of 1 MiB or more reuses a recycled memory map of about its size as it
+/// is (no page faults, no zeroing) when there is one, as the batch outputs
+/// do.
 ///
 /// # Errors
 /// As [`copy`].
@@ -48,9 +52,10 @@ pub fn copy_to_buffer<T: Pod + Send + Sync>(
     Ok(out)
 }
 
-/// Writes `a` into `out` (of its length) in C order: at once if it is
-/// contiguous in that order, else in blocks of its first axis, on
-/// mcsample's threads when it holds [`PARALLEL_MIN`] values or more.
+/// Writes `a` into `out` (of its length) in C order: as one slice if it is
+/// contiguous in that order; else by [`assign_any`], in blocks of its
+/// first axis on mcsample's threads when it holds [`PARALLEL_MIN`] values
+/// or more and its first axis 2 or more.
 fn fill<T: Pod + Send + Sync>(out: &mut [T], a: ArrayViewD<'_, T>) -> Result<()> {
     if let Some(flat) = a.as_slice() {
         out.copy_from_slice(flat);
@@ -98,7 +103,12 @@ fn assign<T: Copy, D: Dimension>(out: &mut [T], a: ArrayViewD<'_, T>) {
     let views = a.view().into_dimensionality::<D>().ok().and_then(|a| {
         let out = ArrayViewMut::from_shape(a.raw_dim(), &mut *out).ok()?;
         let mut axes: Vec<usize> = (0..a.ndim()).collect();
-        axes.sort_by_key(|&i| std::cmp::Reverse(a.strides()[i].unsigned_abs()));
+        // (An axis of length 1 has no loop: it goes first.)
+        let step = |i: usize| match a.shape()[i] {
+            0 | 1 => usize::MAX,
+            _ => a.strides()[i].unsigned_abs(),
+        };
+        axes.sort_by_key(|&i| std::cmp::Reverse(step(i)));
         let mut order = D::zeros(a.ndim());
         for (k, &i) in axes.iter().enumerate() {
             order[k] = i;
