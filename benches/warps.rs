@@ -99,4 +99,18 @@ fn main() {
         #[inline(always)]
         |u| warp::square_to_cosine_power_hemisphere(u, 10.0),
     );
+    rate("square_to_std_normal", &u, warp::square_to_std_normal);
+    rate(
+        "square_to_beckmann",
+        &u,
+        #[inline(always)]
+        |u| warp::square_to_beckmann(u, 0.3),
+    );
+    let lobe = warp::VonMisesFisher::new(10.0f32);
+    rate(
+        "square_to_von_mises_fisher",
+        &u,
+        #[inline(always)]
+        |u| warp::square_to_von_mises_fisher(u, &lobe),
+    );
 }
