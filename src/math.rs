@@ -205,18 +205,23 @@ macro_rules! sin_cos_turn {
 fn pow_unit(x: f64, y: f64) -> f64 {
     const MANTISSA_BITS: u32 = 52;
     const BIAS: f64 = 1023.0;
-    /// `2⁵²`: adding it to a whole number `n` in `[0, 2⁵²)` leaves `n` in the
-    /// low mantissa bits.
-    const SHIFTER: f64 = (1u64 << MANTISSA_BITS) as f64;
+    /// `1.5·2⁵² + BIAS`: `t + ROUNDER` (`|t| < 2⁵¹`) lies in `[2⁵², 2⁵³)`,
+    /// where the sum rounds to a whole number: `t` rounded to the nearest
+    /// whole number `k`, with `2⁵¹ + k + BIAS` in the mantissa. One
+    /// addition, no rounding instruction (`floor` would be a library call
+    /// in code built for baseline x86-64, such as the renderer's Phong
+    /// draws).
+    const ROUNDER: f64 = 1.5 * (1u64 << MANTISSA_BITS) as f64 + BIAS;
     let (m, e) = mantissa_exponent(x);
     let s = (m - 1.0) / (m + 1.0);
     let log2_m = s * estrin(s * s, &ATANH_OVER_S) * (2.0 * std::f64::consts::LOG2_E);
     let t = (y * (e + log2_m)).max(1.0 - BIAS);
-    let k = (t + 0.5).floor();
+    let rounded = t + ROUNDER;
+    let k = rounded - ROUNDER;
     let p = estrin((t - k) * std::f64::consts::LN_2, &EXP);
     // k + BIAS in [1, 2046] (results below 2¹⁰²³): the low mantissa bits
-    // of k + BIAS + 2⁵², shifted into the exponent field.
-    let scale = f64::from_bits((k + (BIAS + SHIFTER)).to_bits() << MANTISSA_BITS);
+    // of `rounded`, shifted into the exponent field.
+    let scale = f64::from_bits(rounded.to_bits() << MANTISSA_BITS);
     let result = p * scale;
     // x = 0 or subnormal: 0ʸ (1 for y = 0); underflow: 0.
     let tiny = x < f64::MIN_POSITIVE;
