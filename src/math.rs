@@ -191,26 +191,27 @@ macro_rules! sin_cos_turn {
 ///
 /// `log₂x = e + log₂m` with `x = m·2ᵉ`, `m ∈ [√½, √2)`, and
 /// `log₂m = (2/ln 2)·atanh(s)`, `s = (m − 1)/(m + 1)` (odd series in `s`);
-/// `2ᵗ = 2ᵏ·e^(f·ln 2)` with `k` the nearest whole number and `|f| ≤ ½`
-/// (Taylor series), `2ᵏ` built from its bits. Both polynomials are
-/// evaluated by Estrin's scheme: the loops that call `pow` (the
-/// cosine-power warp, Phong) wait on the chain of dependent operations,
-/// and Horner's is 24 steps long (Estrin's: 8), at the same accuracy. The
-/// whole numbers `e` and
-/// `k` stay floats: a biased exponent field is read as a float by placing
-/// it in the mantissa of `2⁵²` (and written back the same way), because
-/// AVX2 has no conversion between `f64` and 64-bit integers and a loop
-/// that needs one runs one lane at a time.
+/// `2ᵗ = 2ᵏ·e^(f·ln 2)` with `k` the whole number nearest `t` (ties to
+/// odd) and `|f| ≤ ½` (Taylor series), `2ᵏ` built from its bits. Both
+/// polynomials are evaluated by Estrin's scheme: the loops that call `pow`
+/// (the cosine-power warp, Phong) wait on the chain of dependent
+/// operations, and Horner's is 24 steps long (Estrin's: 8), at the same
+/// accuracy. The whole numbers `e` and `k` stay floats: a biased exponent
+/// field is read as a float by placing it in the mantissa of `2⁵²` (and
+/// written back from the low mantissa bits of `t + 1.5·2⁵² + 1023`),
+/// because AVX2 has no conversion between `f64` and 64-bit integers and a
+/// loop that needs one runs one lane at a time.
 #[inline(always)]
 fn pow_unit(x: f64, y: f64) -> f64 {
     const MANTISSA_BITS: u32 = 52;
     const BIAS: f64 = 1023.0;
-    /// `1.5·2⁵² + BIAS`: `t + ROUNDER` (`|t| < 2⁵¹`) lies in `[2⁵², 2⁵³)`,
-    /// where the sum rounds to a whole number: `t` rounded to the nearest
-    /// whole number `k`, with `2⁵¹ + k + BIAS` in the mantissa. One
-    /// addition, no rounding instruction (`floor` would be a library call
-    /// in code built for baseline x86-64, such as the renderer's Phong
-    /// draws).
+    /// `1.5·2⁵² + BIAS`: `t + ROUNDER` (`−2⁵¹ − BIAS ≤ t < 2⁵¹ − BIAS`; here
+    /// `−1022 ≤ t < 1023`) lies in `[2⁵², 2⁵³)`, where the sum rounds to a
+    /// whole number: `k`, `t` rounded to the nearest whole number, ties to
+    /// the odd one (`ROUNDER` is odd, the sum rounds ties to even), with
+    /// `2⁵¹ + k + BIAS` in the mantissa. One addition, no rounding
+    /// instruction (`floor` would be a library call in code built for
+    /// baseline x86-64, such as the renderer's Phong draws).
     const ROUNDER: f64 = 1.5 * (1u64 << MANTISSA_BITS) as f64 + BIAS;
     let (m, e) = mantissa_exponent(x);
     let s = (m - 1.0) / (m + 1.0);

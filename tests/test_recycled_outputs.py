@@ -29,8 +29,21 @@ def _u(seed: int, dim: int = 2, dtype=np.float32) -> np.ndarray:
     return np.random.default_rng(seed).random((N, dim)).astype(dtype)
 
 
+def _empty_cache() -> None:
+    """Frees what earlier tests left in reference cycles, then empties the
+    cache of freed blocks (as every MemoryError mcsample raises does): a
+    block freed afterwards is then the only one a request can take. (An
+    earlier test's array of another size in range, freed by a later
+    ``gc.collect()``, could otherwise serve the request, as it once did
+    under pytest-xdist.)"""
+    gc.collect()
+    with pytest.raises(MemoryError):
+        mcs.Rng(1).random(1 << 40)
+
+
 def test_a_freed_output_is_reused_and_rewritten():
     warp = mcs.warp.square_to_uniform_disk
+    _empty_cache()
     first = warp(_u(1))
     assert type(first.base).__name__ == "RecycledBlock"
     address = _address(first)
