@@ -277,12 +277,13 @@ pub fn ln_positive(x: f64) -> f64 {
 pub fn ln_one_minus(u: f64) -> f64 {
     let (m, e) = mantissa_exponent(1.0 - u);
     let near = u < 1.0 - std::f64::consts::FRAC_1_SQRT_2;
-    let s = if near {
-        -u / (2.0 - u)
+    // The operands chosen, then one division for both cases.
+    let (num, den) = if near {
+        (-u, 2.0 - u)
     } else {
-        (m - 1.0) / (m + 1.0)
+        (m - 1.0, m + 1.0)
     };
-    let ln = ln_from_parts(if near { 0.0 } else { e }, s);
+    let ln = ln_from_parts(if near { 0.0 } else { e }, num / den);
     if u < 1.0 { ln } else { f64::NEG_INFINITY }
 }
 
@@ -328,12 +329,13 @@ fn ln_positive_f32(x: f32) -> f32 {
 fn ln_one_minus_f32(u: f32) -> f32 {
     let (m, e) = mantissa_exponent_f32(1.0 - u);
     let near = u < 1.0 - std::f32::consts::FRAC_1_SQRT_2;
-    let (s, e) = if near {
-        (-u / (2.0 - u), 0.0)
+    // The operands chosen, then one division for both cases.
+    let (num, den, e) = if near {
+        (-u, 2.0 - u, 0.0)
     } else {
-        ((m - 1.0) / (m + 1.0), e)
+        (m - 1.0, m + 1.0, e)
     };
-    let ln = ln_from_parts_f32(e, s);
+    let ln = ln_from_parts_f32(e, num / den);
     if u < 1.0 { ln } else { f32::NEG_INFINITY }
 }
 

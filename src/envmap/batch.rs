@@ -509,8 +509,8 @@ fn pipelined_blocks<F: Real, T, C: Copy + Default, const K: usize>(
     read: impl Fn(&Columns<F, K>, &[C; simd::BLOCK], &mut [T]),
 ) -> bool {
     const B: usize = simd::BLOCK;
-    let mut queries = [[[F::zero(); B]; K]; 2];
-    let mut entries = [[C::default(); B]; 2];
+    let simd::OnLines(queries) = &mut simd::OnLines([[[F::zero(); B]; K]; 2]);
+    let simd::OnLines(entries) = &mut simd::OnLines([[C::default(); B]; 2]);
     simd::dispatch(
         #[inline(always)]
         |_| {

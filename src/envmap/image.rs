@@ -312,7 +312,7 @@ impl Image {
         cells: &[u32; simd::BLOCK],
     ) -> [[F; simd::BLOCK]; 3] {
         let w = self.width as u32;
-        let mut texels = [[0; simd::BLOCK]; 4];
+        let simd::OnLines(texels) = &mut simd::OnLines([[0; simd::BLOCK]; 4]);
         for (i, &k) in cells.iter().enumerate() {
             let col = q[0][i].floor_u32(w - 1);
             debug_assert_eq!(k % w, col, "a cell that is not its place's");
@@ -322,9 +322,9 @@ impl Image {
         }
         let mut rgb = [[F::zero(); simd::BLOCK]; 3];
         for (j, texels) in texels.iter().enumerate() {
-            let mut t = [[0.0; simd::BLOCK]; 3];
-            simd::gather_columns(&self.texels, texels, &mut t);
-            for (rgb, t) in rgb.iter_mut().zip(&t) {
+            let simd::OnLines(t) = &mut simd::OnLines([[0.0; simd::BLOCK]; 3]);
+            simd::gather_columns(&self.texels, texels, t);
+            for (rgb, t) in rgb.iter_mut().zip(t.iter()) {
                 for i in 0..simd::BLOCK {
                     rgb[i] = rgb[i] + q[2 + j][i] * F::c(f64::from(t[i]));
                 }

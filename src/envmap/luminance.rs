@@ -11,7 +11,7 @@ use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;
 use crate::math::Real;
 use crate::parallel;
-use crate::simd::{self, BLOCK};
+use crate::simd::{self, BLOCK, OnLines};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -298,7 +298,8 @@ impl Tables<'_> {
     #[inline(always)]
     fn block_pdfs_f32(self, q: &[[f32; BLOCK]; 7], cells: &[u32; BLOCK], out: &mut [f32]) {
         debug_assert!(out.len() <= BLOCK);
-        let (mut texels, mut rows) = ([[0; BLOCK]; 4], [0; BLOCK]);
+        let OnLines(texels) = &mut OnLines([[0; BLOCK]; 4]);
+        let OnLines(rows) = &mut OnLines([0; BLOCK]);
         for i in 0..BLOCK {
             let (t, row) = self.cell_texels_f32(cells[i], q[0][i], q[1][i]);
             for (column, t) in texels.iter_mut().zip(t) {
@@ -306,17 +307,17 @@ impl Tables<'_> {
             }
             rows[i] = row;
         }
-        let mut corners = [[0.0; BLOCK]; 4];
-        for (column, texels) in corners.iter_mut().zip(&texels) {
+        let OnLines(corners) = &mut OnLines([[0.0; BLOCK]; 4]);
+        for (column, texels) in corners.iter_mut().zip(texels.iter()) {
             simd::gather_columns(
                 self.lum_f32.as_chunks().0,
                 texels,
                 std::array::from_mut(column),
             );
         }
-        let mut moments = [[0.0; BLOCK]; 2];
-        simd::gather_columns(self.moments_f32, &rows, &mut moments);
-        let mut pdf = [0.0; BLOCK];
+        let OnLines(moments) = &mut OnLines([[0.0; BLOCK]; 2]);
+        simd::gather_columns(self.moments_f32, rows, moments);
+        let OnLines(pdf) = &mut OnLines([0.0; BLOCK]);
         for (i, p) in pdf.iter_mut().enumerate() {
             let wt = [q[2][i], q[3][i], q[4][i], q[5][i]];
             let c = [corners[0][i], corners[1][i], corners[2][i], corners[3][i]];

@@ -131,6 +131,14 @@ const LINE: usize = 64;
 /// Rows per block of [`map_rows`] and [`map_to_columns`].
 pub const BLOCK: usize = 64;
 
+/// A value that starts on a cache-line boundary: a block's columns on the
+/// stack, so that each full-width load and store of them touches one
+/// line, not two (a column split across lines made the standard normal
+/// warp a third slower in one build and not in another, as the stack
+/// happened to fall).
+#[repr(C, align(64))]
+pub(crate) struct OnLines<T>(pub(crate) T);
+
 /// How many blocks ahead [`map_rows`] prefetches its input: the loads of a
 /// block come in an order the hardware prefetchers do not follow, and a
 /// cheap kernel would otherwise wait on memory for most of them.
@@ -225,9 +233,9 @@ where
         return true;
     };
     let n = inputs.len();
-    let mut rows = [[T::default(); M]; BLOCK];
-    let ok = map_block(&mut rows, &padded, kernel, valid, level, false);
-    out.copy_from_slice(&rows[..n]);
+    let mut rows = OnLines([[T::default(); M]; BLOCK]);
+    let ok = map_block(&mut rows.0, &padded, kernel, valid, level, false);
+    out.copy_from_slice(&rows.0[..n]);
     ok
 }
 
@@ -250,15 +258,16 @@ where
     F: Copy + Default,
     T: Copy + Default,
 {
-    let mut results = [[T::default(); BLOCK]; M];
-    let ok = map_block_to_columns(&mut results, inputs, kernel, valid, level);
-    if !permute_columns_to_rows(&results, out, level, stream) {
+    let mut results = OnLines([[T::default(); BLOCK]; M]);
+    let results = &mut results.0;
+    let ok = map_block_to_columns(results, inputs, kernel, valid, level);
+    if !permute_columns_to_rows(results, out, level, stream) {
         if stream {
-            let mut rows = [[T::default(); M]; BLOCK];
-            interleave(&results, &mut rows);
-            stream_copy(out, &rows);
+            let mut rows = OnLines([[T::default(); M]; BLOCK]);
+            interleave(results, &mut rows.0);
+            stream_copy(out, &rows.0);
         } else {
-            interleave(&results, out);
+            interleave(results, out);
         }
     }
     ok
@@ -320,8 +329,9 @@ where
     F: Copy + Default,
     T: Copy,
 {
-    let mut columns = [[F::default(); BLOCK]; K];
-    if !permute_rows_to_columns(inputs, &mut columns, level) {
+    let mut columns = OnLines([[F::default(); BLOCK]; K]);
+    let columns = &mut columns.0;
+    if !permute_rows_to_columns(inputs, columns, level) {
         for i in 0..BLOCK {
             for k in 0..K {
                 columns[k][i] = inputs[i][k];

@@ -9,7 +9,7 @@
 use super::{Hit, Primitive};
 use crate::render::mesh::Mesh;
 use crate::render::shape::{Candidate, Disk, Ray, Sphere, Triangle, Triangles4, moller_trumbore};
-use crate::simd;
+use crate::simd::{self, OnLines};
 
 /// Rays per block of the batch tests (the loops over a block's rays
 /// vectorise; 64 keeps a block's columns within the L1 cache).
@@ -183,8 +183,8 @@ impl Leaf {
     #[inline(always)]
     fn occluded_block(&self, rays: &[Ray], blocked: &mut [bool]) {
         let block = Block::new(rays);
-        let mut tmax = [0.0; BLOCK];
-        let mut any = [false; BLOCK];
+        let OnLines(tmax) = &mut OnLines([0.0; BLOCK]);
+        let OnLines(any) = &mut OnLines([false; BLOCK]);
         for (i, (ray, &b)) in rays.iter().zip(&*blocked).enumerate() {
             tmax[i] = ray.tmax;
             any[i] = b;
@@ -207,7 +207,8 @@ impl Leaf {
 }
 
 /// A block's ray origins and directions, one array per component (the
-/// rows past the block's rays are zero).
+/// rows past the block's rays are zero), on cache-line boundaries.
+#[repr(align(64))]
 struct Block {
     o: [[f32; BLOCK]; 3],
     d: [[f32; BLOCK]; 3],
@@ -242,7 +243,8 @@ impl Block {
 
 /// The nearest hit so far of each ray of a block: distance, primitive
 /// ([`NONE`] for none) and barycentrics. Rows past the block's rays have
-/// distance 0, so that nothing is nearer.
+/// distance 0, so that nothing is nearer. On cache-line boundaries.
+#[repr(align(64))]
 struct Best {
     t: [f32; BLOCK],
     primitive: [u32; BLOCK],
