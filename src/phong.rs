@@ -305,8 +305,8 @@ impl<F: Real> PhongView<F> {
                 [x, y, z, s.pdf, r, g, b, F::c(f64::from(s.component))]
             }
         };
-        let mut us = [[F::zero(); 3]; SAMPLE_BLOCK];
-        let mut samples = [[F::zero(); 8]; SAMPLE_BLOCK];
+        let simd::OnLines(us) = &mut simd::OnLines([[F::zero(); 3]; SAMPLE_BLOCK]);
+        let simd::OnLines(samples) = &mut simd::OnLines([[F::zero(); 8]; SAMPLE_BLOCK]);
         for (b, rows) in rows.chunks(SAMPLE_BLOCK).enumerate() {
             let (us, samples) = (&mut us[..rows.len()], &mut samples[..rows.len()]);
             for (u, row) in us.iter_mut().zip(rows) {

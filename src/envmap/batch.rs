@@ -99,7 +99,7 @@ impl EnvMap {
                 let read = {
                     #[inline(always)]
                     |q: &Columns<F, 6>, cells: &[u32; simd::BLOCK], o: &mut [[F; 3]]| {
-                        let rgb = self.image.blend_places(q, cells);
+                        let simd::OnLines(rgb) = &self.image.blend_places(q, cells);
                         let scale = F::c(self.options.scale);
                         for (i, o) in o.iter_mut().enumerate() {
                             *o = [0, 1, 2].map(|c| rgb[c][i] * scale);
@@ -264,8 +264,8 @@ impl EnvMap {
     ) {
         let zero = F::zero();
         let mut cells = [((0, 0), [zero; 2]); GROUP];
-        let mut points = [[zero; 3]; GROUP];
-        let mut frames = [[zero; 5]; GROUP];
+        let simd::OnLines(points) = &mut simd::OnLines([[zero; 3]; GROUP]);
+        let simd::OnLines(frames) = &mut simd::OnLines([[zero; 5]; GROUP]);
         let mut corners = [([0; 4], [zero; 4]); GROUP];
         let mut bilinear = [([0.0; 2], 0.0); GROUP];
         let mut group = [[zero; 2]; GROUP];
@@ -311,7 +311,7 @@ impl EnvMap {
                     continue;
                 }
             }
-            self.finish_group(&points[..n], &corners, &mut frames, |k, s| {
+            self.finish_group(&points[..n], &corners, frames, |k, s| {
                 out.set(first + k, s);
             });
         }
@@ -365,7 +365,7 @@ impl EnvMap {
     ) {
         match table {
             Cells::Luminance(density) => {
-                let mut placed = [[0.0; 3]; GROUP];
+                let simd::OnLines(placed) = &mut simd::OnLines([[0.0; 3]; GROUP]);
                 let placed = &mut placed[..cells.len()];
                 density.place_group(cells, placed);
                 for (k, (&(cell, _), &p)) in cells.iter().zip(&*placed).enumerate() {
@@ -420,8 +420,8 @@ impl EnvMap {
     ) {
         let zero = F::zero();
         let mut cells = [((0, 0), [zero; 2]); GROUP];
-        let mut points = [[zero; 3]; GROUP];
-        let mut frames = [[zero; 5]; GROUP];
+        let simd::OnLines(points) = &mut simd::OnLines([[zero; 3]; GROUP]);
+        let simd::OnLines(frames) = &mut simd::OnLines([[zero; 5]; GROUP]);
         let mut corners = [([0; 4], [zero; 4]); GROUP];
         for draws in draws.chunks(GROUP) {
             for (cell, &(bits, r)) in cells.iter_mut().zip(draws) {
@@ -434,7 +434,7 @@ impl EnvMap {
                 self.stage(placed, &mut points[k], &mut corners[k]);
             });
             let points = &points[..draws.len()];
-            self.finish_group(points, &corners, &mut frames, |_, s| out.push(s));
+            self.finish_group(points, &corners, frames, |_, s| out.push(s));
         }
     }
 }

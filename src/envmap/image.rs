@@ -304,13 +304,13 @@ impl Image {
     /// puts them), one column per RGB channel: the four texels of each
     /// found at SIMD width (as [`Image::placed_corners`] finds them), read
     /// by gathers and blended at SIMD width, in the same order as `blend`
-    /// (the same bits).
+    /// (the same bits). On cache-line boundaries, as its loops use it.
     #[inline(always)]
     pub(crate) fn blend_places<F: Real>(
         &self,
         q: &[[F; simd::BLOCK]; 6],
         cells: &[u32; simd::BLOCK],
-    ) -> [[F; simd::BLOCK]; 3] {
+    ) -> simd::OnLines<[[F; simd::BLOCK]; 3]> {
         let w = self.width as u32;
         let simd::OnLines(texels) = &mut simd::OnLines([[0; simd::BLOCK]; 4]);
         for (i, &k) in cells.iter().enumerate() {
@@ -320,17 +320,17 @@ impl Image {
                 column[i] = t;
             }
         }
-        let mut rgb = [[F::zero(); simd::BLOCK]; 3];
+        let mut blended = simd::OnLines([[F::zero(); simd::BLOCK]; 3]);
         for (j, texels) in texels.iter().enumerate() {
             let simd::OnLines(t) = &mut simd::OnLines([[0.0; simd::BLOCK]; 3]);
             simd::gather_columns(&self.texels, texels, t);
-            for (rgb, t) in rgb.iter_mut().zip(t.iter()) {
+            for (rgb, t) in blended.0.iter_mut().zip(t.iter()) {
                 for i in 0..simd::BLOCK {
                     rgb[i] = rgb[i] + q[2 + j][i] * F::c(f64::from(t[i]));
                 }
             }
         }
-        rgb
+        blended
     }
 
     /// The texels of a lat-long map's table cell `(row, col)` (the patch

@@ -159,7 +159,7 @@ impl LuminanceDensity {
         out: &mut [[f64; 3]],
     ) {
         debug_assert_eq!(out.len(), cells.len());
-        let mut rows = [[0.0; 6]; GROUP];
+        let OnLines(rows) = &mut OnLines([[0.0; 6]; GROUP]);
         let rows = &mut rows[..cells.len()];
         let index = |(row, col): (usize, usize)| row * self.width + col;
         for (row, &(cell, r)) in rows.iter_mut().zip(cells) {

@@ -372,7 +372,7 @@ impl Camera {
             }
             return;
         }
-        let mut rows = [[0.0f32; 7]; BLOCK];
+        let simd::OnLines(rows) = &mut simd::OnLines([[0.0f32; 7]; BLOCK]);
         let pinhole = {
             #[inline(always)]
             |u: [f32; 4]| self.ray_row(u, false, &self.to_world)

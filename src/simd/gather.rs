@@ -3,7 +3,7 @@
 //! instructions where it has them (a loop of indexed reads is not
 //! vectorised by the compiler).
 
-use super::{BLOCK, Level, detected, level};
+use super::{BLOCK, Level, OnLines, detected, level};
 
 /// `columns[c][i] = table[index[i]][c]` for a block of [`BLOCK`] indices:
 /// on AVX-512 one gather instruction per component and 16 indices, on
@@ -38,7 +38,7 @@ fn gather_at<const C: usize>(
     if C * table.len() <= i32::MAX as usize && level >= Level::Avx2 {
         // Each entry's first offset in `f32`s: at most `C·last`, which fits
         // in an `i32` (checked above), as `last` does in a `u32`.
-        let mut offsets = [0i32; BLOCK];
+        let OnLines(offsets) = &mut OnLines([0i32; BLOCK]);
         for (o, &i) in offsets.iter_mut().zip(index) {
             *o = (C as u32 * i.min(last as u32)) as i32;
         }
@@ -49,9 +49,9 @@ fn gather_at<const C: usize>(
         // flat.len()`, so each gathered `f32` lies inside `flat`.
         unsafe {
             if level == Level::Avx512 {
-                gather_avx512(flat, &offsets, columns);
+                gather_avx512(flat, offsets, columns);
             } else {
-                gather_avx2(flat, &offsets, columns);
+                gather_avx2(flat, offsets, columns);
             }
         }
         return;
