@@ -49,7 +49,7 @@ fn recycle(map: MmapMut) {
 }
 
 /// A fresh anonymous map of `bytes` (zeros), advised to use huge pages.
-fn fresh_map(bytes: usize) -> Option<MmapMut> {
+pub(crate) fn fresh_map(bytes: usize) -> Option<MmapMut> {
     let map = MmapMut::map_anon(bytes).ok()?;
     // Advice only: without huge pages the map still works.
     #[cfg(target_os = "linux")]

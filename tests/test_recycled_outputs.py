@@ -108,3 +108,36 @@ def test_results_of_more_than_32_dimensions_are_refused():
     assert a.shape == (1,) * 31 + (N,) and ((a >= 0) & (a < 1)).all()
     with pytest.raises(ValueError, match="at most 32"):
         mcs.Rng(1).random((1,) * 33 + (N,))
+
+
+def _vm_flags(address: int) -> list[str]:
+    """The VmFlags of the memory mapping that holds ``address`` in this
+    process (Linux's /proc/self/smaps)."""
+    inside = False
+    with open("/proc/self/smaps") as smaps:
+        for line in smaps:
+            head = line.split()[0]
+            if "-" in head and not head.endswith(":"):
+                start, end = (int(x, 16) for x in head.split("-"))
+                inside = start <= address < end
+            elif inside and head == "VmFlags:":
+                return line.split()[1:]
+    raise AssertionError(f"no mapping holds {address:#x}")
+
+
+@pytest.mark.skipif(not __import__("os").path.exists("/proc/self/smaps"),
+                    reason="reads Linux's /proc/self/smaps")
+def test_large_outputs_are_advised_to_use_huge_pages():
+    # As numpy advises its own large arrays (the inputs and out= arrays a
+    # plain call's output is written beside): an output of 4 KiB pages made
+    # the plain call 15-50 % slower than out= (benches/README.md).
+    _empty_cache()
+    fresh = mcs.warp.square_to_uniform_disk(_u(5))
+    assert type(fresh.base).__name__ == "RecycledBlock"
+    assert "hg" in _vm_flags(_address(fresh))
+    address = _address(fresh)
+    del fresh
+    gc.collect()
+    recycled = mcs.warp.square_to_uniform_disk(_u(6))
+    assert _address(recycled) == address
+    assert "hg" in _vm_flags(address)

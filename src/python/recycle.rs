@@ -18,10 +18,12 @@
 use std::sync::{Mutex, PoisonError};
 
 use bytemuck::Pod;
+use memmap2::MmapMut;
 use numpy::ndarray::{ArrayViewMut, IxDyn};
 use numpy::{Element, PyArrayDyn};
 use pyo3::prelude::*;
 
+use crate::buffer::fresh_map;
 use crate::error::{Error, Result};
 
 /// Outputs smaller than this are plain `numpy.zeros` arrays (which malloc
@@ -32,36 +34,31 @@ const MAX_BLOCKS: usize = 8;
 /// The most bytes the cache keeps.
 const MAX_BYTES: usize = 1 << 30;
 
-/// 64 bytes aligned to 64, the unit blocks are counted in (any element
-/// type lies aligned in it).
-#[derive(Clone, Copy)]
-#[repr(C, align(64))]
-struct Line([u8; 64]);
+/// The cache: blocks freed by Python, oldest first. Each block is an
+/// anonymous map advised to use huge pages, as numpy's own large arrays
+/// are: an output of 4 KiB pages, beside inputs and `out=` arrays of 2 MiB
+/// ones, made the plain call of a warp 15-20 % slower than `out=`.
+static CACHE: Mutex<Vec<MmapMut>> = Mutex::new(Vec::new());
 
-/// The cache: blocks freed by Python, oldest first.
-static CACHE: Mutex<Vec<Vec<Line>>> = Mutex::new(Vec::new());
-
-/// The cached block that fits `lines` best (at least `lines`, at most
-/// twice), or a new one.
-fn take(lines: usize) -> Result<Vec<Line>> {
+/// The cached block that fits `bytes` best (at least `bytes`, at most
+/// twice), or a new one (zeros).
+fn take(bytes: usize) -> Result<MmapMut> {
     let mut cache = CACHE.lock().unwrap_or_else(PoisonError::into_inner);
     let best = (0..cache.len())
-        .filter(|&i| (lines..=2 * lines).contains(&cache[i].len()))
+        .filter(|&i| (bytes..=2 * bytes).contains(&cache[i].len()))
         .min_by_key(|&i| cache[i].len());
     if let Some(i) = best {
         return Ok(cache.remove(i));
     }
-    let mut block = Vec::new();
-    if block.try_reserve_exact(lines).is_err() {
-        cache.clear();
-        block.try_reserve_exact(lines).map_err(|_| Error::Memory {
-            what: "an output array",
-            bytes: lines as u128 * 64,
-        })?;
+    if let Some(block) = fresh_map(bytes) {
+        return Ok(block);
     }
+    cache.clear();
     drop(cache);
-    block.resize(lines, Line([0; 64]));
-    Ok(block)
+    fresh_map(bytes).ok_or(Error::Memory {
+        what: "an output array",
+        bytes: bytes as u128,
+    })
 }
 
 /// Empties the cache (when memory is short: see [`super::error`]).
@@ -70,14 +67,14 @@ pub fn clear() {
 }
 
 /// Returns `block` to the cache, making room for it.
-fn give_back(block: Vec<Line>) {
-    let bytes = block.len() * 64;
+fn give_back(block: MmapMut) {
+    let bytes = block.len();
     if bytes > MAX_BYTES {
         return;
     }
     let mut cache = CACHE.lock().unwrap_or_else(PoisonError::into_inner);
     while cache.len() >= MAX_BLOCKS
-        || cache.iter().map(|b| b.len() * 64).sum::<usize>() + bytes > MAX_BYTES
+        || cache.iter().map(|m| m.len()).sum::<usize>() + bytes > MAX_BYTES
     {
         cache.remove(0);
     }
@@ -87,11 +84,13 @@ fn give_back(block: Vec<Line>) {
 /// The memory under a recycled numpy array (its `base`): the block goes
 /// back to the cache when the array is freed.
 #[pyclass(module = "mcsample._core", frozen)]
-pub struct RecycledBlock(Vec<Line>);
+pub struct RecycledBlock(Option<MmapMut>);
 
 impl Drop for RecycledBlock {
     fn drop(&mut self) {
-        give_back(std::mem::take(&mut self.0));
+        if let Some(block) = self.0.take() {
+            give_back(block);
+        }
     }
 }
 
@@ -105,14 +104,14 @@ pub fn array<'py, T: Element + Pod>(
     shape: &[usize],
 ) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
     let len: usize = shape.iter().product();
-    let lines = len.saturating_mul(size_of::<T>()).div_ceil(64);
-    let mut block = take(lines)?;
+    let mut block = take(len.saturating_mul(size_of::<T>()))?;
     let ptr = block.as_mut_ptr().cast::<T>();
-    let owner = Bound::new(py, RecycledBlock(block))?;
-    // SAFETY: the block holds `len` values of `T` (64 · lines bytes, aligned
-    // to 64, initialised, and any bytes are a valid `T`: `Pod`), and no
-    // other array or reference uses it; `owner` becomes the array's base,
-    // so the block lives, never reallocated, as long as the array.
+    let owner = Bound::new(py, RecycledBlock(Some(block)))?;
+    // SAFETY: the block holds `len` values of `T` (at least that many bytes,
+    // aligned to a page, initialised (zeros, or an earlier array's values),
+    // and any bytes are a valid `T`: `Pod`), and no other array or
+    // reference uses it; `owner` becomes the array's base, so the map lives,
+    // never moved, as long as the array.
     #[allow(unsafe_code)]
     unsafe {
         let view = ArrayViewMut::from_shape_ptr(IxDyn(shape), ptr);
