@@ -18,33 +18,65 @@ use crate::error::Result;
 use bytemuck::Pod;
 use memmap2::MmapMut;
 use std::ops::{Deref, DerefMut};
-use std::sync::Mutex;
+use std::sync::{Mutex, PoisonError};
 
 /// Buffers of at least this many bytes are memory maps.
 const MAP_MIN_BYTES: usize = 1 << 20;
 
-/// The most bytes of dropped maps kept for reuse.
-const RECYCLE_MAX_BYTES: usize = 256 << 20;
+/// Dropped maps kept for reuse, up to 256 MiB.
+static RECYCLED: MapCache = MapCache::new(256 << 20, usize::MAX);
 
-/// Dropped maps, oldest first.
-static RECYCLED: Mutex<Vec<MmapMut>> = Mutex::new(Vec::new());
-
-/// A kept map of at least `bytes` and at most twice that, the smallest.
-fn take_recycled(bytes: usize) -> Option<MmapMut> {
-    let mut kept = RECYCLED.lock().unwrap_or_else(|p| p.into_inner());
-    let fits = |m: &MmapMut| (bytes..=2 * bytes).contains(&m.len());
-    let best = (0..kept.len())
-        .filter(|&i| fits(&kept[i]))
-        .min_by_key(|&i| kept[i].len())?;
-    Some(kept.swap_remove(best))
+/// Dropped memory maps kept for the next request of about their size,
+/// oldest first, at most `max_maps` of them and `max_bytes` in all.
+pub(crate) struct MapCache {
+    kept: Mutex<Vec<MmapMut>>,
+    max_bytes: usize,
+    max_maps: usize,
 }
 
-/// Keeps `map` for reuse, dropping the oldest maps beyond the cap.
-fn recycle(map: MmapMut) {
-    let mut kept = RECYCLED.lock().unwrap_or_else(|p| p.into_inner());
-    kept.push(map);
-    while kept.iter().map(|m| m.len()).sum::<usize>() > RECYCLE_MAX_BYTES {
-        kept.remove(0);
+impl MapCache {
+    /// An empty cache with these caps.
+    pub(crate) const fn new(max_bytes: usize, max_maps: usize) -> Self {
+        MapCache {
+            kept: Mutex::new(Vec::new()),
+            max_bytes,
+            max_maps,
+        }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<MmapMut>> {
+        self.kept.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// The kept map of at least `bytes` and at most twice that, the
+    /// smallest, taken out of the cache.
+    pub(crate) fn take(&self, bytes: usize) -> Option<MmapMut> {
+        let mut kept = self.lock();
+        let fits = |m: &MmapMut| (bytes..=bytes.saturating_mul(2)).contains(&m.len());
+        let best = (0..kept.len())
+            .filter(|&i| fits(&kept[i]))
+            .min_by_key(|&i| kept[i].len())?;
+        Some(kept.remove(best))
+    }
+
+    /// Keeps `map` for reuse, dropping the oldest maps beyond the caps (or
+    /// `map` itself, when it alone is over the byte cap).
+    pub(crate) fn give_back(&self, map: MmapMut) {
+        if map.len() > self.max_bytes {
+            return;
+        }
+        let mut kept = self.lock();
+        kept.push(map);
+        while kept.len() > self.max_maps
+            || kept.iter().map(|m| m.len()).sum::<usize>() > self.max_bytes
+        {
+            kept.remove(0);
+        }
+    }
+
+    /// Drops every kept map.
+    pub(crate) fn clear(&self) {
+        self.lock().clear();
     }
 }
 
@@ -111,7 +143,7 @@ impl<T: Pod> Buffer<T> {
 fn allocate<T: Pod>(len: usize, what: &'static str) -> Result<(Storage<T>, bool)> {
     let bytes = len.saturating_mul(size_of::<T>());
     if bytes >= MAP_MIN_BYTES {
-        if let Some(map) = take_recycled(bytes) {
+        if let Some(map) = RECYCLED.take(bytes) {
             return Ok((Storage::Mapped(map), true));
         }
         if let Some(map) = fresh_map(bytes) {
@@ -126,7 +158,7 @@ impl<T: Pod> Drop for Buffer<T> {
         if let Storage::Mapped(map) =
             std::mem::replace(&mut self.storage, Storage::Heap(Vec::new()))
         {
-            recycle(map);
+            RECYCLED.give_back(map);
         }
     }
 }

@@ -7,15 +7,12 @@
 //! Outputs of at least [`MIN_BYTES`] are arrays over a block of this
 //! cache, owned by a [`RecycledBlock`] object (the array's `base`); when Python
 //! frees the array, the block goes back to the cache, which keeps at most
-//! [`MAX_BLOCKS`] blocks and [`MAX_BYTES`] in all (the oldest leave
-//! first). A request the cache cannot serve is allocated fresh, after the
+//! 8 blocks and 1 GiB in all (the oldest leave first: [`CACHE`]). A request the cache cannot serve is allocated fresh, after the
 //! cache is emptied if memory is short: a request too big for memory is
 //! still a `MemoryError`, and every `MemoryError` mcsample raises empties
 //! the cache too. Only kernels that write every element of their
 //! output take these arrays ([`super::arrays::fresh`]): a recycled block
 //! holds an earlier array's values.
-
-use std::sync::{Mutex, PoisonError};
 
 use bytemuck::Pod;
 use memmap2::MmapMut;
@@ -23,38 +20,27 @@ use numpy::ndarray::{ArrayViewMut, IxDyn};
 use numpy::{Element, PyArrayDyn};
 use pyo3::prelude::*;
 
-use crate::buffer::fresh_map;
+use crate::buffer::{MapCache, fresh_map};
 use crate::error::{Error, Result};
 
 /// Outputs smaller than this are plain `numpy.zeros` arrays (which malloc
 /// recycles by itself).
 pub const MIN_BYTES: usize = 1 << 20;
-/// The most blocks the cache keeps.
-const MAX_BLOCKS: usize = 8;
-/// The most bytes the cache keeps.
-const MAX_BYTES: usize = 1 << 30;
 
-/// The cache: blocks freed by Python, oldest first. Each block is an
-/// anonymous map advised to use huge pages, as numpy's own large arrays
-/// are: an output of 4 KiB pages, beside inputs and `out=` arrays of 2 MiB
-/// ones, made the plain call of a warp 15-20 % slower than `out=`.
-static CACHE: Mutex<Vec<MmapMut>> = Mutex::new(Vec::new());
+/// The cache: blocks freed by Python, at most 8 blocks and 1 GiB. Each
+/// block is an anonymous map advised to use huge pages, as numpy's own
+/// large arrays are: an output of 4 KiB pages, beside inputs and `out=`
+/// arrays of 2 MiB ones, made the plain call of a warp 5-50 % slower than
+/// `out=`.
+static CACHE: MapCache = MapCache::new(1 << 30, 8);
 
 /// The cached block that fits `bytes` best (at least `bytes`, at most
 /// twice), or a new one (zeros).
 fn take(bytes: usize) -> Result<MmapMut> {
-    let mut cache = CACHE.lock().unwrap_or_else(PoisonError::into_inner);
-    let best = (0..cache.len())
-        .filter(|&i| (bytes..=2 * bytes).contains(&cache[i].len()))
-        .min_by_key(|&i| cache[i].len());
-    if let Some(i) = best {
-        return Ok(cache.remove(i));
-    }
-    if let Some(block) = fresh_map(bytes) {
+    if let Some(block) = CACHE.take(bytes).or_else(|| fresh_map(bytes)) {
         return Ok(block);
     }
-    cache.clear();
-    drop(cache);
+    CACHE.clear();
     fresh_map(bytes).ok_or(Error::Memory {
         what: "an output array",
         bytes: bytes as u128,
@@ -63,22 +49,7 @@ fn take(bytes: usize) -> Result<MmapMut> {
 
 /// Empties the cache (when memory is short: see [`super::error`]).
 pub fn clear() {
-    CACHE.lock().unwrap_or_else(PoisonError::into_inner).clear();
-}
-
-/// Returns `block` to the cache, making room for it.
-fn give_back(block: MmapMut) {
-    let bytes = block.len();
-    if bytes > MAX_BYTES {
-        return;
-    }
-    let mut cache = CACHE.lock().unwrap_or_else(PoisonError::into_inner);
-    while cache.len() >= MAX_BLOCKS
-        || cache.iter().map(|m| m.len()).sum::<usize>() + bytes > MAX_BYTES
-    {
-        cache.remove(0);
-    }
-    cache.push(block);
+    CACHE.clear();
 }
 
 /// The memory under a recycled numpy array (its `base`): the block goes
@@ -89,7 +60,7 @@ pub struct RecycledBlock(Option<MmapMut>);
 impl Drop for RecycledBlock {
     fn drop(&mut self) {
         if let Some(block) = self.0.take() {
-            give_back(block);
+            CACHE.give_back(block);
         }
     }
 }
