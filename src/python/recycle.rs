@@ -5,10 +5,11 @@
 //! output written into memory already touched runs at the `out=` speed.
 //!
 //! Outputs of at least [`MIN_BYTES`] are arrays over a block of this
-//! cache, owned by a [`RecycledBlock`] object (the array's `base`); when Python
-//! frees the array, the block goes back to the cache, which keeps at most
-//! 8 blocks and 1 GiB in all (the oldest leave first: [`CACHE`]). A request the cache cannot serve is allocated fresh, after the
-//! cache is emptied if memory is short: a request too big for memory is
+//! cache, owned by a [`RecycledBlock`] object (the array's `base`); when
+//! Python frees the array, the block goes back to the cache, which keeps
+//! at most 8 blocks and 1 GiB in all (the oldest leave first: [`CACHE`]).
+//! A request the cache cannot serve is allocated fresh, after the cache is
+//! emptied if memory is short: a request too big for memory is
 //! still a `MemoryError`, and every `MemoryError` mcsample raises empties
 //! the cache too. Only kernels that write every element of their
 //! output take these arrays ([`super::arrays::fresh`]): a recycled block

@@ -233,9 +233,9 @@ where
         return true;
     };
     let n = inputs.len();
-    let mut rows = OnLines([[T::default(); M]; BLOCK]);
-    let ok = map_block(&mut rows.0, &padded, kernel, valid, level, false);
-    out.copy_from_slice(&rows.0[..n]);
+    let OnLines(rows) = &mut OnLines([[T::default(); M]; BLOCK]);
+    let ok = map_block(rows, &padded, kernel, valid, level, false);
+    out.copy_from_slice(&rows[..n]);
     ok
 }
 
@@ -258,14 +258,13 @@ where
     F: Copy + Default,
     T: Copy + Default,
 {
-    let mut results = OnLines([[T::default(); BLOCK]; M]);
-    let results = &mut results.0;
+    let OnLines(results) = &mut OnLines([[T::default(); BLOCK]; M]);
     let ok = map_block_to_columns(results, inputs, kernel, valid, level);
     if !permute_columns_to_rows(results, out, level, stream) {
         if stream {
-            let mut rows = OnLines([[T::default(); M]; BLOCK]);
-            interleave(results, &mut rows.0);
-            stream_copy(out, &rows.0);
+            let OnLines(rows) = &mut OnLines([[T::default(); M]; BLOCK]);
+            interleave(results, rows);
+            stream_copy(out, rows);
         } else {
             interleave(results, out);
         }
@@ -329,8 +328,7 @@ where
     F: Copy + Default,
     T: Copy,
 {
-    let mut columns = OnLines([[F::default(); BLOCK]; K]);
-    let columns = &mut columns.0;
+    let OnLines(columns) = &mut OnLines([[F::default(); BLOCK]; K]);
     if !permute_rows_to_columns(inputs, columns, level) {
         for i in 0..BLOCK {
             for k in 0..K {
