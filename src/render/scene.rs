@@ -280,6 +280,15 @@ impl Scene {
         )
     }
 
+    /// Whether the shape `hit` is on is an area light: [`Scene::is_emitter`]
+    /// without the surface point (moving shapes do not emit: [`Scene::new`]
+    /// refuses them).
+    #[inline]
+    pub fn hits_emitter(&self, hit: &Hit) -> bool {
+        let still = hit.primitive < self.accel.primitives().len() as u32;
+        still && self.is_emitter(self.accel.shape_of(hit.primitive))
+    }
+
     /// [`Scene::surface`] of a hit on a moving shape.
     #[inline(never)]
     fn moving_surface(&self, ray: &Ray, hit: &Hit, tau: f32) -> (u32, SurfacePoint) {

@@ -818,3 +818,56 @@ fn spheres_shade_in_their_azimuthal_frame_under_stratified_samplers() {
         assert_eq!(frame, want, "shape {shape}, {sampler:?}");
     }
 }
+
+/// [`Scene::hits_emitter`] (how a path's last vertex skips its surface
+/// point) tells an area light as the hit's surface does, on still and
+/// moving shapes alike.
+#[test]
+fn hits_emitter_agrees_with_the_surface_shape() {
+    use crate::render::motion::Motion;
+    use glam::DAffine3;
+    let cam = Camera::new(
+        Affine3A::IDENTITY,
+        40.0,
+        FovAxis::X,
+        4,
+        4,
+        0.01,
+        100.0,
+        0.0,
+        0.0,
+    );
+    let at = |x: f32| Affine3A::from_translation(Vec3::new(x, 0.0, -6.0));
+    let moved = DAffine3::from_translation(DVec3::new(0.0, 1.0, 0.0));
+    let shape = |x: f32, emission: Option<[f64; 3]>, moves: bool| Shape {
+        geometry: cube(at(x)),
+        material: diffuse(0.5),
+        emission,
+        motion: moves.then(|| Motion::new("to_world", DAffine3::IDENTITY, moved).unwrap()),
+    };
+    let shapes = vec![
+        shape(-3.0, None, false),
+        shape(0.0, None, true),
+        shape(3.0, Some([2.0; 3]), false),
+        shape(6.0, Some([1.0; 3]), false),
+    ];
+    let scene = Scene::new(shapes, None, cam.unwrap(), 4, 4).unwrap();
+    let mut seen = [false; 4];
+    for i in 0..400 {
+        let x = -0.7 + 1.4 * (i % 20) as f32 / 19.0;
+        let y = -0.25 + 0.5 * (i / 20) as f32 / 19.0;
+        let ray = Ray {
+            o: Vec3A::ZERO,
+            d: Vec3A::new(x, y, -0.6).normalize(),
+            tmax: f32::INFINITY,
+        };
+        let tau = (i % 7) as f32 / 6.0;
+        let Some(hit) = scene.intersect(&ray, tau) else {
+            continue;
+        };
+        let (shape, _) = scene.surface(&ray, &hit, tau);
+        assert_eq!(scene.hits_emitter(&hit), scene.is_emitter(shape), "ray {i}");
+        seen[shape as usize] = true;
+    }
+    assert_eq!(seen, [true; 4], "every shape hit");
+}

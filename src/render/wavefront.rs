@@ -345,6 +345,12 @@ impl Wavefront {
                     found
                 };
                 if let Some(hit) = hit {
+                    // At the last vertex only an area light's emission
+                    // counts: a path that meets another shape there ends
+                    // without its surface point.
+                    if path.depth + 1 >= settings.max_depth() && !scene.hits_emitter(&hit) {
+                        return false;
+                    }
                     self.hits.push(hit);
                     return true;
                 }
