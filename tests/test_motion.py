@@ -261,6 +261,28 @@ def test_each_strategy_sees_the_moving_shadow():
     assert not stats.render_ztest(r, runs["mis"]).passed
 
 
+def test_each_strategy_sees_the_moving_shadow_of_the_sky():
+    """The same under a constant sky and no area light, whose BSDF-sampled
+    rays need only know whether they leave the scene (the moving sphere
+    must stop them at the sample's time, as it stops shadow rays)."""
+    def sky_lit(moves=True):
+        d = lit_scene()
+        del d["light"]
+        d["sky"] = {"type": "constant", "radiance": 1.0}
+        if not moves:
+            del d["ball"]["to_world_end"]
+        return mcs.Scene.from_mitsuba(d)
+
+    s = sky_lit()
+    runs = {k: mcs.render(s, 1024, integrator="direct", strategy=k, seed=i)
+            for i, k in enumerate(["emitter", "bsdf", "mis"])}
+    for a, b in [("emitter", "bsdf"), ("mis", "bsdf"), ("emitter", "mis")]:
+        t = stats.render_ztest(runs[a], runs[b])
+        assert t.passed, (a, b, t.message)
+    r = mcs.render(sky_lit(moves=False), 1024, integrator="direct", seed=9)
+    assert not stats.render_ztest(r, runs["mis"]).passed
+
+
 def test_no_motion_and_a_closed_shutter_are_the_still_scene():
     """Bit for bit: a to_world_end equal to to_world, a shutter of length 0
     (the image at shutter_open), and a camera that does not move."""

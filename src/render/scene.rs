@@ -280,6 +280,12 @@ impl Scene {
         )
     }
 
+    /// Whether any shape is an area light.
+    #[inline]
+    pub fn has_area_lights(&self) -> bool {
+        self.emission.iter().any(Option::is_some)
+    }
+
     /// Whether the shape `hit` is on is an area light: [`Scene::is_emitter`]
     /// without the surface point (moving shapes do not emit: [`Scene::new`]
     /// refuses them).

@@ -325,6 +325,17 @@ impl Wavefront {
                     add_scaled(&mut l[u.slot as usize], u.beta, u.fc, u.s);
                 }
             }
+            // Next rays toward the last vertex of a scene without area
+            // lights: only whether they leave the scene counts, which the
+            // shadow rays' test answers.
+            let last = self
+                .paths
+                .first()
+                .map(|p| p.depth + 1 >= settings.max_depth());
+            if last == Some(true) && !scene.has_area_lights() {
+                self.escape_or_end(scene, settings)?;
+                continue;
+            }
             self.found.clear();
             scene
                 .accel()
@@ -354,15 +365,43 @@ impl Wavefront {
                     self.hits.push(hit);
                     return true;
                 }
-                if scene.environment().is_some() && settings.strategy != Strategy::Emitter {
-                    let mis = settings.strategy == Strategy::Mis;
-                    let pdf = mis.then_some(path.bsdf_pdf);
-                    self.escaped.push(path.slot, path.ray.d, path.beta, pdf);
-                }
+                escape(scene, settings, &mut self.escaped, path);
                 false
             });
         }
         Ok(())
+    }
+
+    /// Ends every path in flight: those whose next ray leaves the scene go
+    /// to the escaped rays, the others stop (their next vertex, the last,
+    /// would not emit).
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] as [`Wavefront::trace`].
+    fn escape_or_end(&mut self, scene: &Scene, settings: &Settings) -> Result<()> {
+        self.blocked.clear();
+        scene
+            .accel()
+            .occluded_many(&self.rays, &mut self.stream, &mut self.blocked)?;
+        for (path, &blocked) in self.paths.iter().zip(&self.blocked) {
+            let blocked = blocked || scene.moves() && scene.movers_occlude(&path.ray, path.time);
+            if !blocked {
+                escape(scene, settings, &mut self.escaped, path);
+            }
+        }
+        self.paths.clear();
+        self.hits.clear();
+        Ok(())
+    }
+}
+
+/// Keeps the ray of `path`, which leaves the scene, with the batch's
+/// `escaped` rays when BSDF sampling counts the environment's light.
+#[inline]
+fn escape(scene: &Scene, settings: &Settings, escaped: &mut Escaped, path: &Path) {
+    if scene.environment().is_some() && settings.strategy != Strategy::Emitter {
+        let pdf = (settings.strategy == Strategy::Mis).then_some(path.bsdf_pdf);
+        escaped.push(path.slot, path.ray.d, path.beta, pdf);
     }
 }
 
