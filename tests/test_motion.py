@@ -276,7 +276,12 @@ def test_each_strategy_sees_the_moving_shadow_of_the_sky():
     s = sky_lit()
     runs = {k: mcs.render(s, 1024, integrator="direct", strategy=k, seed=i)
             for i, k in enumerate(["emitter", "bsdf", "mis"])}
-    for a, b in [("emitter", "bsdf"), ("mis", "bsdf"), ("emitter", "mis")]:
+    # Path tracing to the third vertex: the last bounce's rays likewise.
+    runs["path"] = mcs.render(s, 1024, integrator="path", max_depth=3, seed=4)
+    runs["path, emitter"] = mcs.render(s, 1024, integrator="path", max_depth=3,
+                                       strategy="emitter", seed=5)
+    for a, b in [("emitter", "bsdf"), ("mis", "bsdf"), ("emitter", "mis"),
+                 ("path", "path, emitter")]:
         t = stats.render_ztest(runs[a], runs[b])
         assert t.passed, (a, b, t.message)
     r = mcs.render(sky_lit(moves=False), 1024, integrator="direct", seed=9)

@@ -14,7 +14,10 @@
 //!   occlude every shadow ray of the batch, one stream; add the light of
 //!           those that reach it
 //!   trace   every next ray, one stream; rays that leave the scene go to
-//!           the batch's escaped rays ([`Escaped`])
+//!           the batch's escaped rays ([`Escaped`]). Toward the last
+//!           vertex, where only an area light's emission counts, a ray
+//!           that meets another shape ends its path; in a scene without
+//!           area lights these rays are tested as shadow rays are
 //! ```
 //!
 //! Each ray tracer call then serves hundreds of rays: Embree's streams, and
@@ -245,12 +248,12 @@ impl Wavefront {
             // paths in flight have all made as many bounces.
             self.dims.clear();
             self.drawn.values.clear();
-            if let Some(depth) = self.paths.first().map(|p| p.depth)
-                && streams
-                    .first()
-                    .is_some_and(|s| s.sampler() != Sampler::Independent)
+            let depth = self.paths.first().map_or(0, |p| p.depth);
+            debug_assert!(self.paths.iter().all(|p| p.depth == depth));
+            if streams
+                .first()
+                .is_some_and(|s| s.sampler() != Sampler::Independent)
             {
-                debug_assert!(self.paths.iter().all(|p| p.depth == depth));
                 let many = scene.chooses_among_lights();
                 bounce_dims(settings, many, depth, &mut self.dims);
                 let samples = self.paths.iter().map(|p| (p.pixel, p.index));
@@ -325,14 +328,12 @@ impl Wavefront {
                     add_scaled(&mut l[u.slot as usize], u.beta, u.fc, u.s);
                 }
             }
-            // Next rays toward the last vertex of a scene without area
-            // lights: only whether they leave the scene counts, which the
-            // shadow rays' test answers.
-            let last = self
-                .paths
-                .first()
-                .map(|p| p.depth + 1 >= settings.max_depth());
-            if last == Some(true) && !scene.has_area_lights() {
+            // The next rays lead to the last vertex: only an area light's
+            // emission counts there. In a scene without area lights, only
+            // whether they leave the scene counts, which the shadow rays'
+            // test answers.
+            let last = depth + 2 >= settings.max_depth();
+            if last && !scene.has_area_lights() {
                 self.escape_or_end(scene, settings)?;
                 continue;
             }
@@ -341,7 +342,8 @@ impl Wavefront {
                 .accel()
                 .intersect_many(&self.rays, false, &mut self.stream, &mut self.found)?;
             // The paths whose next ray meets the scene stay, with their
-            // hits; the others' rays go to the escaped rays.
+            // hits (toward the last vertex, only those on an area light);
+            // the others' rays go to the escaped rays.
             debug_assert_eq!(self.found.len(), self.paths.len());
             self.hits.clear();
             let mut stream_hits = self.found.iter();
@@ -356,10 +358,9 @@ impl Wavefront {
                     found
                 };
                 if let Some(hit) = hit {
-                    // At the last vertex only an area light's emission
-                    // counts: a path that meets another shape there ends
+                    // Another shape at the last vertex: the path ends
                     // without its surface point.
-                    if path.depth + 1 >= settings.max_depth() && !scene.hits_emitter(&hit) {
+                    if last && !scene.hits_emitter(&hit) {
                         return false;
                     }
                     self.hits.push(hit);
@@ -379,6 +380,7 @@ impl Wavefront {
     /// # Errors
     /// [`crate::Error::Memory`] as [`Wavefront::trace`].
     fn escape_or_end(&mut self, scene: &Scene, settings: &Settings) -> Result<()> {
+        debug_assert!(!scene.has_area_lights());
         self.blocked.clear();
         scene
             .accel()
