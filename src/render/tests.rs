@@ -826,17 +826,6 @@ fn spheres_shade_in_their_azimuthal_frame_under_stratified_samplers() {
 fn hits_emitter_agrees_with_the_surface_shape() {
     use crate::render::motion::Motion;
     use glam::DAffine3;
-    let cam = Camera::new(
-        Affine3A::IDENTITY,
-        40.0,
-        FovAxis::X,
-        4,
-        4,
-        0.01,
-        100.0,
-        0.0,
-        0.0,
-    );
     let at = |x: f32| Affine3A::from_translation(Vec3::new(x, 0.0, -6.0));
     let moved = DAffine3::from_translation(DVec3::new(0.0, 1.0, 0.0));
     let shape = |x: f32, emission: Option<[f64; 3]>, moves: bool| Shape {
@@ -851,7 +840,7 @@ fn hits_emitter_agrees_with_the_surface_shape() {
         shape(3.0, Some([2.0; 3]), false),
         shape(6.0, Some([1.0; 3]), false),
     ];
-    let scene = Scene::new(shapes, None, cam.unwrap(), 4, 4).unwrap();
+    let scene = Scene::new(shapes, None, camera(), 4, 4).unwrap();
     let mut seen = [false; 4];
     for i in 0..400 {
         let x = -0.7 + 1.4 * (i % 20) as f32 / 19.0;
