@@ -132,7 +132,7 @@ def _time_to_relmse(scene: mcs.Scene, ours: dict[str, dict], reference: dict,
                                                                seconds)
     out = []
     for label, (images, seconds) in runs.items():
-        relmse = np.mean([mcs.stats.relmse(image, ref_a.image) for image in images])
+        relmse = float(np.mean([mcs.stats.relmse(image, ref_a.image) for image in images]))
         needed = max(relmse - floor, 1e-12) * spp / target
         out.append(Timing(f"time to relMSE {target:g}, {name}", label, "float32",
                           int(needed * w * h), needed * seconds / spp))
