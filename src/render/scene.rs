@@ -75,6 +75,8 @@ pub struct Scene {
     /// [`super::integrator::shading`]).
     spheres: Vec<bool>,
     emission: Vec<Option<[f32; 3]>>,
+    /// Whether any shape emits (asked once a bounce).
+    area_lights: bool,
     light_of_shape: Vec<Option<u32>>,
     environment: Option<Environment>,
     env_light: Option<u32>,
@@ -210,6 +212,7 @@ impl Scene {
             accel,
             materials,
             spheres,
+            area_lights: emission.iter().any(Option::is_some),
             emission,
             light_of_shape,
             environment,
@@ -283,7 +286,7 @@ impl Scene {
     /// Whether any shape is an area light.
     #[inline]
     pub fn has_area_lights(&self) -> bool {
-        self.emission.iter().any(Option::is_some)
+        self.area_lights
     }
 
     /// Whether the shape `hit` is on is an area light: [`Scene::is_emitter`]
