@@ -75,6 +75,7 @@ impl MapCache {
     }
 
     /// Drops every kept map.
+    #[cfg(feature = "python")]
     pub(crate) fn clear(&self) {
         self.lock().clear();
     }

@@ -104,9 +104,9 @@ def test_sample_reuse_is_a_fresh_uniform(weights):
     assert counts.min() > 0.8 * len(sel) / 10
 
 
-def blocked_cumsum(w, block=1 << 16):
+def blocked_cumsum(w, block=8000):
     """Running sums as Discrete1D accumulates them: in order within blocks
-    of 2^16 entries, each block then offset by the sum of those before it."""
+    of 8000 entries, each block then offset by the sum of those before it."""
     parts = [np.cumsum(w[s:s + block]) for s in range(0, len(w), block)]
     offsets = np.cumsum([0.0] + [p[-1] for p in parts[:-1]])
     return np.concatenate([p + o for p, o in zip(parts, offsets)])
@@ -116,7 +116,7 @@ def test_large_table_guide_matches_binary_search(rng):
     w = rng.random(100_000) ** 4
     w[rng.random(100_000) < 0.2] = 0
     d = mcs.Discrete1D(w)
-    cdf = blocked_cumsum(w)  # two blocks, summed as the table sums them
+    cdf = blocked_cumsum(w)  # 13 blocks, summed as the table sums them
     u = np.concatenate([rng.random(200_000), np.minimum(cdf / cdf[-1], 1), [0.0, 1.0]])
     # numpy's searchsorted 'left' gives the first i with C[i] >= u * sum.
     ref = np.searchsorted(cdf, u * cdf[-1], side="left")

@@ -1,6 +1,9 @@
 //! [`Discrete1D`]: a discrete distribution sampled by inverting its CDF.
 
-use super::search::{Search, fill_guide, guide_len, positive_range, sum_into};
+use super::search::{
+    CHAINS, GuideCell, Search, close_guide, guide_len, positive_range, scatter_guide,
+    sum_blocks_into,
+};
 use super::{GROUP, Weights, check_len, find_invalid};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
@@ -12,8 +15,14 @@ use rayon::prelude::*;
 /// Entries per block of the running sums of a long table: each block is
 /// summed from 0 and then offset by the blocks before it, in parallel. Fixed,
 /// so that the sums do not depend on the thread count (a table of at most
-/// one block is summed strictly in order, as Mitsuba does).
-const SUM_BLOCK: usize = 1 << 16;
+/// one block is summed strictly in order, as Mitsuba does). Not a power of
+/// two: the blocks of a group are read and written side by side, and
+/// streams a power of two apart fall into the same cache sets.
+const SUM_BLOCK: usize = 8000;
+
+/// Entries per task of the running sums: [`CHAINS`] blocks, summed side by
+/// side ([`sum_blocks_into`]).
+const SUM_GROUP: usize = CHAINS * SUM_BLOCK;
 
 /// A discrete distribution over the indices `0..n`, with probabilities
 /// proportional to non-negative weights `w`.
@@ -44,6 +53,47 @@ pub struct Discrete1D {
     /// `guide[k]`: the first index whose running sum reaches `k/G · Σw`,
     /// clamped to `[first, last]`, for `k = 0..=G` (empty for short tables).
     guide: Buffer<u32>,
+}
+
+/// Adds to each block of the running sums `cdf` its entry of `offsets`
+/// (the total of the blocks before it), and fills the guide of the sums
+/// (total `sum`) but for [`close_guide`]: each entry's index written into
+/// its cell ([`scatter_guide`]), the cells no entry hits `u32::MAX`. In
+/// parallel by groups of blocks: the sums never decrease, so the entries
+/// of a group hit the cells after its offset's (the group before's last
+/// sum) up to its own last sum's, which no other group writes.
+fn offset_blocks(cdf: &mut [f64], offsets: &[f64], sum: f64, guide: &mut [u32]) {
+    let cell = GuideCell::new(guide.len(), sum);
+    let (mut rest, mut start) = (guide, 0);
+    let mut groups = Vec::with_capacity(offsets.len().div_ceil(CHAINS));
+    for (g, group) in offsets.chunks(CHAINS).enumerate() {
+        let end = offsets.get((g + 1) * CHAINS).copied().unwrap_or(sum);
+        let next = cell.map_or(0, |cell| cell.of(end) as usize + 1);
+        let (own, later) = std::mem::take(&mut rest).split_at_mut(next - start);
+        groups.push((group, start, own));
+        (rest, start) = (later, next);
+    }
+    rest.fill(u32::MAX);
+    (cdf.par_chunks_mut(SUM_GROUP), groups)
+        .into_par_iter()
+        .enumerate()
+        .for_each(|(g, (cdf, (offsets, start, own)))| {
+            own.fill(u32::MAX);
+            // The blocks last first, as the guide is filled.
+            let blocks = (cdf.chunks_mut(SUM_BLOCK).zip(offsets).enumerate()).rev();
+            simd::dispatch(
+                #[inline(always)]
+                |_| {
+                    for (b, (cdf, &offset)) in blocks {
+                        let first = g * SUM_GROUP + b * SUM_BLOCK;
+                        match cell {
+                            Some(cell) => scatter_guide((cdf, offset, first), cell, own, start),
+                            None => cdf.iter_mut().for_each(|c| *c += offset),
+                        }
+                    }
+                },
+            )
+        });
 }
 
 impl Discrete1D {
@@ -80,21 +130,23 @@ impl Discrete1D {
     /// parallel (on the current rayon pool).
     fn build(weights: &[f64]) -> Result<(Option<Self>, bool)> {
         // The copy of the weights and each block's running sums from 0, in
-        // parallel; then to each block the sum of the blocks before it.
+        // parallel (a group of blocks per task); then to each block the sum
+        // of the blocks before it, with the guide.
         let mut copy = Buffer::for_overwrite(weights.len(), "the table's weights")?;
         let mut cdf = Buffer::for_overwrite(weights.len(), "the table's running sums")?;
-        let (totals, valid): (Vec<f64>, Vec<bool>) = (
-            cdf.par_chunks_mut(SUM_BLOCK),
-            copy.par_chunks_mut(SUM_BLOCK),
-            weights.par_chunks(SUM_BLOCK),
+        let (totals, valid): (Vec<_>, Vec<bool>) = (
+            cdf.par_chunks_mut(SUM_GROUP),
+            copy.par_chunks_mut(SUM_GROUP),
+            weights.par_chunks(SUM_GROUP),
         )
             .into_par_iter()
-            .map(|(cdf, copy, weights)| sum_into(weights, cdf, copy))
+            .map(|(cdf, copy, weights)| sum_blocks_into(weights, cdf, copy, SUM_BLOCK))
             .unzip();
         let valid = valid.into_iter().all(|v| v);
-        let mut offsets = Vec::with_capacity(totals.len());
+        let blocks = weights.len().div_ceil(SUM_BLOCK);
+        let mut offsets = Vec::with_capacity(blocks);
         let mut acc = 0.0;
-        for total in &totals {
+        for total in totals.iter().flatten().take(blocks) {
             offsets.push(acc);
             acc += total;
         }
@@ -104,12 +156,9 @@ impl Discrete1D {
         if !(valid && acc > 0.0 && acc.is_finite()) {
             return Ok((None, valid));
         }
-        cdf.par_chunks_mut(SUM_BLOCK)
-            .zip(offsets)
-            .skip(1)
-            .for_each(|(cdf, offset)| cdf.iter_mut().for_each(|c| *c += offset));
         let mut guide = Buffer::for_overwrite(guide_len(weights.len()), "the table's guide")?;
-        fill_guide(&cdf, acc, (first, last), &mut guide);
+        offset_blocks(&mut cdf, &offsets, acc, &mut guide);
+        close_guide(&mut guide, (first, last));
         let table = Discrete1D {
             weights: Weights::new(copy, acc),
             cdf,
@@ -219,6 +268,7 @@ impl std::ops::Deref for Discrete1D {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::distr::search::{GuideCell, fill_guide};
     use proptest::prelude::*;
 
     /// The reference: a linear scan for `C_{i−1} < u·Σw ≤ C_i` over the
@@ -308,20 +358,98 @@ mod tests {
         }
     }
 
+    /// Weights of a long table (several groups of blocks, and a part
+    /// group): a pattern, zeros across block and group boundaries (cells
+    /// shared by two blocks), a weight that spans many cells, leading and
+    /// trailing zeros.
+    fn long_tables() -> Vec<Vec<f64>> {
+        let n = 3 * SUM_GROUP + 7;
+        let zeros = [
+            SUM_BLOCK - 50..SUM_BLOCK + 50,
+            SUM_GROUP - 9..2 * SUM_GROUP + 9,
+        ];
+        let cases: [Box<dyn Fn(usize) -> f64>; 4] = [
+            Box::new(|i| ((i * 7919) % 13) as f64),
+            Box::new(|i| f64::from(!zeros.iter().any(|z| z.contains(&i)))),
+            Box::new(|i| if i == SUM_GROUP { 1e6 } else { 1.0 }),
+            Box::new(|i| f64::from(i > 100 && i + 200 < n && i % 3 == 0)),
+        ];
+        cases.iter().map(|w| (0..n).map(w).collect()).collect()
+    }
+
     #[test]
-    fn long_tables_are_summed_by_blocks_consistently() {
-        let n = 3 * SUM_BLOCK + 7;
-        let weights: Vec<f64> = (0..n).map(|i| ((i * 7919) % 13) as f64).collect();
-        let d = Discrete1D::new(&weights).unwrap();
-        let exact: f64 = weights.iter().sum();
-        assert!((d.sum() - exact).abs() <= 1e-12 * exact);
-        assert!(d.cdf.windows(2).all(|c| c[0] <= c[1]));
-        assert_eq!(d.cdf[n - 1], d.sum());
-        for k in 0..=500 {
-            let u = k as f64 / 500.0;
-            let i = d.sample(u);
-            assert_eq!(i, linear(&d, u), "u = {u}");
-            assert!(weights[i] > 0.0);
+    fn long_tables_are_summed_by_blocks() {
+        for weights in long_tables() {
+            let d = Discrete1D::new(&weights).unwrap();
+            // Each block's sums in order from 0, offset by the sum in order
+            // of the totals of the blocks before it: the same bits.
+            let mut offset = 0.0;
+            for (b, block) in weights.chunks(SUM_BLOCK).enumerate() {
+                let mut acc = 0.0;
+                for (i, &w) in block.iter().enumerate() {
+                    acc += w;
+                    assert_eq!(d.cdf[b * SUM_BLOCK + i], acc + offset);
+                }
+                offset += acc;
+            }
+            assert_eq!(d.sum(), offset);
+            let exact: f64 = weights.iter().sum();
+            assert!((d.sum() - exact).abs() <= 1e-12 * exact);
+            for k in 0..=500 {
+                let u = k as f64 / 500.0;
+                let i = d.sample(u);
+                assert_eq!(i, linear(&d, u), "u = {u}");
+                assert!(weights[i] > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn guide_cells_are_the_floors_of_the_scaled_sums() {
+        for (len, sum) in [(65, 1.0), (250_001, 3.7e5), (1 << 20, 7.0), (4097, 1e-300)] {
+            let cell = GuideCell::new(len, sum).unwrap();
+            let cells = len - 1;
+            let scale = cells as f64 / sum;
+            // Whole, half and nearly whole cells (ties and round-ups), and
+            // sums past the total.
+            let xs = (0..=4 * cells)
+                .map(|k| k as f64 / 4.0)
+                .chain([1e9, f64::MAX]);
+            for x in xs.flat_map(|x| [x, x.next_down().max(0.0), x.next_up()]) {
+                let c = x / scale;
+                let floor = ((c * scale) as usize).min(cells);
+                assert_eq!(cell.of(c) as usize, floor, "len {len}, x {x}");
+            }
+        }
+    }
+
+    #[test]
+    fn long_tables_get_the_guide_of_their_sums() {
+        for (case, weights) in long_tables().iter().enumerate() {
+            let d = Discrete1D::new(weights).unwrap();
+            // Cell k holds the first entry whose sum's cell is k or more,
+            // kept within the entries of positive weight; cells past the
+            // last sum's, the last entry.
+            let cell = GuideCell::new(d.guide.len(), d.sum()).unwrap();
+            let mut expected = vec![d.last; d.guide.len()];
+            let mut k = 0;
+            for (i, &c) in d.cdf.iter().enumerate() {
+                while k <= cell.of(c) as usize {
+                    expected[k] = i.clamp(d.first, d.last);
+                    k += 1;
+                }
+            }
+            let guide: Vec<usize> = d.guide.iter().map(|&g| g as usize).collect();
+            assert_eq!(guide, expected, "case {case}");
+            // Filled in one pass over the table, the same guide.
+            let mut one_pass = vec![0; d.guide.len()];
+            fill_guide(
+                &mut d.cdf.to_vec(),
+                d.sum(),
+                (d.first, d.last),
+                &mut one_pass,
+            );
+            assert_eq!(&one_pass[..], &d.guide[..], "case {case}");
         }
     }
 

@@ -27,6 +27,48 @@ pub(crate) fn sum_into(weights: &[f64], cdf: &mut [f64], copy: &mut [f64]) -> (f
     (acc, valid)
 }
 
+/// Blocks whose running sums [`sum_blocks_into`] computes side by side.
+pub(crate) const CHAINS: usize = 8;
+
+/// The running sums from 0 of each block of `block` entries of `weights`
+/// into `cdf`, and the weights into `copy` (all three of one length, at
+/// most [`CHAINS`] blocks): each block's total, and whether every weight is
+/// finite and `>= 0`. Each block is summed in order, as [`sum_into`] sums
+/// it, but a group of [`CHAINS`] whole blocks side by side: one block's sums
+/// are a chain of additions, each waiting on the one before, and the
+/// chains of several overlap.
+pub(crate) fn sum_blocks_into(
+    weights: &[f64],
+    cdf: &mut [f64],
+    copy: &mut [f64],
+    block: usize,
+) -> ([f64; CHAINS], bool) {
+    let mut totals = [0.0; CHAINS];
+    if weights.len() != CHAINS * block || cdf.len() != weights.len() {
+        let mut valid = true;
+        let blocks = (cdf.chunks_mut(block)).zip(weights.chunks(block).zip(copy.chunks_mut(block)));
+        for (t, (cdf, (weights, copy))) in totals.iter_mut().zip(blocks) {
+            let (total, ok) = sum_into(weights, cdf, copy);
+            (*t, valid) = (total, valid & ok);
+        }
+        return (totals, valid);
+    }
+    simd::stream_copy(copy, weights);
+    let w: [&[f64]; CHAINS] = std::array::from_fn(|j| &weights[j * block..][..block]);
+    let mut parts = cdf.chunks_exact_mut(block);
+    let c: [&mut [f64]; CHAINS] = std::array::from_fn(|_| parts.next().unwrap_or_default());
+    let mut valid = [true; CHAINS];
+    for i in 0..block {
+        for j in 0..CHAINS {
+            let x = w[j][i];
+            totals[j] += x;
+            c[j][i] = totals[j];
+            valid[j] &= is_weight(x);
+        }
+    }
+    (totals, valid.iter().all(|&v| v))
+}
+
 /// The first and last entries of positive weight (`None` if there is none).
 pub(crate) fn positive_range(weights: &[f64]) -> Option<(usize, usize)> {
     let positive = |w: &f64| *w > 0.0;
@@ -48,18 +90,91 @@ pub(crate) fn guide_len(n: usize) -> usize {
 /// with `C_i ≥ k·Σw/G`, for `G + 1 = guide.len()` cells.
 ///
 /// Branch-free: entry `i` writes its index into cell `⌊C_i·G/Σw⌋`, last
-/// entries first, so each hit cell keeps its smallest index; a cell no
-/// entry hits takes the answer of the next cell up (a suffix minimum).
-/// Round-off here only costs a fallback search (see [`Search::bracket`]).
-pub(crate) fn fill_guide(cdf: &[f64], sum: f64, (first, last): (usize, usize), guide: &mut [u32]) {
-    let Some(cells) = guide.len().checked_sub(1) else {
+/// entries first, so each hit cell keeps its smallest index
+/// ([`scatter_guide`], which adds 0 to the sums); a cell no entry hits takes the answer of the next
+/// cell up ([`close_guide`]). Round-off here only costs a fallback search
+/// (see [`Search::bracket`]).
+pub(crate) fn fill_guide(cdf: &mut [f64], sum: f64, range: (usize, usize), guide: &mut [u32]) {
+    let Some(cell) = GuideCell::new(guide.len(), sum) else {
         return;
     };
-    let scale = cells as f64 / sum;
     guide.fill(u32::MAX);
-    for (i, &c) in cdf.iter().enumerate().rev() {
-        guide[((c * scale) as usize).min(cells)] = i as u32;
+    scatter_guide((cdf, 0.0, 0), cell, guide, 0);
+    close_guide(guide, range);
+}
+
+/// The guide cell `⌊C·G/Σw⌋` (at most `G`) of a running sum `C`, for a
+/// guide of `G + 1` cells.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct GuideCell {
+    scale: f64,
+    /// `G` (below 2³¹: a table has fewer than 2³² entries, and a quarter as
+    /// many cells).
+    cells: f64,
+}
+
+impl GuideCell {
+    /// The cells of a guide of `len` entries over a total `sum` (`None`
+    /// for a table without a guide).
+    pub(crate) fn new(len: usize, sum: f64) -> Option<Self> {
+        let cells = len.checked_sub(1)? as f64;
+        Some(GuideCell {
+            scale: cells / sum,
+            cells,
+        })
     }
+
+    /// The cell of running sum `c` (`>= 0`; never decreasing as `c`
+    /// grows). `⌊x⌋` of `x = min(c·G/Σw, G)` from the bits of `x + 2⁵²`,
+    /// whose mantissa's low bits hold `x` rounded to the nearest whole
+    /// number, less 1 where that rounded up: a float-to-integer cast, which
+    /// saturates, compiles to scalar code; this vectorises.
+    #[inline(always)]
+    pub(crate) fn of(self, c: f64) -> u32 {
+        const TWO_52: f64 = (1u64 << 52) as f64;
+        let x = (c * self.scale).min(self.cells);
+        let r = x + TWO_52;
+        (r.to_bits() as u32) - u32::from(r - TWO_52 > x)
+    }
+}
+
+/// Adds `offset` to the running sums `cdf` (those of entries `first..`)
+/// and writes into `guide` (the cells from `start` on) the index of each
+/// into its cell, the last entries first, so that each cell keeps the
+/// smallest index that hits it; the cells are found [`SCATTER`] entries at
+/// a time, at SIMD width. Entries whose cell lies before `start` write
+/// nothing. As the sums never decrease, the guide can be filled block by
+/// block, the blocks taken last first: a block of entries whose first
+/// entry's cell is past the block before's last keeps to its own cells.
+#[inline(always)]
+pub(crate) fn scatter_guide(
+    (cdf, offset, first): (&mut [f64], f64, usize),
+    cell: GuideCell,
+    guide: &mut [u32],
+    start: usize,
+) {
+    let mut cells = [0; SCATTER];
+    for (k, chunk) in cdf.chunks_mut(SCATTER).enumerate().rev() {
+        for (to, c) in cells.iter_mut().zip(chunk.iter_mut()) {
+            *c += offset;
+            *to = cell.of(*c);
+        }
+        let first = first + k * SCATTER;
+        for (i, &to) in cells[..chunk.len()].iter().enumerate().rev() {
+            if let Some(g) = guide.get_mut((to as usize).wrapping_sub(start)) {
+                *g = (first + i) as u32;
+            }
+        }
+    }
+}
+
+/// Entries whose guide cells [`scatter_guide`] finds together.
+const SCATTER: usize = 64;
+
+/// The guide after [`scatter_guide`]: each cell that no entry hit takes
+/// the answer of the next cell up (the last cells `last`), and every answer
+/// is kept within `first..=last`.
+pub(crate) fn close_guide(guide: &mut [u32], (first, last): (usize, usize)) {
     let (first, mut next) = (first as u32, last as u32);
     for g in guide.iter_mut().rev() {
         next = next.min(*g);
