@@ -128,6 +128,17 @@ fn default_threads() -> Result<usize> {
     })
 }
 
+/// The CPUs to pin the pool's threads to, one each, when the pool has one
+/// thread for each CPU this process may run on (more than one). Left to the
+/// OS, the two threads of a 2-core machine, woken for a batch of a
+/// millisecond, were often placed on the same CPU and stayed there for many
+/// batches, each of which then took twice as long. With fewer threads than
+/// CPUs they are not pinned: the OS may have better places for them (CPUs
+/// shared with other work, a CPU quota below the CPU count).
+fn cpus_to_pin(threads: usize) -> Option<Vec<core_affinity::CoreId>> {
+    core_affinity::get_core_ids().filter(|cpus| threads > 1 && cpus.len() == threads)
+}
+
 /// The pool for `threads` threads, (re)built when the count changed or the
 /// process was forked since it was built.
 fn pool(threads: usize) -> Result<Arc<ThreadPool>> {
@@ -145,14 +156,21 @@ fn pool(threads: usize) -> Result<Arc<ThreadPool>> {
         // The pool's threads do not exist in a forked child: never touch it.
         std::mem::forget(old);
     }
-    let pool = rayon::ThreadPoolBuilder::new()
+    let mut builder = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
-        .thread_name(|i| format!("mcsample-{i}"))
-        .build()
-        .map_err(|e| Error::ThreadPool {
-            threads,
-            message: e.to_string(),
-        })?;
+        .thread_name(|i| format!("mcsample-{i}"));
+    if let Some(cpus) = cpus_to_pin(threads) {
+        builder = builder.start_handler(move |i| {
+            if let Some(&cpu) = cpus.get(i) {
+                // Advice only: a thread that cannot be pinned runs anywhere.
+                core_affinity::set_for_current(cpu);
+            }
+        });
+    }
+    let pool = builder.build().map_err(|e| Error::ThreadPool {
+        threads,
+        message: e.to_string(),
+    })?;
     let pool = Arc::new(pool);
     *guard = Some(Pool {
         pid,
