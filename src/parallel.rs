@@ -129,14 +129,20 @@ fn default_threads() -> Result<usize> {
 }
 
 /// The CPUs to pin the pool's threads to, one each, when the pool has one
-/// thread for each CPU this process may run on (more than one). Left to the
-/// OS, the two threads of a 2-core machine, woken for a batch of a
-/// millisecond, were often placed on the same CPU and stayed there for many
-/// batches, each of which then took twice as long. With fewer threads than
-/// CPUs they are not pinned: the OS may have better places for them (CPUs
-/// shared with other work, a CPU quota below the CPU count).
+/// thread for each CPU that the thread building it may run on (more than
+/// one), on Linux. Left to the OS, the two threads of a 2-core machine,
+/// woken for a batch of a millisecond, were often placed on the same CPU
+/// and stayed there for many batches, each of which then took twice as
+/// long. With fewer threads than CPUs they are not pinned: the OS may have
+/// better places for them (CPUs shared with other work, a CPU quota below
+/// the CPU count). Pinned, a thread no longer moves to balance the load of
+/// several processes that each pin theirs (the work is still shared out
+/// within the pool), and what it starts inherits its one CPU.
 fn cpus_to_pin(threads: usize) -> Option<Vec<core_affinity::CoreId>> {
-    core_affinity::get_core_ids().filter(|cpus| threads > 1 && cpus.len() == threads)
+    if !cfg!(target_os = "linux") || threads < 2 {
+        return None;
+    }
+    core_affinity::get_core_ids().filter(|cpus| cpus.len() == threads)
 }
 
 /// The pool for `threads` threads, (re)built when the count changed or the

@@ -398,6 +398,7 @@ impl AliasTable {
             .zip(weights.par_chunks(BLOCK))
             .map(|(copy, w)| {
                 simd::stream_copy(copy, w);
+                simd::store_fence();
                 (lane_sum(w), all_weights(w))
             })
             .unzip();

@@ -44,7 +44,8 @@ pub(crate) fn sum_blocks_into(
     block: usize,
 ) -> ([f64; CHAINS], bool) {
     let mut totals = [0.0; CHAINS];
-    if weights.len() != CHAINS * block || cdf.len() != weights.len() {
+    let whole = weights.len() == CHAINS * block;
+    if !(whole && cdf.len() == weights.len() && copy.len() == weights.len()) {
         let mut valid = true;
         let blocks = (cdf.chunks_mut(block)).zip(weights.chunks(block).zip(copy.chunks_mut(block)));
         for (t, (cdf, (weights, copy))) in totals.iter_mut().zip(blocks) {
@@ -54,6 +55,8 @@ pub(crate) fn sum_blocks_into(
         return (totals, valid);
     }
     simd::stream_copy(copy, weights);
+    simd::store_fence();
+    // The loop of `sum_into`, over the blocks at once.
     let w: [&[f64]; CHAINS] = std::array::from_fn(|j| &weights[j * block..][..block]);
     let mut parts = cdf.chunks_exact_mut(block);
     let c: [&mut [f64]; CHAINS] = std::array::from_fn(|_| parts.next().unwrap_or_default());
@@ -91,15 +94,16 @@ pub(crate) fn guide_len(n: usize) -> usize {
 ///
 /// Branch-free: entry `i` writes its index into cell `⌊C_i·G/Σw⌋`, last
 /// entries first, so each hit cell keeps its smallest index
-/// ([`scatter_guide`], which adds 0 to the sums); a cell no entry hits takes the answer of the next
+/// ([`scatter_guide`]); a cell no entry hits takes the answer of the next
 /// cell up ([`close_guide`]). Round-off here only costs a fallback search
-/// (see [`Search::bracket`]).
+/// (see [`Search::bracket`]). `cdf` is borrowed mutably only because
+/// [`scatter_guide`] can offset the sums it reads; it is not changed.
 pub(crate) fn fill_guide(cdf: &mut [f64], sum: f64, range: (usize, usize), guide: &mut [u32]) {
     let Some(cell) = GuideCell::new(guide.len(), sum) else {
         return;
     };
     guide.fill(u32::MAX);
-    scatter_guide((cdf, 0.0, 0), cell, guide, 0);
+    scatter_guide((cdf, None, 0), cell, guide, 0);
     close_guide(guide, range);
 }
 
@@ -118,14 +122,16 @@ impl GuideCell {
     /// for a table without a guide).
     pub(crate) fn new(len: usize, sum: f64) -> Option<Self> {
         let cells = len.checked_sub(1)? as f64;
+        // Finite even for a subnormal sum, so that `c·scale` is never NaN.
         Some(GuideCell {
-            scale: cells / sum,
+            scale: (cells / sum).min(f64::MAX),
             cells,
         })
     }
 
-    /// The cell of running sum `c` (`>= 0`; never decreasing as `c`
-    /// grows). `⌊x⌋` of `x = min(c·G/Σw, G)` from the bits of `x + 2⁵²`,
+    /// The cell of running sum `c` (finite, `>= 0`; never decreasing as
+    /// `c` grows). `⌊x⌋` of `x = min(c·s, G)`, `s = G/Σw` (at most the
+    /// largest float), from the bits of `x + 2⁵²`,
     /// whose mantissa's low bits hold `x` rounded to the nearest whole
     /// number, less 1 where that rounded up: a float-to-integer cast, which
     /// saturates, compiles to scalar code; this vectorises.
@@ -138,8 +144,8 @@ impl GuideCell {
     }
 }
 
-/// Adds `offset` to the running sums `cdf` (those of entries `first..`)
-/// and writes into `guide` (the cells from `start` on) the index of each
+/// Adds `offset` (if any) to the running sums `cdf` (those of entries
+/// `first..`) and writes into `guide` (the cells from `start` on) the index of each
 /// into its cell, the last entries first, so that each cell keeps the
 /// smallest index that hits it; the cells are found [`SCATTER`] entries at
 /// a time, at SIMD width. Entries whose cell lies before `start` write
@@ -148,16 +154,18 @@ impl GuideCell {
 /// entry's cell is past the block before's last keeps to its own cells.
 #[inline(always)]
 pub(crate) fn scatter_guide(
-    (cdf, offset, first): (&mut [f64], f64, usize),
+    (cdf, offset, first): (&mut [f64], Option<f64>, usize),
     cell: GuideCell,
     guide: &mut [u32],
     start: usize,
 ) {
     let mut cells = [0; SCATTER];
     for (k, chunk) in cdf.chunks_mut(SCATTER).enumerate().rev() {
-        for (to, c) in cells.iter_mut().zip(chunk.iter_mut()) {
-            *c += offset;
-            *to = cell.of(*c);
+        if let Some(offset) = offset {
+            chunk.iter_mut().for_each(|c| *c += offset);
+        }
+        for (to, &c) in cells.iter_mut().zip(&*chunk) {
+            *to = cell.of(c);
         }
         let first = first + k * SCATTER;
         for (i, &to) in cells[..chunk.len()].iter().enumerate().rev() {

@@ -169,7 +169,7 @@ record! {
 
 /// A discrete distribution over 0..n-1 proportional to ``weights``,
 /// sampled by inverting its CDF (binary search on running sums accumulated
-/// in float64, in order within blocks of 65536 entries, narrowed by a guide
+/// in float64, in order within blocks of 8000 entries, narrowed by a guide
 /// table).
 ///
 /// ``sample(u)`` returns the index i with C[i-1] < u * sum <= C[i], as

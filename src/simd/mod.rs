@@ -409,7 +409,7 @@ fn interleave<T: Copy, const M: usize>(columns: &[[T; BLOCK]; M], rows: &mut [[T
 /// [`map_rows`] arranges, and as the blocks of a page-aligned
 /// [`crate::buffer::Buffer`] are); otherwise with plain stores. For copies
 /// that are not read again soon: such stores skip reading each line before
-/// writing it. The width is read at run time on purpose: given as the
+/// writing it. Follow the copies by [`store_fence`]. The width is read at run time on purpose: given as the
 /// dispatch's constant, LLVM merged the copy into the block's transpose,
 /// which cost the AVX2 warps of three components instructions per row.
 #[inline(always)]
@@ -488,10 +488,10 @@ stream_lines!(
     _mm_stream_si128
 );
 
-/// Orders non-temporal stores before whatever follows (another thread
-/// reading the output after the batch joins).
+/// Orders non-temporal stores (those of [`stream_copy`]) before whatever
+/// follows (another thread reading the output after the batch joins).
 #[inline(always)]
-fn store_fence() {
+pub(crate) fn store_fence() {
     #[cfg(target_arch = "x86_64")]
     #[allow(unsafe_code)]
     // SAFETY: SSE is part of every x86-64 CPU.
