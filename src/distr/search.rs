@@ -130,11 +130,11 @@ impl GuideCell {
     }
 
     /// The cell of running sum `c` (finite, `>= 0`; never decreasing as
-    /// `c` grows). `⌊x⌋` of `x = min(c·s, G)`, `s = G/Σw` (at most the
-    /// largest float), from the bits of `x + 2⁵²`,
-    /// whose mantissa's low bits hold `x` rounded to the nearest whole
-    /// number, less 1 where that rounded up: a float-to-integer cast, which
-    /// saturates, compiles to scalar code; this vectorises.
+    /// `c` grows): `⌊x⌋` of `x = min(c·s, G)`, `s = G/Σw` (at most the
+    /// largest float), from the bits of `x + 2⁵²`, whose mantissa's low
+    /// bits hold `x` rounded to the nearest whole number, less 1 where that
+    /// rounded up. A float-to-integer cast, which saturates, compiles to
+    /// scalar code; this vectorises.
     #[inline(always)]
     pub(crate) fn of(self, c: f64) -> u32 {
         const TWO_52: f64 = (1u64 << 52) as f64;
@@ -145,10 +145,10 @@ impl GuideCell {
 }
 
 /// Adds `offset` (if any) to the running sums `cdf` (those of entries
-/// `first..`) and writes into `guide` (the cells from `start` on) the index of each
-/// into its cell, the last entries first, so that each cell keeps the
-/// smallest index that hits it; the cells are found [`SCATTER`] entries at
-/// a time, at SIMD width. Entries whose cell lies before `start` write
+/// `first..`) and writes into `guide` (the cells from `start` on) the
+/// index of each into its cell, the last entries first, so that each cell
+/// keeps the smallest index that hits it; the cells are found [`SCATTER`]
+/// entries at a time, at SIMD width. Entries whose cell lies before `start` write
 /// nothing. As the sums never decrease, the guide can be filled block by
 /// block, the blocks taken last first: a block of entries whose first
 /// entry's cell is past the block before's last keeps to its own cells.
