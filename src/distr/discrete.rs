@@ -85,12 +85,10 @@ fn offset_blocks_and_fill_guide(cdf: &mut [f64], offsets: &[f64], sum: f64, guid
                 #[inline(always)]
                 |_| {
                     for (b, (cdf, &offset)) in blocks {
-                        let first = g * SUM_GROUP + b * SUM_BLOCK;
-                        match cell {
-                            Some(cell) => {
-                                scatter_guide((cdf, Some(offset), first), cell, own, start)
-                            }
-                            None => cdf.iter_mut().for_each(|c| *c += offset),
+                        cdf.iter_mut().for_each(|c| *c += offset);
+                        if let Some(cell) = cell {
+                            let first = g * SUM_GROUP + b * SUM_BLOCK;
+                            scatter_guide(cdf, first, cell, own, start);
                         }
                     }
                 },
@@ -463,12 +461,7 @@ mod tests {
             assert_eq!(guide, expected, "case {case}");
             // Filled in one pass over the table, the same guide.
             let mut one_pass = vec![0; d.guide.len()];
-            fill_guide(
-                &mut d.cdf.to_vec(),
-                d.sum(),
-                (d.first, d.last),
-                &mut one_pass,
-            );
+            fill_guide(&d.cdf, d.sum(), (d.first, d.last), &mut one_pass);
             assert_eq!(&one_pass[..], &d.guide[..], "case {case}");
         }
     }

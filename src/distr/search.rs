@@ -96,14 +96,13 @@ pub(crate) fn guide_len(n: usize) -> usize {
 /// entries first, so each hit cell keeps its smallest index
 /// ([`scatter_guide`]); a cell no entry hits takes the answer of the next
 /// cell up ([`close_guide`]). Round-off here only costs a fallback search
-/// (see [`Search::bracket`]). `cdf` is borrowed mutably only because
-/// [`scatter_guide`] can offset the sums it reads; it is not changed.
-pub(crate) fn fill_guide(cdf: &mut [f64], sum: f64, range: (usize, usize), guide: &mut [u32]) {
+/// (see [`Search::bracket`]).
+pub(crate) fn fill_guide(cdf: &[f64], sum: f64, range: (usize, usize), guide: &mut [u32]) {
     let Some(cell) = GuideCell::new(guide.len(), sum) else {
         return;
     };
     guide.fill(u32::MAX);
-    scatter_guide((cdf, None, 0), cell, guide, 0);
+    scatter_guide(cdf, 0, cell, guide, 0);
     close_guide(guide, range);
 }
 
@@ -144,27 +143,25 @@ impl GuideCell {
     }
 }
 
-/// Adds `offset` (if any) to the running sums `cdf` (those of entries
-/// `first..`) and writes into `guide` (the cells from `start` on) the
-/// index of each into its cell, the last entries first, so that each cell
-/// keeps the smallest index that hits it; the cells are found [`SCATTER`]
-/// entries at a time, at SIMD width. Entries whose cell lies before `start` write
-/// nothing. As the sums never decrease, the guide can be filled block by
-/// block, the blocks taken last first: a block of entries whose first
-/// entry's cell is past the block before's last keeps to its own cells.
+/// Writes into `guide` (the cells from `start` on) the index of each of the
+/// running sums `cdf` (those of entries `first..`) into its cell, the last
+/// entries first, so that each cell keeps the smallest index that hits it;
+/// the cells are found [`SCATTER`] entries at a time, at SIMD width.
+/// Entries whose cell lies before `start` write nothing. As the sums never
+/// decrease, the guide can be filled block by block, the blocks taken last
+/// first: a block of entries whose first entry's cell is past the block
+/// before's last keeps to its own cells.
 #[inline(always)]
 pub(crate) fn scatter_guide(
-    (cdf, offset, first): (&mut [f64], Option<f64>, usize),
+    cdf: &[f64],
+    first: usize,
     cell: GuideCell,
     guide: &mut [u32],
     start: usize,
 ) {
     let mut cells = [0; SCATTER];
-    for (k, chunk) in cdf.chunks_mut(SCATTER).enumerate().rev() {
-        if let Some(offset) = offset {
-            chunk.iter_mut().for_each(|c| *c += offset);
-        }
-        for (to, &c) in cells.iter_mut().zip(&*chunk) {
+    for (k, chunk) in cdf.chunks(SCATTER).enumerate().rev() {
+        for (to, &c) in cells.iter_mut().zip(chunk) {
             *to = cell.of(c);
         }
         let first = first + k * SCATTER;

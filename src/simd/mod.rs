@@ -409,9 +409,10 @@ fn interleave<T: Copy, const M: usize>(columns: &[[T; BLOCK]; M], rows: &mut [[T
 /// [`map_rows`] arranges, and as the blocks of a page-aligned
 /// [`crate::buffer::Buffer`] are); otherwise with plain stores. For copies
 /// that are not read again soon: such stores skip reading each line before
-/// writing it. Follow the copies by [`store_fence`]. The width is read at run time on purpose: given as the
-/// dispatch's constant, LLVM merged the copy into the block's transpose,
-/// which cost the AVX2 warps of three components instructions per row.
+/// writing it. Follow the copies by [`store_fence`]. The width is read at
+/// run time on purpose: given as the dispatch's constant, LLVM merged the
+/// copy into the block's transpose, which cost the AVX2 warps of three
+/// components instructions per row.
 #[inline(always)]
 pub(crate) fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
     #[cfg(target_arch = "x86_64")]
