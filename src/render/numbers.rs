@@ -106,7 +106,8 @@ pub fn draws_light_choice(many_lights: bool, sampler: Sampler) -> bool {
 }
 
 /// The dimensions the shading of each path's vertex at `depth` asks for
-/// (`Bounce::shade` of [`super::wavefront`], in its order) under a sampler
+/// (its light sample's, then `Bounce::shade`'s, in [`super::wavefront`];
+/// in this order) under a sampler
 /// other than the independent one, into `out`: none at the last vertex;
 /// the light's choice (when `many_lights`, [`draws_light_choice`]) and
 /// position unless only the BSDF is sampled; the BSDF's direction and

@@ -5,12 +5,12 @@
 //! loop while paths remain:
 //!   numbers the numbers the shading below will ask for, drawn together
 //!           (samplers other than the independent one: `sampler::batch`)
-//!   shade   each path at its hit: emission, a light sample (its shadow
-//!           ray kept for later; an environment map's draw left for the
-//!           next step), a BSDF sample (the next ray), roulette
-//!   light   the environment-map light samples of the bounce, drawn
-//!           together (`CellSampler::sample_many`, or by inversion
-//!           `EnvMap::sample_into` for the other samplers)
+//!   light   each path's light sample, drawn before its shading: the
+//!           environment map's together (`CellSampler::sample_many`, or
+//!           by inversion `EnvMap::sample_into` for the other samplers)
+//!   shade   each path at its hit: emission, its light sample's light
+//!           (the shadow ray kept for later), a BSDF sample (the next
+//!           ray), roulette
 //!   occlude every shadow ray of the batch, one stream; add the light of
 //!           those that reach it
 //!   trace   every next ray, one stream; rays that leave the scene go to
@@ -87,18 +87,6 @@ struct Unshadowed {
     s: f32,
 }
 
-/// A shading point as a light sample sees it.
-#[derive(Clone, Copy, Debug)]
-struct Vertex {
-    slot: u32,
-    time: f32,
-    beta: [f32; 3],
-    p: Vec3A,
-    ng: Vec3A,
-    frame: Frame<f32>,
-    view: PhongView<f32>,
-}
-
 /// A camera sample that starts a path.
 #[derive(Clone, Debug)]
 pub struct CameraSample {
@@ -134,13 +122,15 @@ pub struct Wavefront {
     shadows: Vec<Unshadowed>,
     shadow_rays: Vec<Ray>,
     blocked: Vec<bool>,
-    /// The vertices whose environment-map light samples are left for the
-    /// batch's others, by the map's cell sampler (its bits and the point's
-    /// numbers) or by inversion (the numbers).
+    /// The paths whose environment-map light samples are drawn together,
+    /// by the map's cell sampler (its bits and the point's numbers) or by
+    /// inversion (the numbers).
     by_cells: Waiting<(u64, [f32; 2])>,
     by_inversion: Waiting<[f64; 2]>,
     env_samples: Vec<EnvSample<f32>>,
     inverted: InvertedSamples,
+    /// The light sample of each path's vertex at this bounce (none under
+    /// BSDF sampling, and at the last vertex).
     light_samples: Vec<Option<LightSample>>,
     /// The numbers of the bounce drawn beforehand (the samplers other than
     /// the independent one): the dimensions every path's vertex asks for,
@@ -175,9 +165,9 @@ impl Wavefront {
             self.shadows,
             self.shadow_rays,
             self.blocked,
-            self.by_cells.vertices,
+            self.by_cells.at,
             self.by_cells.draws,
-            self.by_inversion.vertices,
+            self.by_inversion.at,
             self.by_inversion.draws,
             self.env_samples,
             self.light_samples
@@ -233,8 +223,6 @@ impl Wavefront {
             self.rays.clear();
             self.shadows.clear();
             self.shadow_rays.clear();
-            self.by_cells.clear();
-            self.by_inversion.clear();
             // The surfaces first, in a loop of their own: the reads of
             // the hit primitives overlap.
             self.surfaces.clear();
@@ -259,6 +247,7 @@ impl Wavefront {
                 let samples = self.paths.iter().map(|p| (p.pixel, p.index));
                 self.drawn.draw(streams, samples, &self.dims)?;
             }
+            self.sample_lights(scene, settings, streams, depth);
             // Each path shaded in place; those that stop are removed, the
             // others keep their order (so that they line up with their rays
             // in `self.rays`, then with `self.found`).
@@ -280,39 +269,16 @@ impl Wavefront {
                     settings,
                     shadows: &mut self.shadows,
                     shadow_rays: &mut self.shadow_rays,
-                    by_cells: &mut self.by_cells,
-                    by_inversion: &mut self.by_inversion,
                 };
                 let l = &mut l[path.slot as usize];
-                let goes_on = bounce.shade(path, (hit.t, *surface), &mut numbers, l);
+                let ls = self.light_samples.get(k).and_then(Option::as_ref);
+                let goes_on = bounce.shade(path, (hit.t, *surface), ls, &mut numbers, l);
                 swap_generators(numbers.stream, path);
                 if goes_on {
                     self.rays.push(path.ray);
                 }
                 goes_on
             });
-            // The deferred environment samples, together: their table reads
-            // overlap, and their directions are computed at SIMD width.
-            self.light_samples.clear();
-            scene.sample_environment_cells(
-                &self.by_cells.draws,
-                &mut self.env_samples,
-                &mut self.light_samples,
-                settings.env_density(),
-            );
-            scene.sample_environment_inverted(
-                &self.by_inversion.draws,
-                &mut self.inverted,
-                &mut self.light_samples,
-                settings.env_density(),
-            );
-            let waiting = (self.by_cells.vertices.iter()).chain(&self.by_inversion.vertices);
-            debug_assert_eq!(self.light_samples.len(), waiting.clone().count());
-            for (vertex, ls) in waiting.zip(&self.light_samples) {
-                if let Some(ls) = ls {
-                    vertex.connect(ls, settings, &mut self.shadows, &mut self.shadow_rays);
-                }
-            }
             self.blocked.clear();
             scene
                 .accel()
@@ -373,6 +339,81 @@ impl Wavefront {
         Ok(())
     }
 
+    /// The light sample of each path's vertex at `depth`, into
+    /// `self.light_samples` (one per path; none under BSDF sampling or at
+    /// the last vertex), drawn before the shading: the light's choice and
+    /// position numbers (then, for an environment map's cell sampler, 64
+    /// random bits) are the first the vertex asks for. The environment
+    /// map's samples are drawn together: their table reads overlap, and
+    /// their directions are computed at SIMD width.
+    fn sample_lights(
+        &mut self,
+        scene: &Scene,
+        settings: &Settings,
+        streams: &mut [Stream],
+        depth: u32,
+    ) {
+        let Wavefront {
+            paths,
+            surfaces,
+            dims: wanted,
+            drawn,
+            by_cells,
+            by_inversion,
+            env_samples,
+            inverted,
+            light_samples,
+            ..
+        } = self;
+        light_samples.clear();
+        by_cells.clear();
+        by_inversion.clear();
+        if depth + 1 >= settings.max_depth() || settings.strategy == Strategy::Bsdf {
+            return;
+        }
+        light_samples.resize(paths.len(), None);
+        let many = scene.chooses_among_lights();
+        let density = settings.env_density();
+        for (k, (path, (_, sp))) in paths.iter_mut().zip(&*surfaces).enumerate() {
+            let stream = &mut streams[path.pixel as usize];
+            stream.start(path.index);
+            swap_generators(stream, path);
+            let mut numbers = Numbers::new(stream, (&wanted[..], &drawn.values[..]), k);
+            let choice = if draws_light_choice(many, numbers.stream.sampler()) {
+                numbers.get1(dims::bounce(depth, dims::LIGHT_CHOICE))
+            } else {
+                0.0
+            };
+            let u = numbers.get2(dims::bounce(depth, dims::LIGHT_POSITION));
+            // The independent sampler picks environment cells from extra
+            // random bits (an alias table); the others by inversion, which
+            // keeps their stratification.
+            if let Some(light) = scene.choose_light(choice, density) {
+                let bits = light
+                    .cells()
+                    .and(numbers.independent())
+                    .map(|r| r.next_u64());
+                match bits {
+                    // A map's cell: drawn with the bounce's others.
+                    Some(bits) => by_cells.push(k, (bits, u)),
+                    // A map by inversion (the other samplers, or a map
+                    // without cells): likewise.
+                    None if light.is_environment() && scene.environment_map().is_some() => {
+                        by_inversion.push(k, u.map(f64::from));
+                    }
+                    None => light_samples[k] = scene.sample_chosen(light, sp.p, u, None),
+                }
+            }
+            swap_generators(numbers.stream, path);
+        }
+        scene.sample_environment_cells(&by_cells.draws, env_samples, density, |i, ls| {
+            light_samples[by_cells.at[i] as usize] = ls;
+        });
+        scene.sample_environment_inverted(&by_inversion.draws, inverted, density, |i, ls| {
+            light_samples[by_inversion.at[i] as usize] = ls;
+        });
+    }
+
     /// Ends every path in flight: those whose next ray leaves the scene go
     /// to the escaped rays, the others stop (their next vertex, the last,
     /// would not emit).
@@ -422,22 +463,20 @@ struct Bounce<'a> {
     settings: &'a Settings,
     shadows: &'a mut Vec<Unshadowed>,
     shadow_rays: &'a mut Vec<Ray>,
-    by_cells: &'a mut Waiting<(u64, [f32; 2])>,
-    by_inversion: &'a mut Waiting<[f64; 2]>,
 }
 
-/// Vertices whose environment-map light samples wait for the bounce's
-/// others, with the numbers of each draw.
+/// The paths (their indices in the bounce) whose environment-map light
+/// samples are drawn together, with the numbers of each draw.
 #[derive(Debug)]
 struct Waiting<D> {
-    vertices: Vec<Vertex>,
+    at: Vec<u32>,
     draws: Vec<D>,
 }
 
 impl<D> Default for Waiting<D> {
     fn default() -> Self {
         Waiting {
-            vertices: Vec::new(),
+            at: Vec::new(),
             draws: Vec::new(),
         }
     }
@@ -445,64 +484,61 @@ impl<D> Default for Waiting<D> {
 
 impl<D> Waiting<D> {
     fn clear(&mut self) {
-        self.vertices.clear();
+        self.at.clear();
         self.draws.clear();
     }
 
-    fn push(&mut self, vertex: Vertex, draw: D) {
-        self.vertices.push(vertex);
+    fn push(&mut self, path: usize, draw: D) {
+        self.at.push(path as u32);
         self.draws.push(draw);
     }
 }
 
-impl Vertex {
-    /// The light sample `ls` seen from this vertex: its light (BSDF,
-    /// cosine, MIS weight), kept with its shadow ray when it carries any.
+impl Bounce<'_> {
+    /// The light sample `ls` seen from `path`'s shading point `sp` (its
+    /// shading `frame` and BSDF `view`): its light (BSDF, cosine, MIS
+    /// weight), kept with its shadow ray when it carries any.
     #[inline]
     fn connect(
-        &self,
+        &mut self,
+        path: &Path,
+        sp: &SurfacePoint,
+        (frame, view): (&Frame<f32>, &PhongView<f32>),
         ls: &LightSample,
-        settings: &Settings,
-        shadows: &mut Vec<Unshadowed>,
-        shadow_rays: &mut Vec<Ray>,
     ) {
-        let wo = self.frame.to_local(ls.d.to_array());
-        let (f, pdf_wo) = self.view.eval_pdf_one(wo);
+        let wo = frame.to_local(ls.d.to_array());
+        let (f, pdf_wo) = view.eval_pdf_one(wo);
         if f.iter().any(|&v| v > 0.0) {
-            let w = if settings.strategy == Strategy::Mis {
-                settings.weight(ls.pdf, pdf_wo)
+            let w = if self.settings.strategy == Strategy::Mis {
+                self.settings.weight(ls.pdf, pdf_wo)
             } else {
                 1.0
             };
-            shadows.push(Unshadowed {
-                slot: self.slot,
-                time: self.time,
-                beta: self.beta,
+            self.shadows.push(Unshadowed {
+                slot: path.slot,
+                time: path.time,
+                beta: path.beta,
                 fc: mul(f, ls.radiance),
                 s: w * wo[2].abs() / ls.pdf,
             });
-            shadow_rays.push(shadow_ray(self.p, self.ng, ls));
+            self.shadow_rays.push(shadow_ray(sp.p, sp.ng, ls));
         }
     }
-}
 
-impl Bounce<'_> {
     /// The vertex where `path.ray` meets the scene (at distance `t`, on
-    /// `shape` at `sp`): its emission
-    /// added to `l`, its light sample kept (with its shadow ray) when it
-    /// carries light, and `path` moved on to its next ray. Whether the
-    /// path goes on.
+    /// `shape` at `sp`): its emission added to `l`, the light of its light
+    /// sample `ls` kept (with its shadow ray) when it carries any, and
+    /// `path` moved on to its next ray. Whether the path goes on.
     #[inline]
     fn shade(
-        self,
+        mut self,
         path: &mut Path,
         (t, (shape, sp)): (f32, (u32, SurfacePoint)),
+        ls: Option<&LightSample>,
         numbers: &mut Numbers,
         l: &mut [f32; 3],
     ) -> bool {
-        let Bounce {
-            scene, settings, ..
-        } = self;
+        let (scene, settings) = (self.scene, self.settings);
         let (ray, depth) = (path.ray, path.depth);
         let wi = -ray.d;
         if let Some(le) = scene.emitted(shape, sp.ng, wi) {
@@ -518,44 +554,8 @@ impl Bounce<'_> {
         let (frame, view) = shading(scene, shape, sp.ns, wi, numbers.stream.sampler());
 
         if settings.strategy != Strategy::Bsdf {
-            let many = scene.chooses_among_lights();
-            let choice = if draws_light_choice(many, numbers.stream.sampler()) {
-                numbers.get1(dims::bounce(depth, dims::LIGHT_CHOICE))
-            } else {
-                0.0
-            };
-            let [u1, u2] = numbers.get2(dims::bounce(depth, dims::LIGHT_POSITION));
-            // The independent sampler picks environment cells from extra
-            // random bits (an alias table); the others by inversion, which
-            // keeps their stratification.
-            if let Some(light) = scene.choose_light(choice, settings.env_density()) {
-                let bits = light
-                    .cells()
-                    .and(numbers.independent())
-                    .map(|r| r.next_u64());
-                let vertex = Vertex {
-                    slot: path.slot,
-                    time: path.time,
-                    beta: path.beta,
-                    p: sp.p,
-                    ng: sp.ng,
-                    frame,
-                    view,
-                };
-                match bits {
-                    // A map's cell: drawn with the batch's others.
-                    Some(bits) => self.by_cells.push(vertex, (bits, [u1, u2])),
-                    // A map by inversion (the other samplers, or a map
-                    // without cells): likewise.
-                    None if light.is_environment() && scene.environment_map().is_some() => {
-                        self.by_inversion.push(vertex, [u1, u2].map(f64::from));
-                    }
-                    None => {
-                        if let Some(ls) = scene.sample_chosen(light, sp.p, [u1, u2], None) {
-                            vertex.connect(&ls, settings, self.shadows, self.shadow_rays);
-                        }
-                    }
-                }
+            if let Some(ls) = ls {
+                self.connect(path, &sp, (&frame, &view), ls);
             }
             // Under emitter sampling, the next vertex's emission is not
             // counted: when it would be the last, stop here.

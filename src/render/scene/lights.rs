@@ -375,14 +375,15 @@ impl Scene {
     /// The environment drawn by `density` (by that density's cell sampler,
     /// [`ChosenLight::cells`]) for each `(bits, u)` of `draws`: the
     /// samples [`Scene::sample_chosen`] draws one at a time, drawn
-    /// together ([`CellSampler::sample_many`]) and appended to `out`
-    /// (`scratch`: the map's samples); nothing without a cell sampler.
+    /// together ([`CellSampler::sample_many`]) and handed to `put` with
+    /// their draw's index (`scratch`: the map's samples); nothing without
+    /// a cell sampler.
     pub fn sample_environment_cells(
         &self,
         draws: &[(u64, [f32; 2])],
         scratch: &mut Vec<EnvSample<f32>>,
-        out: &mut Vec<Option<LightSample>>,
         density: EnvDensity,
+        mut put: impl FnMut(usize, Option<LightSample>),
     ) {
         let Some(EnvDraw {
             env: Environment::Map(env),
@@ -394,24 +395,25 @@ impl Scene {
         let pmf = self.choice_pmf(self.env_light);
         scratch.clear();
         cells.sample_many(env, draws, scratch);
-        out.extend(
-            scratch
-                .iter()
-                .map(|s| environment_sample(Vec3A::from(s.direction), s.pdf, pmf, s.radiance)),
-        );
+        for (i, s) in scratch.iter().enumerate() {
+            put(
+                i,
+                environment_sample(Vec3A::from(s.direction), s.pdf, pmf, s.radiance),
+            );
+        }
     }
 
     /// The environment drawn by `density`, by inversion (no cells), for
     /// each `u` of `us`: the samples [`Scene::sample_chosen`] draws one at
     /// a time, drawn together ([`EnvMap::sample_into`], in `f64` as one
-    /// draw is) and appended to `out` (`scratch`: the map's samples);
-    /// nothing when the environment is not a map.
+    /// draw is) and handed to `put` with their draw's index (`scratch`: the
+    /// map's samples); nothing when the environment is not a map.
     pub fn sample_environment_inverted(
         &self,
         us: &[[f64; 2]],
         scratch: &mut InvertedSamples,
-        out: &mut Vec<Option<LightSample>>,
         density: EnvDensity,
+        mut put: impl FnMut(usize, Option<LightSample>),
     ) {
         let Some(EnvDraw {
             env: Environment::Map(env),
@@ -438,7 +440,7 @@ impl Scene {
             weight,
         };
         env.sample_into(us, samples);
-        out.extend((0..us.len()).map(|i| {
+        for i in 0..us.len() {
             let s = EnvSample {
                 direction: direction[i],
                 pdf: pdf[i],
@@ -446,8 +448,8 @@ impl Scene {
                 radiance: [0.0; 3],
             };
             let (d, pdf, radiance) = Environment::of_inversion(s);
-            environment_sample(d, pdf, pmf, radiance)
-        }));
+            put(i, environment_sample(d, pdf, pmf, radiance));
+        }
     }
 
     /// The environment map, when the scene's environment is one.

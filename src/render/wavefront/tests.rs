@@ -12,7 +12,10 @@ use crate::sampler::Sampler;
 use crate::sampler::zorder::ZOrder;
 
 /// A floor, a box on it, a spherical light over it and a sky: a
-/// constant one, or a map (whose cells are drawn by the batch).
+/// constant one, or a map (whose samples are drawn by the batch), dim
+/// enough that emitter sampling draws it and the light about equally
+/// often (so that the paths that wait for the map's samples are not all
+/// of them).
 fn scene(map: bool) -> Scene {
     let still = |geometry, rho| Shape {
         geometry,
@@ -33,7 +36,7 @@ fn scene(map: bool) -> Scene {
     let sky = if map {
         let (w, h) = (16, 8);
         let texels: Vec<f32> = (0..w * h * 3)
-            .map(|i| 0.2 + ((i * 7919) % 13) as f32 / 13.0)
+            .map(|i| 2e-4 + ((i * 7919) % 13) as f32 / 13e3)
             .collect();
         let env = EnvMap::new(w, h, &texels, Options::default()).unwrap();
         Environment::Map(Arc::new(env))
