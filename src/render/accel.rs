@@ -472,6 +472,32 @@ impl Accel {
     pub fn bounds(&self) -> Option<(Vec3A, Vec3A)> {
         self.bounds.map(|b| (b.min, b.max))
     }
+
+    /// Whether the primitives are one leaf (at most [`LEAF_MAX`], all
+    /// tested against each ray).
+    pub fn is_leaf(&self) -> bool {
+        self.embree.is_none() && self.bvh.is_none()
+    }
+
+    /// The primitives `ids` alone, all tested against each ray (for a few
+    /// of them: [`Subset`]).
+    pub fn subset(&self, ids: &[u32]) -> Subset {
+        Subset(Leaf::new(&self.primitives, ids, &self.meshes))
+    }
+}
+
+/// A few of a scene's primitives (an area light's, say), all tested
+/// against each ray, a block of rays at a time at SIMD width, without the
+/// rest of the scene.
+pub struct Subset(Leaf);
+
+impl Subset {
+    /// The nearest hit of each ray of `rays` on these primitives (primitive
+    /// numbers as in the whole scene), into `hits` (of the same length).
+    pub fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        hits.fill(None);
+        self.0.intersect_many(rays, hits);
+    }
 }
 
 /// The number among `primitives` of each mesh's first face (0 for a mesh

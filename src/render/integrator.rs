@@ -25,7 +25,7 @@ use glam::Vec3A;
 
 use super::accel::Hit;
 use super::scene::{EnvDensity, LightSample, Scene};
-use super::shape::Ray;
+use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
 use crate::frame::Frame;
 use crate::phong::PhongView;
@@ -181,15 +181,21 @@ pub(crate) fn shadow_ray(p: Vec3A, n: Vec3A, ls: &LightSample) -> Ray {
             d: ls.d,
             tmax: f32::INFINITY,
         },
-        Some((y, _)) => {
-            let to = offset(y.p, y.ng, -ls.d) - o;
-            let tmax = to.length();
-            Ray {
-                o,
-                d: if tmax > 0.0 { to / tmax } else { ls.d },
-                tmax,
-            }
-        }
+        Some((y, _)) => ray_to(o, &y, ls.d),
+    }
+}
+
+/// The ray from `o` to the surface point `y`, which lies along `d` from
+/// `o`: it ends at `y` moved off its surface toward `o` by [`offset`], so
+/// that `y`'s own surface cannot block it.
+#[inline]
+pub(crate) fn ray_to(o: Vec3A, y: &SurfacePoint, d: Vec3A) -> Ray {
+    let to = offset(y.p, y.ng, -d) - o;
+    let tmax = to.length();
+    Ray {
+        o,
+        d: if tmax > 0.0 { to / tmax } else { d },
+        tmax,
     }
 }
 

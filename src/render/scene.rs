@@ -4,8 +4,7 @@
 
 use glam::Vec3A;
 
-use super::accel::Accel;
-use super::accel::Hit;
+use super::accel::{Accel, Hit, LEAF_MAX, Subset};
 use super::camera::Camera;
 pub use super::environment::Environment;
 use super::filter::{FilmFilter, Filter};
@@ -77,6 +76,9 @@ pub struct Scene {
     emission: Vec<Option<[f32; 3]>>,
     /// Whether any shape emits (asked once a bounce).
     area_lights: bool,
+    /// The area lights' primitives, when they are few
+    /// ([`Scene::emitters`]).
+    emitters: Option<Subset>,
     light_of_shape: Vec<Option<u32>>,
     environment: Option<Environment>,
     env_light: Option<u32>,
@@ -208,11 +210,19 @@ impl Scene {
         let light_choice = (!powers.is_empty())
             .then(|| Discrete1D::new(&powers))
             .transpose()?;
+        let emitting = lights.iter().filter_map(|light| match light {
+            Light::Area(a) => Some(a.first..a.first + a.count),
+            Light::Environment(_) => None,
+        });
+        let ids: Vec<u32> = emitting.flatten().take(LEAF_MAX + 1).collect();
+        let few = ids.is_empty() || ids.len() <= LEAF_MAX && !accel.is_leaf();
+        let emitters = few.then(|| accel.subset(&ids));
         Ok(Scene {
             accel,
             materials,
             spheres,
             area_lights: emission.iter().any(Option::is_some),
+            emitters,
             emission,
             light_of_shape,
             environment,
@@ -287,6 +297,17 @@ impl Scene {
     #[inline]
     pub fn has_area_lights(&self) -> bool {
         self.area_lights
+    }
+
+    /// The primitives of the area lights (of nonzero radiance; none in a
+    /// scene without area lights), when the nearest of them a ray meets is
+    /// better found without the rest of the scene: when they are at most
+    /// [`LEAF_MAX`] (as many as the ray tracer tests one by one rather
+    /// than by a BVH), in a scene that is more than one such leaf (in one
+    /// leaf, the nearest hit costs no more than an any-hit test).
+    #[inline]
+    pub fn emitters(&self) -> Option<&Subset> {
+        self.emitters.as_ref()
     }
 
     /// Whether the shape `hit` is on is an area light: [`Scene::is_emitter`]

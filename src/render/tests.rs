@@ -311,14 +311,32 @@ fn lights_at(m: Affine3A) -> Vec<(&'static str, Geometry, f64)> {
 /// Every light shape at every placement, rendered by BSDF sampling,
 /// emitter sampling and MIS: the radiance of the lit floor point is
 /// `ρ/π · E` (E the irradiance in closed form or by quadrature), within 5
-/// standard errors and 0.2 %.
+/// standard errors and 0.2 %. A small box under the floor, in no ray's
+/// way, makes the scene more than one leaf of primitives: the
+/// BSDF-sampled rays then find the lights of a few primitives as last
+/// vertices do in large scenes ([`Scene::emitters`]), the cube's (twelve
+/// triangles) by their nearest hit.
 #[test]
 fn direct_light_from_every_shape_matches_its_irradiance() {
     let rho = 0.6;
     let from = Vec3A::new(-0.01, 0.004, 0.01);
+    let under_the_floor = Affine3A::from_scale_rotation_translation(
+        Vec3::splat(0.1),
+        Quat::IDENTITY,
+        Vec3::new(0.0, 0.0, -5.0),
+    );
     for (place, m) in placements() {
         for (shape, geometry, e) in lights_at(m) {
-            let scene = floor_scene(rho, vec![light(geometry, 1.0)]);
+            let clutter = Shape {
+                geometry: cube(under_the_floor),
+                material: diffuse(0.5),
+                emission: None,
+                motion: None,
+            };
+            let scene = floor_scene(rho, vec![light(geometry, 1.0), clutter]);
+            assert!(!scene.accel().is_leaf());
+            let few = shape != "cube";
+            assert_eq!(scene.emitters().is_some(), few, "{shape}");
             let expected = rho / std::f64::consts::PI * e;
             for (strategy, sampler) in strategies_and_samplers() {
                 let n = if strategy == Strategy::Bsdf && place != "near" {

@@ -16,8 +16,10 @@
 //!   trace   every next ray, one stream; rays that leave the scene go to
 //!           the batch's escaped rays ([`Escaped`]). Toward the last
 //!           vertex, where only an area light's emission counts, a ray
-//!           that meets another shape ends its path; in a scene without
-//!           area lights these rays are tested as shadow rays are
+//!           that meets another shape ends its path: when the scene's
+//!           area lights are a few primitives, the nearest of them on
+//!           the ray is found alone, and the ray is tested as shadow
+//!           rays are, up to it (or without end)
 //! ```
 //!
 //! Each ray tracer call then serves hundreds of rays: Embree's streams, and
@@ -32,11 +34,11 @@
 
 use glam::Vec3A;
 
-use super::accel::Hit;
+use super::accel::{Hit, Subset};
 use super::embree;
 use super::integrator::{
     Escaped, Integrator, Settings, Strategy, add_scaled, dims, emission_weight, mul, offset,
-    shading, shadow_ray,
+    ray_to, shading, shadow_ray,
 };
 use super::numbers::{Numbers, bounce_dims, draws_light_choice};
 use super::scene::{InvertedSamples, LightSample, Scene};
@@ -295,12 +297,11 @@ impl Wavefront {
                 }
             }
             // The next rays lead to the last vertex: only an area light's
-            // emission counts there. In a scene without area lights, only
-            // whether they leave the scene counts, which the shadow rays'
-            // test answers.
+            // emission counts there, and whether a ray reaches one (or
+            // leaves the scene) is a shadow ray's test.
             let last = depth + 2 >= settings.max_depth();
-            if last && !scene.has_area_lights() {
-                self.escape_or_end(scene, settings)?;
+            if let Some(emitters) = scene.emitters().filter(|_| last) {
+                self.last_vertices(scene, settings, emitters)?;
                 continue;
             }
             self.found.clear();
@@ -414,26 +415,52 @@ impl Wavefront {
         });
     }
 
-    /// Ends every path in flight: those whose next ray leaves the scene go
-    /// to the escaped rays, the others stop (their next vertex, the last,
-    /// would not emit).
+    /// The last vertex of every path in flight, where only an area
+    /// light's emission counts. A path whose ray meets one of the
+    /// `emitters` (the nearest of them) with nothing before it keeps that
+    /// hit (its emission is added at the next step); one whose ray leaves
+    /// the scene goes to the escaped rays; the others end. Each ray is
+    /// tested as a shadow ray is (an any-hit test, cheaper than finding the
+    /// nearest hit): toward its emitter's point, moved off that surface
+    /// ([`ray_to`]), or without end.
     ///
     /// # Errors
     /// [`crate::Error::Memory`] as [`Wavefront::trace`].
-    fn escape_or_end(&mut self, scene: &Scene, settings: &Settings) -> Result<()> {
-        debug_assert!(!scene.has_area_lights());
+    fn last_vertices(
+        &mut self,
+        scene: &Scene,
+        settings: &Settings,
+        emitters: &Subset,
+    ) -> Result<()> {
+        self.found.clear();
+        self.found.resize(self.rays.len(), None);
+        emitters.intersect_many(&self.rays, &mut self.found);
+        for ((ray, path), found) in self.rays.iter_mut().zip(&self.paths).zip(&self.found) {
+            if let Some(hit) = found {
+                let (_, y) = scene.surface(ray, hit, path.time);
+                *ray = ray_to(ray.o, &y, ray.d);
+            }
+        }
         self.blocked.clear();
         scene
             .accel()
             .occluded_many(&self.rays, &mut self.stream, &mut self.blocked)?;
-        for (path, &blocked) in self.paths.iter().zip(&self.blocked) {
-            let blocked = blocked || scene.moves() && scene.movers_occlude(&path.ray, path.time);
-            if !blocked {
-                escape(scene, settings, &mut self.escaped, path);
-            }
-        }
-        self.paths.clear();
         self.hits.clear();
+        let mut tests = self.rays.iter().zip(&self.blocked).zip(&self.found);
+        self.paths.retain(|path| {
+            let Some(((ray, &blocked), &found)) = tests.next() else {
+                debug_assert!(false, "a path without its ray");
+                return false;
+            };
+            if blocked || scene.moves() && scene.movers_occlude(ray, path.time) {
+                return false;
+            }
+            match found {
+                Some(hit) => self.hits.push(hit),
+                None => escape(scene, settings, &mut self.escaped, path),
+            }
+            found.is_some()
+        });
         Ok(())
     }
 }
