@@ -106,8 +106,8 @@ pub fn draws_light_choice(many_lights: bool, sampler: Sampler) -> bool {
 }
 
 /// The dimensions the shading of each path's vertex at `depth` asks for
-/// (its light sample's, then `Bounce::shade`'s, in [`super::wavefront`];
-/// in this order) under a sampler
+/// (its light sample's in `Wavefront::sample_lights`, then
+/// `Bounce::shade`'s, in this order: [`super::wavefront`]) under a sampler
 /// other than the independent one, into `out`: none at the last vertex;
 /// the light's choice (when `many_lights`, [`draws_light_choice`]) and
 /// position unless only the BSDF is sampled; the BSDF's direction and

@@ -74,8 +74,6 @@ pub struct Scene {
     /// [`super::integrator::shading`]).
     spheres: Vec<bool>,
     emission: Vec<Option<[f32; 3]>>,
-    /// Whether any shape emits (asked once a bounce).
-    area_lights: bool,
     /// The area lights' primitives, when they are few
     /// ([`Scene::emitters`]).
     emitters: Option<Subset>,
@@ -221,7 +219,6 @@ impl Scene {
             accel,
             materials,
             spheres,
-            area_lights: emission.iter().any(Option::is_some),
             emitters,
             emission,
             light_of_shape,
@@ -293,18 +290,16 @@ impl Scene {
         )
     }
 
-    /// Whether any shape is an area light.
-    #[inline]
-    pub fn has_area_lights(&self) -> bool {
-        self.area_lights
-    }
-
-    /// The primitives of the area lights (of nonzero radiance; none in a
-    /// scene without area lights), when the nearest of them a ray meets is
-    /// better found without the rest of the scene: when they are at most
-    /// [`LEAF_MAX`] (as many as the ray tracer tests one by one rather
-    /// than by a BVH), in a scene that is more than one such leaf (in one
-    /// leaf, the nearest hit costs no more than an any-hit test).
+    /// The primitives of the area lights (those of nonzero power), when
+    /// the nearest of them a ray meets is better found without the rest of
+    /// the scene: when they are at most [`LEAF_MAX`] (as many as the ray
+    /// tracer tests one by one rather than by a BVH) in a scene that is
+    /// more than one such leaf (in one leaf, the nearest hit costs no more
+    /// than an any-hit test), and always when there are none (an empty
+    /// subset: a ray then only leaves the scene or not). Their triangles
+    /// are tested as the leaf tests them, which is not watertight as
+    /// Embree's robust test is: a ray through the edge two of them share
+    /// may miss both.
     #[inline]
     pub fn emitters(&self) -> Option<&Subset> {
         self.emitters.as_ref()

@@ -362,6 +362,56 @@ fn direct_light_from_every_shape_matches_its_irradiance() {
     }
 }
 
+/// At the last vertex, a BSDF-sampled ray counts the light of the nearest
+/// emitter it meets with nothing before it (moving shapes placed where
+/// they are at the path's time): with a small light in front of a larger,
+/// brighter one and a moving box hiding part of both at time 0, in a scene
+/// of more than one leaf ([`Scene::emitters`]), BSDF sampling agrees with
+/// emitter sampling (whose shadow rays are tested apart) within 5
+/// standard errors of their difference.
+#[test]
+fn last_vertices_see_the_nearest_light_past_moving_shapes() {
+    use crate::render::motion::Motion;
+    use glam::DAffine3;
+    let shape = |geometry, motion| Shape {
+        geometry,
+        material: diffuse(0.5),
+        emission: None,
+        motion,
+    };
+    let placed = |scale: Vec3, at: Vec3| {
+        Affine3A::from_scale_rotation_translation(scale, Quat::IDENTITY, at)
+    };
+    let away = DAffine3::from_translation(DVec3::new(0.0, 0.0, 50.0));
+    let lights = vec![
+        light(Geometry::sphere([0.0, 0.0, 2.0], 0.3, false).unwrap(), 1.0),
+        light(Geometry::sphere([0.1, 0.0, 3.5], 0.8, false).unwrap(), 4.0),
+        // Under the floor, in no ray's way: more than one leaf.
+        shape(cube(placed(Vec3::splat(0.1), -5.0 * Vec3::Z)), None),
+        shape(
+            cube(placed(Vec3::new(0.3, 0.3, 0.05), Vec3::new(0.25, 0.0, 1.0))),
+            Some(Motion::new("to_world", DAffine3::IDENTITY, away).unwrap()),
+        ),
+    ];
+    let scene = floor_scene(0.6, lights);
+    assert!(scene.emitters().is_some() && scene.moves());
+    let from = Vec3A::new(-0.01, 0.004, 0.01);
+    let [(b, sb), (e, se)] = [Strategy::Bsdf, Strategy::Emitter].map(|t| {
+        estimate(
+            &scene,
+            from,
+            Vec3A::ZERO,
+            &settings(Integrator::Direct, t),
+            1 << 20,
+        )
+    });
+    assert!(
+        (b - e).abs() < 5.0 * sb.hypot(se),
+        "BSDF {b} ± {sb}, emitter {e} ± {se}"
+    );
+    assert!(sb < 0.01 * b, "{b} ± {sb}");
+}
+
 /// From a receiver at any distance and angle, the shadow ray toward a
 /// light sample is never blocked by the light itself or by the receiver's
 /// own surface (nothing else is in the scene).

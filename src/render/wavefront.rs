@@ -118,7 +118,8 @@ pub struct Wavefront {
     /// point there.
     hits: Vec<Hit>,
     surfaces: Vec<(u32, SurfacePoint)>,
-    /// What the stream of next rays found.
+    /// What the stream of next rays found (toward the last vertex, the
+    /// nearest emitter on each: [`Wavefront::last_vertices`]).
     found: Vec<Option<Hit>>,
     rays: Vec<Ray>,
     shadows: Vec<Unshadowed>,
@@ -298,7 +299,9 @@ impl Wavefront {
             }
             // The next rays lead to the last vertex: only an area light's
             // emission counts there, and whether a ray reaches one (or
-            // leaves the scene) is a shadow ray's test.
+            // leaves the scene) is a shadow ray's test when the scene's
+            // emitters are few (`Scene::emitters`); else by the nearest
+            // hit, below.
             let last = depth + 2 >= settings.max_depth();
             if let Some(emitters) = scene.emitters().filter(|_| last) {
                 self.last_vertices(scene, settings, emitters)?;

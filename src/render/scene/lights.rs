@@ -395,6 +395,7 @@ impl Scene {
         let pmf = self.choice_pmf(self.env_light);
         scratch.clear();
         cells.sample_many(env, draws, scratch);
+        debug_assert_eq!(scratch.len(), draws.len());
         for (i, s) in scratch.iter().enumerate() {
             put(
                 i,
