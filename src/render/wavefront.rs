@@ -180,6 +180,7 @@ impl Wavefront {
     }
 
     /// Starts the path of camera sample `c`.
+    #[inline]
     pub fn push(&mut self, scene: &Scene, settings: &Settings, c: CameraSample) {
         if settings.max_depth() == 0 {
             return;
