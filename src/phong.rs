@@ -82,6 +82,9 @@ pub struct PhongSamples<'a, F, C> {
 /// lobe a float can resolve: `cosⁿ` of the nearest angle below 1 is 0.)
 pub const MAX_EXPONENT: f64 = 1e30;
 
+/// The number of [`Phong::view_terms`].
+pub const VIEW_TERMS: usize = 9;
+
 /// Rows per block of [`PhongView::sample_rows`]: its numbers and samples
 /// stay in the L1 cache.
 const SAMPLE_BLOCK: usize = 256;
@@ -162,19 +165,32 @@ impl Phong {
     /// `wi` shares, computed once in the kernel's float type.
     #[inline(always)]
     pub fn view<F: Real>(&self, wi: V3<F>) -> PhongView<F> {
-        let mirror = reflect(wi);
+        PhongView::from_terms(wi, self.view_terms())
+    }
+
+    /// The terms of [`Phong::view`] that do not depend on `wi`, in `F`, as
+    /// one row of numbers: `[n, p_d, ρd/π (3), ρs·(n + 2)/(2π) (3), (n +
+    /// 1)/(2π)]`. A batch kernel over the views of several BRDFs reads
+    /// them with its other numbers ([`PhongView::from_terms`]).
+    #[inline(always)]
+    pub fn view_terms<F: Real>(&self) -> [F; VIEW_TERMS] {
         let n = self.exponent;
         let inv_pi = std::f64::consts::FRAC_1_PI;
-        PhongView {
-            wi_above: wi[2] > F::zero(),
-            mirror,
-            mirror_frame: Frame::from_normal(mirror),
-            exponent: F::c(n),
-            diffuse_probability: F::c(self.diffuse_probability),
-            diffuse: self.diffuse.map(|v| F::c(v * inv_pi)),
-            specular: self.specular.map(|v| F::c(v * (n + 2.0) * 0.5 * inv_pi)),
-            glossy_norm: F::c((n + 1.0) * 0.5 * inv_pi),
-        }
+        let [d0, d1, d2] = self.diffuse.map(|v| v * inv_pi);
+        let [s0, s1, s2] = self.specular.map(|v| v * (n + 2.0) * 0.5 * inv_pi);
+        let glossy_norm = (n + 1.0) * 0.5 * inv_pi;
+        [
+            n,
+            self.diffuse_probability,
+            d0,
+            d1,
+            d2,
+            s0,
+            s1,
+            s2,
+            glossy_norm,
+        ]
+        .map(F::c)
     }
 
     /// The BRDF value `f_r(wi, wo)` per RGB channel (no cosine).
@@ -217,6 +233,43 @@ pub struct PhongView<F> {
 }
 
 impl<F: Real> PhongView<F> {
+    /// The view from `wi` of the BRDF whose [`Phong::view_terms`] are
+    /// `terms`: [`Phong::view`], without branches (for a batch of views at
+    /// SIMD width as for one).
+    #[inline(always)]
+    pub fn from_terms(wi: V3<F>, terms: [F; VIEW_TERMS]) -> Self {
+        let [
+            exponent,
+            diffuse_probability,
+            d0,
+            d1,
+            d2,
+            s0,
+            s1,
+            s2,
+            glossy_norm,
+        ] = terms;
+        let mirror = reflect(wi);
+        PhongView {
+            wi_above: wi[2] > F::zero(),
+            mirror,
+            mirror_frame: Frame::from_normal(mirror),
+            exponent,
+            diffuse_probability,
+            diffuse: [d0, d1, d2],
+            specular: [s0, s1, s2],
+            glossy_norm,
+        }
+    }
+
+    /// `(f_r(wi, wo), pdf(wo))`, as [`PhongView::eval`] and
+    /// [`PhongView::pdf`] (one power for both), without branches.
+    #[inline(always)]
+    pub fn eval_pdf(&self, wo: V3<F>) -> (V3<F>, F) {
+        let lobe = self.lobe(wo);
+        (self.eval_with_lobe(wo, lobe), self.pdf_with_lobe(wo, lobe))
+    }
+
     /// `max(0, cos α)ⁿ`, with α between `wo` and the mirror of `wi`.
     #[inline(always)]
     fn lobe(&self, wo: V3<F>) -> F {

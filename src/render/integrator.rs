@@ -224,19 +224,33 @@ pub(super) fn shading(
     from: Vec3A,
     sampler: Sampler,
 ) -> (Frame<f32>, PhongView<f32>) {
-    let material = scene.material(shape);
-    let ns = if material.two_sided && ns.dot(from) < 0.0 {
+    let frame = shading_frame(scene, shape, ns, from, sampler);
+    let view = scene
+        .material(shape)
+        .bsdf
+        .view(frame.to_local(from.to_array()));
+    (frame, view)
+}
+
+/// The shading frame of [`shading`].
+#[inline]
+pub(super) fn shading_frame(
+    scene: &Scene,
+    shape: u32,
+    ns: Vec3A,
+    from: Vec3A,
+    sampler: Sampler,
+) -> Frame<f32> {
+    let ns = if scene.material(shape).two_sided && ns.dot(from) < 0.0 {
         -ns
     } else {
         ns
     };
-    let frame = if sampler != Sampler::Independent && scene.is_sphere(shape) {
+    if sampler != Sampler::Independent && scene.is_sphere(shape) {
         Frame::azimuthal(ns.to_array())
     } else {
         Frame::from_normal(ns.to_array())
-    };
-    let view = material.bsdf.view(frame.to_local(from.to_array()));
-    (frame, view)
+    }
 }
 
 /// Whether nothing blocks the segment from `o` to `end` at time `tau`

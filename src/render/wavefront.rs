@@ -10,7 +10,8 @@
 //!           by inversion `EnvMap::sample_into` for the other samplers)
 //!   shade   each path at its hit: emission, its light sample's light
 //!           (the shadow ray kept for later), a BSDF sample (the next
-//!           ray), roulette
+//!           ray), roulette; the BSDF's evaluation and sample of every
+//!           path by one kernel at SIMD width (`shade`)
 //!   occlude every shadow ray of the batch, one stream; add the light of
 //!           those that reach it
 //!   trace   every next ray, one stream; rays that leave the scene go to
@@ -36,21 +37,18 @@ use glam::Vec3A;
 
 use super::accel::{Hit, Subset};
 use super::embree;
-use super::integrator::{
-    Escaped, Integrator, Settings, Strategy, add_scaled, dims, emission_weight, mul, offset,
-    ray_to, shading, shadow_ray,
-};
+use super::integrator::{Escaped, Settings, Strategy, add_scaled, dims, ray_to};
 use super::numbers::{Numbers, bounce_dims, draws_light_choice};
 use super::scene::{InvertedSamples, LightSample, Scene};
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
 use crate::envmap::EnvSample;
 use crate::error::Result;
-use crate::frame::Frame;
-use crate::phong::PhongView;
 use crate::rng::Rng;
 use crate::sampler::batch::{Dim, Drawn};
 use crate::sampler::{Sampler, Stream};
+use crate::simd;
+use shade::{BSDF_IN, BSDF_OUT, Begun, Bounce, bsdf_kernel};
 
 /// A path between two bounces.
 #[derive(Clone, Debug)]
@@ -135,6 +133,11 @@ pub struct Wavefront {
     /// The light sample of each path's vertex at this bounce (none under
     /// BSDF sampling, and at the last vertex).
     light_samples: Vec<Option<LightSample>>,
+    /// The paths shaded at this bounce ([`Bounce::begin`]), and their
+    /// rows into and out of the BSDF kernel.
+    begun: Vec<Begun>,
+    bsdf_in: Vec<[f32; BSDF_IN]>,
+    bsdf_out: Vec<[f32; BSDF_OUT]>,
     /// The numbers of the bounce drawn beforehand (the samplers other than
     /// the independent one): the dimensions every path's vertex asks for,
     /// and their values, path after path.
@@ -173,7 +176,10 @@ impl Wavefront {
             self.by_inversion.at,
             self.by_inversion.draws,
             self.env_samples,
-            self.light_samples
+            self.light_samples,
+            self.begun,
+            self.bsdf_in,
+            self.bsdf_out
         )?;
         self.escaped.clear();
         self.escaped.reserve(n)
@@ -252,37 +258,7 @@ impl Wavefront {
                 self.drawn.draw(streams, samples, &self.dims)?;
             }
             self.sample_lights(scene, settings, streams, depth);
-            // Each path shaded in place; those that stop are removed, the
-            // others keep their order (so that they line up with their rays
-            // in `self.rays`, then with `self.found`).
-            debug_assert_eq!(self.hits.len(), self.paths.len());
-            debug_assert_eq!(self.surfaces.len(), self.paths.len());
-            let mut shading_points = self.hits.iter().zip(&self.surfaces).enumerate();
-            self.paths.retain_mut(|path| {
-                let Some((k, (hit, surface))) = shading_points.next() else {
-                    debug_assert!(false, "a path without its hit");
-                    return false;
-                };
-                let stream = &mut streams[path.pixel as usize];
-                stream.start(path.index);
-                swap_generators(stream, path);
-                let drawn = (&self.dims[..], &self.drawn.values[..]);
-                let mut numbers = Numbers::new(stream, drawn, k);
-                let bounce = Bounce {
-                    scene,
-                    settings,
-                    shadows: &mut self.shadows,
-                    shadow_rays: &mut self.shadow_rays,
-                };
-                let l = &mut l[path.slot as usize];
-                let ls = self.light_samples.get(k).and_then(Option::as_ref);
-                let goes_on = bounce.shade(path, (hit.t, *surface), ls, &mut numbers, l);
-                swap_generators(numbers.stream, path);
-                if goes_on {
-                    self.rays.push(path.ray);
-                }
-                goes_on
-            });
+            self.shade(scene, settings, streams, l);
             self.blocked.clear();
             scene
                 .accel()
@@ -379,21 +355,21 @@ impl Wavefront {
         light_samples.resize(paths.len(), None);
         let many = scene.chooses_among_lights();
         let density = settings.env_density();
+        let drawn = (&wanted[..], &drawn.values[..]);
         for (k, (path, (_, sp))) in paths.iter_mut().zip(&*surfaces).enumerate() {
-            let stream = &mut streams[path.pixel as usize];
-            stream.start(path.index);
-            swap_generators(stream, path);
-            let mut numbers = Numbers::new(stream, (&wanted[..], &drawn.values[..]), k);
-            let choice = if draws_light_choice(many, numbers.stream.sampler()) {
-                numbers.get1(dims::bounce(depth, dims::LIGHT_CHOICE))
-            } else {
-                0.0
-            };
-            let u = numbers.get2(dims::bounce(depth, dims::LIGHT_POSITION));
-            // The independent sampler picks environment cells from extra
-            // random bits (an alias table); the others by inversion, which
-            // keeps their stratification.
-            if let Some(light) = scene.choose_light(choice, density) {
+            with_numbers(streams, drawn, (k, path), |numbers, _| {
+                let choice = if draws_light_choice(many, numbers.stream.sampler()) {
+                    numbers.get1(dims::bounce(depth, dims::LIGHT_CHOICE))
+                } else {
+                    0.0
+                };
+                let u = numbers.get2(dims::bounce(depth, dims::LIGHT_POSITION));
+                // The independent sampler picks environment cells from extra
+                // random bits (an alias table); the others by inversion, which
+                // keeps their stratification.
+                let Some(light) = scene.choose_light(choice, density) else {
+                    return;
+                };
                 let bits = light
                     .cells()
                     .and(numbers.independent())
@@ -408,14 +384,91 @@ impl Wavefront {
                     }
                     None => light_samples[k] = scene.sample_chosen(light, sp.p, u, None),
                 }
-            }
-            swap_generators(numbers.stream, path);
+            });
         }
         scene.sample_environment_cells(&by_cells.draws, env_samples, density, |i, ls| {
             light_samples[by_cells.at[i] as usize] = ls;
         });
         scene.sample_environment_inverted(&by_inversion.draws, inverted, density, |i, ls| {
             light_samples[by_inversion.at[i] as usize] = ls;
+        });
+    }
+
+    /// Shades every path in flight at its hit, in the three steps of
+    /// [`shade`]: its emission added to `l[slot]`, its light sample's
+    /// light kept with its shadow ray (`self.shadows`, `self.shadow_rays`),
+    /// its next ray (`self.rays`). The paths that end are removed; the
+    /// others keep their order, so that they line up with their rays.
+    fn shade(
+        &mut self,
+        scene: &Scene,
+        settings: &Settings,
+        streams: &mut [Stream],
+        l: &mut [[f32; 3]],
+    ) {
+        let Wavefront {
+            paths,
+            hits,
+            surfaces,
+            light_samples,
+            dims: wanted,
+            drawn,
+            begun,
+            bsdf_in,
+            bsdf_out,
+            shadows,
+            shadow_rays,
+            rays,
+            ..
+        } = self;
+        debug_assert_eq!(hits.len(), paths.len());
+        debug_assert_eq!(surfaces.len(), paths.len());
+        let bounce = Bounce { scene, settings };
+        let drawn = (&wanted[..], &drawn.values[..]);
+        let light = |k: usize| light_samples.get(k).and_then(Option::as_ref);
+        begun.clear();
+        bsdf_in.clear();
+        let mut at = hits.iter().zip(&*surfaces).enumerate();
+        paths.retain_mut(|path| {
+            let Some((k, (hit, (shape, sp)))) = at.next() else {
+                debug_assert!(false, "a path without its hit");
+                return false;
+            };
+            let l = &mut l[path.slot as usize];
+            let vertex = (hit.t, (*shape, sp));
+            let started = with_numbers(streams, drawn, (k, path), |numbers, path| {
+                bounce.begin((k, path), vertex, light(k), numbers, l)
+            });
+            let Some((b, row)) = started else {
+                return false;
+            };
+            begun.push(b);
+            bsdf_in.push(row);
+            true
+        });
+        bsdf_out.clear();
+        bsdf_out.resize(bsdf_in.len(), [0.0; BSDF_OUT]);
+        let kernel = {
+            #[inline(always)]
+            |row| bsdf_kernel(row)
+        };
+        simd::map_rows(bsdf_out, bsdf_in, &kernel, |_| true, false);
+        let mut done = begun.iter().zip(&*bsdf_out);
+        paths.retain_mut(|path| {
+            let Some((b, out)) = done.next() else {
+                debug_assert!(false, "a path without its BSDF sample");
+                return false;
+            };
+            let k = b.k as usize;
+            let roulette = |path: &mut Path, dim| {
+                with_numbers(streams, drawn, (k, path), |numbers, _| numbers.get1(dim))
+            };
+            let at = (b, &surfaces[k].1, out);
+            let goes_on = bounce.finish(path, at, light(k), (shadows, shadow_rays), roulette);
+            if goes_on {
+                rays.push(path.ray);
+            }
+            goes_on
         });
     }
 
@@ -479,6 +532,27 @@ fn escape(scene: &Scene, settings: &Settings, escaped: &mut Escaped, path: &Path
     }
 }
 
+/// `f` of `path` and the numbers of its vertex (`k`: its index among the
+/// bounce's paths, whose numbers `drawn` were drawn beforehand), its
+/// pixel's stream set to its sample, and the generator the path carries
+/// swapped in for the call (the independent sampler's: its draws go on
+/// where the path left them).
+#[inline(always)]
+fn with_numbers<T>(
+    streams: &mut [Stream],
+    drawn: (&[Dim], &[[f32; 2]]),
+    (k, path): (usize, &mut Path),
+    f: impl FnOnce(&mut Numbers, &mut Path) -> T,
+) -> T {
+    let stream = &mut streams[path.pixel as usize];
+    stream.start(path.index);
+    swap_generators(stream, path);
+    let mut numbers = Numbers::new(stream, drawn, k);
+    let out = f(&mut numbers, path);
+    swap_generators(numbers.stream, path);
+    out
+}
+
 /// Swaps the generator of `stream` (the independent sampler's) with the
 /// one `path` carries: before and after its draws.
 #[inline]
@@ -486,14 +560,6 @@ fn swap_generators(stream: &mut Stream, path: &mut Path) {
     if let (Some(rng), Some(own)) = (stream.independent(), path.rng.as_mut()) {
         std::mem::swap(rng, own);
     }
-}
-
-/// What shading a path's vertex needs besides the path.
-struct Bounce<'a> {
-    scene: &'a Scene,
-    settings: &'a Settings,
-    shadows: &'a mut Vec<Unshadowed>,
-    shadow_rays: &'a mut Vec<Ray>,
 }
 
 /// The paths (their indices in the bounce) whose environment-map light
@@ -525,105 +591,6 @@ impl<D> Waiting<D> {
     }
 }
 
-impl Bounce<'_> {
-    /// The light sample `ls` seen from `path`'s shading point `sp` (its
-    /// shading `frame` and BSDF `view`): its light (BSDF, cosine, MIS
-    /// weight), kept with its shadow ray when it carries any.
-    #[inline]
-    fn connect(
-        &mut self,
-        path: &Path,
-        sp: &SurfacePoint,
-        (frame, view): (&Frame<f32>, &PhongView<f32>),
-        ls: &LightSample,
-    ) {
-        let wo = frame.to_local(ls.d.to_array());
-        let (f, pdf_wo) = view.eval_pdf_one(wo);
-        if f.iter().any(|&v| v > 0.0) {
-            let w = if self.settings.strategy == Strategy::Mis {
-                self.settings.weight(ls.pdf, pdf_wo)
-            } else {
-                1.0
-            };
-            self.shadows.push(Unshadowed {
-                slot: path.slot,
-                time: path.time,
-                beta: path.beta,
-                fc: mul(f, ls.radiance),
-                s: w * wo[2].abs() / ls.pdf,
-            });
-            self.shadow_rays.push(shadow_ray(sp.p, sp.ng, ls));
-        }
-    }
-
-    /// The vertex where `path.ray` meets the scene (at distance `t`, on
-    /// `shape` at `sp`): its emission added to `l`, the light of its light
-    /// sample `ls` kept (with its shadow ray) when it carries any, and
-    /// `path` moved on to its next ray. Whether the path goes on.
-    #[inline]
-    fn shade(
-        mut self,
-        path: &mut Path,
-        (t, (shape, sp)): (f32, (u32, SurfacePoint)),
-        ls: Option<&LightSample>,
-        numbers: &mut Numbers,
-        l: &mut [f32; 3],
-    ) -> bool {
-        let (scene, settings) = (self.scene, self.settings);
-        let (ray, depth) = (path.ray, path.depth);
-        let wi = -ray.d;
-        if let Some(le) = scene.emitted(shape, sp.ng, wi) {
-            let w = emission_weight(settings, depth, path.bsdf_pdf, || {
-                scene.light_pdf(shape, path.from, sp.ng, ray.d, t)
-            });
-            add_scaled(l, path.beta, le, w);
-        }
-        let max_depth = settings.max_depth();
-        if depth + 1 >= max_depth {
-            return false;
-        }
-        let (frame, view) = shading(scene, shape, sp.ns, wi, numbers.stream.sampler());
-
-        if settings.strategy != Strategy::Bsdf {
-            if let Some(ls) = ls {
-                self.connect(path, &sp, (&frame, &view), ls);
-            }
-            // Under emitter sampling, the next vertex's emission is not
-            // counted: when it would be the last, stop here.
-            if settings.strategy == Strategy::Emitter && depth + 2 >= max_depth {
-                return false;
-            }
-        }
-
-        // The direction from the 2D request, the part from the 1D one
-        // (drawn in this order, the independent sampler's numbers are
-        // those of `PhongView::sample`'s `[u0, u1, part]`).
-        let u = numbers.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
-        let component = numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT));
-        let s = view.sample_one(component, u);
-        if s.weight.iter().all(|&v| v <= 0.0) {
-            return false;
-        }
-        path.beta = mul(path.beta, s.weight);
-        path.bsdf_pdf = s.pdf;
-        let d = Vec3A::from(frame.to_world(s.wo)).normalize();
-        path.from = sp.p;
-        path.ray = Ray {
-            o: offset(sp.p, sp.ng, d),
-            d,
-            tmax: f32::INFINITY,
-        };
-        path.depth += 1;
-        if settings.integrator == Integrator::Path && path.depth >= settings.rr_depth {
-            let q = path.beta.iter().copied().fold(0.0f32, f32::max).min(0.95);
-            if numbers.get1(dims::bounce(depth, dims::ROULETTE)) >= q {
-                return false;
-            }
-            path.beta = path.beta.map(|b| b / q);
-        }
-        true
-    }
-}
-
+mod shade;
 #[cfg(test)]
 mod tests;

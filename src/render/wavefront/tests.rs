@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use crate::envmap::{EnvMap, Options};
 use crate::render::geometry::Geometry;
-use crate::render::integrator::add_escaped;
+use crate::render::integrator::{Integrator, add_escaped};
 use crate::render::scene::{Environment, Shape};
 use crate::render::tests::{camera, cube, diffuse, light, rectangle, settings};
 use crate::sampler::Sampler;

@@ -1,0 +1,216 @@
+//! The shading of a bounce's paths, in three steps over the whole bounce:
+//!
+//! ```text
+//! begin   each path at its hit: its emission, its shading frame, and
+//!         its row of the BSDF kernel (the view's wi, the light sample's
+//!         direction, the BSDF sample's numbers, the BRDF's terms)
+//! kernel  every row at SIMD width (bsdf_kernel): the BRDF and its
+//!         density toward the light sample, and the BSDF sample
+//! finish  each path: its light sample's light kept with its shadow ray,
+//!         its next ray, roulette
+//! ```
+//!
+//! The kernel holds what costs most per vertex (three powers, a sine and
+//! a cosine, the mirror's frame), which one path at a time would compute
+//! in scalar code. It computes both parts' directions and selects (where
+//! one path at a time would draw only the chosen part's): the same bits.
+
+use glam::Vec3A;
+
+use super::{Path, Unshadowed};
+use crate::frame::Frame;
+use crate::phong::{PhongView, VIEW_TERMS};
+use crate::render::integrator::{
+    Integrator, Settings, Strategy, add_scaled, dims, emission_weight, mul, offset, shading_frame,
+    shadow_ray,
+};
+use crate::render::numbers::Numbers;
+use crate::render::scene::{LightSample, Scene};
+use crate::render::shape::{Ray, SurfacePoint};
+
+/// Numbers per row into [`bsdf_kernel`]: `wi` in the shading frame (3),
+/// the light sample's direction there (3, zeros without one), the BSDF
+/// sample's numbers `u0, u1, part` (3) and the BRDF's
+/// [`crate::phong::Phong::view_terms`].
+pub(super) const BSDF_IN: usize = 9 + VIEW_TERMS;
+
+/// Numbers per row out of [`bsdf_kernel`]: `f_r` toward the light sample
+/// (3) and the BSDF's density there, then the BSDF sample's direction (3),
+/// density and weight (3).
+pub(super) const BSDF_OUT: usize = 11;
+
+/// What [`Bounce::finish`] needs of a path's [`Bounce::begin`].
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Begun {
+    /// The path's index at the bounce's start (of its surface, light
+    /// sample and numbers drawn beforehand).
+    pub k: u32,
+    /// Its shading frame.
+    pub frame: Frame<f32>,
+    /// The cosine of its light sample's direction with the shading
+    /// normal (0 without one).
+    pub wl_z: f32,
+    /// Whether it ends after its light sample (emitter sampling, whose
+    /// next vertex's emission would not count).
+    pub ends: bool,
+}
+
+/// The BSDF's part of a vertex's shading, for one row of [`BSDF_IN`]
+/// numbers: `(f_r(wi, wl), p(wl))` toward the light sample's direction
+/// `wl` ([`PhongView::eval_pdf`]) and the sample [`PhongView::sample`]
+/// of `[u0, u1, part]`, as [`BSDF_OUT`] numbers. Branch-free, for
+/// [`crate::simd::map_rows`].
+#[inline(always)]
+pub(super) fn bsdf_kernel(row: [f32; BSDF_IN]) -> [f32; BSDF_OUT] {
+    let [w0, w1, w2, l0, l1, l2, u0, u1, part, terms @ ..] = row;
+    let view = PhongView::from_terms([w0, w1, w2], terms);
+    let ([f0, f1, f2], pdf_l) = view.eval_pdf([l0, l1, l2]);
+    let s = view.sample([u0, u1, part]);
+    let ([x, y, z], [r, g, b]) = (s.wo, s.weight);
+    [f0, f1, f2, pdf_l, x, y, z, s.pdf, r, g, b]
+}
+
+/// What shading a path's vertex needs besides the path.
+pub(super) struct Bounce<'a> {
+    pub scene: &'a Scene,
+    pub settings: &'a Settings,
+}
+
+impl Bounce<'_> {
+    /// The first step of shading the vertex where `path.ray` meets the
+    /// scene (at distance `t`, on `shape` at `sp`), whose light sample is
+    /// `ls`: its emission added to `l`; `None` if the path ends there,
+    /// else what [`Bounce::finish`] needs of it (`k`: the path's index at
+    /// the bounce's start) and its row of [`bsdf_kernel`] (the BSDF
+    /// sample's numbers drawn from `numbers`, unless the path ends after
+    /// its light sample).
+    #[inline]
+    pub fn begin(
+        &self,
+        (k, path): (usize, &Path),
+        (t, (shape, sp)): (f32, (u32, &SurfacePoint)),
+        ls: Option<&LightSample>,
+        numbers: &mut Numbers,
+        l: &mut [f32; 3],
+    ) -> Option<(Begun, [f32; BSDF_IN])> {
+        let (scene, settings) = (self.scene, self.settings);
+        let (ray, depth) = (path.ray, path.depth);
+        let wi = -ray.d;
+        if let Some(le) = scene.emitted(shape, sp.ng, wi) {
+            let w = emission_weight(settings, depth, path.bsdf_pdf, || {
+                scene.light_pdf(shape, path.from, sp.ng, ray.d, t)
+            });
+            add_scaled(l, path.beta, le, w);
+        }
+        let max_depth = settings.max_depth();
+        if depth + 1 >= max_depth {
+            return None;
+        }
+        let frame = shading_frame(scene, shape, sp.ns, wi, numbers.stream.sampler());
+        let wl = match ls {
+            Some(ls) if settings.strategy != Strategy::Bsdf => frame.to_local(ls.d.to_array()),
+            _ => [0.0; 3],
+        };
+        // Under emitter sampling, the next vertex's emission is not
+        // counted: when it would be the last, stop after the light sample.
+        let ends = settings.strategy == Strategy::Emitter && depth + 2 >= max_depth;
+        // The direction from the 2D request, the part from the 1D one
+        // (drawn in this order, the independent sampler's numbers are
+        // those of `PhongView::sample`'s `[u0, u1, part]`).
+        let ([u0, u1], part) = if ends {
+            ([0.0; 2], 0.0)
+        } else {
+            let u = numbers.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
+            (u, numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT)))
+        };
+        let [w0, w1, w2] = frame.to_local(wi.to_array());
+        let [l0, l1, l2] = wl;
+        let [n, pd, d0, d1, d2, s0, s1, s2, gn] = scene.material(shape).bsdf.view_terms();
+        let row = [
+            w0, w1, w2, l0, l1, l2, u0, u1, part, n, pd, d0, d1, d2, s0, s1, s2, gn,
+        ];
+        let begun = Begun {
+            k: k as u32,
+            frame,
+            wl_z: l2,
+            ends,
+        };
+        Some((begun, row))
+    }
+
+    /// The light sample `ls` seen from the shading point `sp` of `path`,
+    /// where the cosine of its direction is `wl_z`, the BRDF toward it `f`
+    /// and its density `pdf_wl` (the kernel's): its light (BSDF, cosine,
+    /// MIS weight) kept in `shadows` with its shadow ray when it carries
+    /// any.
+    #[inline]
+    fn connect(
+        &self,
+        path: &Path,
+        sp: &SurfacePoint,
+        (wl_z, f, pdf_wl): (f32, [f32; 3], f32),
+        ls: &LightSample,
+        (shadows, shadow_rays): (&mut Vec<Unshadowed>, &mut Vec<Ray>),
+    ) {
+        if f.iter().any(|&v| v > 0.0) {
+            let w = if self.settings.strategy == Strategy::Mis {
+                self.settings.weight(ls.pdf, pdf_wl)
+            } else {
+                1.0
+            };
+            shadows.push(Unshadowed {
+                slot: path.slot,
+                time: path.time,
+                beta: path.beta,
+                fc: mul(f, ls.radiance),
+                s: w * wl_z.abs() / ls.pdf,
+            });
+            shadow_rays.push(shadow_ray(sp.p, sp.ng, ls));
+        }
+    }
+
+    /// The last step of shading a path's vertex (at `sp`, begun as
+    /// `begun`, with the kernel's numbers `out`): its light sample `ls`
+    /// connected, and the path moved on along its BSDF sample, after
+    /// roulette (whose number `roulette` draws for the path and a
+    /// dimension). Whether the path goes on.
+    #[inline]
+    pub fn finish(
+        &self,
+        path: &mut Path,
+        (begun, sp, out): (&Begun, &SurfacePoint, &[f32; BSDF_OUT]),
+        ls: Option<&LightSample>,
+        shadows: (&mut Vec<Unshadowed>, &mut Vec<Ray>),
+        roulette: impl FnOnce(&mut Path, u32) -> f32,
+    ) -> bool {
+        let settings = self.settings;
+        let [f0, f1, f2, pdf_wl, x, y, z, pdf, r, g, b] = *out;
+        if settings.strategy != Strategy::Bsdf
+            && let Some(ls) = ls
+        {
+            self.connect(path, sp, (begun.wl_z, [f0, f1, f2], pdf_wl), ls, shadows);
+        }
+        if begun.ends || [r, g, b].iter().all(|&v| v <= 0.0) {
+            return false;
+        }
+        let depth = path.depth;
+        path.beta = mul(path.beta, [r, g, b]);
+        path.bsdf_pdf = pdf;
+        let d = Vec3A::from(begun.frame.to_world([x, y, z])).normalize();
+        path.from = sp.p;
+        path.ray = Ray {
+            o: offset(sp.p, sp.ng, d),
+            d,
+            tmax: f32::INFINITY,
+        };
+        path.depth += 1;
+        if settings.integrator == Integrator::Path && path.depth >= settings.rr_depth {
+            let q = path.beta.iter().copied().fold(0.0f32, f32::max).min(0.95);
+            if roulette(path, dims::bounce(depth, dims::ROULETTE)) >= q {
+                return false;
+            }
+            path.beta = path.beta.map(|b| b / q);
+        }
+        true
+    }
+}
