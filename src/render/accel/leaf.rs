@@ -128,7 +128,7 @@ impl Leaf {
                 best.take(i, scaled.inside & ahead, t, id, bary);
             }
         }
-        for &(sphere, id) in &self.spheres {
+        for &(sphere, id) in self.spheres.iter().filter(|(s, _)| block.comes_near(s)) {
             for i in 0..BLOCK {
                 let (take, t) = sphere.hit_branchless(block.o(i), block.d(i), best.t[i]);
                 best.take(i, take, t, id, [0.0; 2]);
@@ -195,7 +195,7 @@ impl Leaf {
                 any[i] |= scaled.inside & scaled.hit(tmax[i]).0;
             }
         }
-        for (sphere, _) in &self.spheres {
+        for (sphere, _) in self.spheres.iter().filter(|(s, _)| block.comes_near(s)) {
             for i in 0..BLOCK {
                 any[i] |= sphere.occludes_branchless(block.o(i), block.d(i), tmax[i]);
             }
@@ -212,6 +212,8 @@ impl Leaf {
 struct Block {
     o: [[f32; BLOCK]; 3],
     d: [[f32; BLOCK]; 3],
+    /// The block's rays.
+    rows: usize,
 }
 
 impl Block {
@@ -220,6 +222,7 @@ impl Block {
         let mut block = Block {
             o: [[0.0; BLOCK]; 3],
             d: [[0.0; BLOCK]; 3],
+            rows: rays.len().min(BLOCK),
         };
         for (i, ray) in rays.iter().enumerate().take(BLOCK) {
             for k in 0..3 {
@@ -228,6 +231,18 @@ impl Block {
             }
         }
         block
+    }
+
+    /// Whether the line of some ray of the block meets `sphere`
+    /// ([`Sphere::line_meets`]): if none does, no ray hits it, and its
+    /// tests (a square root and divisions in `f64` per ray) can be
+    /// skipped. Coherent rays (a few pixels' camera rays, their shadow
+    /// rays) mostly pass a small sphere by together.
+    #[inline(always)]
+    fn comes_near(&self, sphere: &Sphere) -> bool {
+        (0..BLOCK).fold(false, |any, i| {
+            any | (i < self.rows) & sphere.line_meets(self.o(i), self.d(i))
+        })
     }
 
     #[inline(always)]

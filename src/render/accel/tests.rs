@@ -298,6 +298,51 @@ fn leaf_batches_are_single_rays_bit_for_bit() {
     }
 }
 
+/// The batch tests skip a sphere for a block of rays none of whose lines
+/// meet it: a small sphere that one ray of a block meets (its last, one
+/// past its first half, or one of a short block's) is still found, by `intersect_many`
+/// and `occluded_many` alike, and the other rays of those blocks pass it.
+#[test]
+fn a_sphere_met_by_one_ray_of_a_block_is_still_tested() {
+    let small = Sphere {
+        center: DVec3::new(0.0, 10.0, 0.0),
+        radius: 0.5,
+        flip: false,
+    };
+    let far = Sphere {
+        center: DVec3::new(0.0, 0.0, -50.0),
+        ..small
+    };
+    let prims = [small, far].map(|s| Primitive::Sphere(Box::new(s)));
+    let accel = Accel::new(prims.into(), vec![0, 1], Vec::new()).unwrap();
+    assert!(accel.bvh.is_none());
+    let toward = [63, 64 + 40, 128 + 1];
+    let rays: Vec<Ray> = (0..130)
+        .map(|i| Ray {
+            o: Vec3A::new(0.0, 0.0, i as f32 * 1e-3),
+            d: if toward.contains(&i) {
+                Vec3A::Y
+            } else {
+                Vec3A::X
+            },
+            tmax: f32::INFINITY,
+        })
+        .collect();
+    let (mut hits, mut blocked) = (Vec::new(), Vec::new());
+    let mut stream = Default::default();
+    accel
+        .intersect_many(&rays, false, &mut stream, &mut hits)
+        .unwrap();
+    accel
+        .occluded_many(&rays, &mut stream, &mut blocked)
+        .unwrap();
+    for (i, (hit, blocked)) in hits.iter().zip(&blocked).enumerate() {
+        let meets = toward.contains(&i);
+        assert_eq!(hit.map(|h| h.primitive), meets.then_some(0), "ray {i}");
+        assert_eq!(*blocked, meets, "ray {i}");
+    }
+}
+
 /// A scene's list of primitives holds a triangle as its mesh and face:
 /// spheres and disks stay out of line.
 #[test]
