@@ -47,8 +47,7 @@ use crate::error::Result;
 use crate::rng::Rng;
 use crate::sampler::batch::{Dim, Drawn};
 use crate::sampler::{Sampler, Stream};
-use crate::simd;
-use shade::{BSDF_IN, BSDF_OUT, Begun, Bounce, bsdf_kernel};
+use shade::{BSDF_IN, BSDF_OUT, Begun, Bounce, bsdf_kernels};
 
 /// A path between two bounces.
 #[derive(Clone, Debug)]
@@ -258,7 +257,7 @@ impl Wavefront {
                 self.drawn.draw(streams, samples, &self.dims)?;
             }
             self.sample_lights(scene, settings, streams, depth);
-            self.shade(scene, settings, streams, l);
+            self.shade(scene, settings, (streams, depth), l);
             self.blocked.clear();
             scene
                 .accel()
@@ -394,8 +393,8 @@ impl Wavefront {
         });
     }
 
-    /// Shades every path in flight at its hit, in the three steps of
-    /// [`shade`]: its emission added to `l[slot]`, its light sample's
+    /// Shades every path in flight (at bounce `depth`) at its hit, in the
+    /// three steps of [`shade`]: its emission added to `l[slot]`, its light sample's
     /// light kept with its shadow ray (`self.shadows`, `self.shadow_rays`),
     /// its next ray (`self.rays`). The paths that end are removed; the
     /// others keep their order, so that they line up with their rays.
@@ -403,7 +402,7 @@ impl Wavefront {
         &mut self,
         scene: &Scene,
         settings: &Settings,
-        streams: &mut [Stream],
+        (streams, depth): (&mut [Stream], u32),
         l: &mut [[f32; 3]],
     ) {
         let Wavefront {
@@ -448,11 +447,7 @@ impl Wavefront {
         });
         bsdf_out.clear();
         bsdf_out.resize(bsdf_in.len(), [0.0; BSDF_OUT]);
-        let kernel = {
-            #[inline(always)]
-            |row| bsdf_kernel(row)
-        };
-        simd::map_rows(bsdf_out, bsdf_in, &kernel, |_| true, false);
+        bsdf_kernels(settings, depth, bsdf_in, bsdf_out);
         let mut done = begun.iter().zip(&*bsdf_out);
         paths.retain_mut(|path| {
             let Some((b, out)) = done.next() else {

@@ -27,6 +27,7 @@ use crate::render::integrator::{
 use crate::render::numbers::Numbers;
 use crate::render::scene::{LightSample, Scene};
 use crate::render::shape::{Ray, SurfacePoint};
+use crate::simd;
 
 /// Numbers per row into [`bsdf_kernel`]: `wi` in the shading frame (3),
 /// the light sample's direction there (3, zeros without one), the BSDF
@@ -56,18 +57,67 @@ pub(super) struct Begun {
 }
 
 /// The BSDF's part of a vertex's shading, for one row of [`BSDF_IN`]
-/// numbers: `(f_r(wi, wl), p(wl))` toward the light sample's direction
-/// `wl` ([`PhongView::eval_pdf`]) and the sample [`PhongView::sample`]
-/// of `[u0, u1, part]`, as [`BSDF_OUT`] numbers. Branch-free, for
-/// [`crate::simd::map_rows`].
+/// numbers: with `LIGHT`, `(f_r(wi, wl), p(wl))` toward the light
+/// sample's direction `wl` ([`PhongView::eval_pdf`]); with `SAMPLE`, the
+/// sample [`PhongView::sample`] of `[u0, u1, part]`; as [`BSDF_OUT`]
+/// numbers (zeros for the part not asked for: a bounce whose paths have
+/// no light sample, or all end after it, skips its powers). Branch-free,
+/// for [`crate::simd::map_rows`].
 #[inline(always)]
-pub(super) fn bsdf_kernel(row: [f32; BSDF_IN]) -> [f32; BSDF_OUT] {
+pub(super) fn bsdf_kernel<const LIGHT: bool, const SAMPLE: bool>(
+    row: [f32; BSDF_IN],
+) -> [f32; BSDF_OUT] {
     let [w0, w1, w2, l0, l1, l2, u0, u1, part, terms @ ..] = row;
     let view = PhongView::from_terms([w0, w1, w2], terms);
-    let ([f0, f1, f2], pdf_l) = view.eval_pdf([l0, l1, l2]);
-    let s = view.sample([u0, u1, part]);
-    let ([x, y, z], [r, g, b]) = (s.wo, s.weight);
-    [f0, f1, f2, pdf_l, x, y, z, s.pdf, r, g, b]
+    let ([f0, f1, f2], pdf_l) = if LIGHT {
+        view.eval_pdf([l0, l1, l2])
+    } else {
+        ([0.0; 3], 0.0)
+    };
+    let ([x, y, z], pdf, [r, g, b]) = if SAMPLE {
+        let s = view.sample([u0, u1, part]);
+        (s.wo, s.pdf, s.weight)
+    } else {
+        ([0.0; 3], 0.0, [0.0; 3])
+    };
+    [f0, f1, f2, pdf_l, x, y, z, pdf, r, g, b]
+}
+
+/// [`bsdf_kernel`] of every row of `rows` into `out` (of one length), for
+/// a bounce of `settings` at `depth`: the light's part where the strategy
+/// draws light samples, the BSDF sample's where the paths go on after
+/// them.
+pub(super) fn bsdf_kernels(
+    settings: &Settings,
+    depth: u32,
+    rows: &[[f32; BSDF_IN]],
+    out: &mut [[f32; BSDF_OUT]],
+) {
+    macro_rules! map {
+        ($light:literal, $sample:literal) => {{
+            let kernel = {
+                #[inline(always)]
+                |row| bsdf_kernel::<$light, $sample>(row)
+            };
+            simd::map_rows(out, rows, &kernel, |_| true, false);
+        }};
+    }
+    let light = settings.strategy != Strategy::Bsdf;
+    match (light, !ends_after_light(settings, depth)) {
+        (true, true) => map!(true, true),
+        (true, false) => map!(true, false),
+        (false, true) => map!(false, true),
+        // Under BSDF sampling a path always goes on to its next vertex.
+        (false, false) => {}
+    }
+}
+
+/// Whether the paths of a bounce at `depth` end after their light samples:
+/// under emitter sampling the next vertex's emission is not counted, so
+/// when it would be the last they stop there.
+#[inline]
+fn ends_after_light(settings: &Settings, depth: u32) -> bool {
+    settings.strategy == Strategy::Emitter && depth + 2 >= settings.max_depth()
 }
 
 /// What shading a path's vertex needs besides the path.
@@ -111,9 +161,7 @@ impl Bounce<'_> {
             Some(ls) if settings.strategy != Strategy::Bsdf => frame.to_local(ls.d.to_array()),
             _ => [0.0; 3],
         };
-        // Under emitter sampling, the next vertex's emission is not
-        // counted: when it would be the last, stop after the light sample.
-        let ends = settings.strategy == Strategy::Emitter && depth + 2 >= max_depth;
+        let ends = ends_after_light(settings, depth);
         // The direction from the 2D request, the part from the 1D one
         // (drawn in this order, the independent sampler's numbers are
         // those of `PhongView::sample`'s `[u0, u1, part]`).
