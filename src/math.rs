@@ -211,7 +211,7 @@ fn pow_unit(x: f64, y: f64) -> f64 {
     /// the odd one (`ROUNDER` is odd, the sum rounds ties to even), with
     /// `2⁵¹ + k + BIAS` in the mantissa. One addition, no rounding
     /// instruction (`floor` would be a library call in code built for
-    /// baseline x86-64, such as the renderer's Phong draws).
+    /// baseline x86-64, such as bidirectional path tracing's Phong draws).
     const ROUNDER: f64 = 1.5 * (1u64 << MANTISSA_BITS) as f64 + BIAS;
     let (m, e) = mantissa_exponent(x);
     let s = (m - 1.0) / (m + 1.0);

@@ -83,7 +83,7 @@ pub struct PhongSamples<'a, F, C> {
 pub const MAX_EXPONENT: f64 = 1e30;
 
 /// The number of [`Phong::view_terms`].
-pub const VIEW_TERMS: usize = 9;
+pub(crate) const VIEW_TERMS: usize = 9;
 
 /// Rows per block of [`PhongView::sample_rows`]: its numbers and samples
 /// stay in the L1 cache.
@@ -173,7 +173,7 @@ impl Phong {
     /// 1)/(2π)]`. A batch kernel over the views of several BRDFs reads
     /// them with its other numbers ([`PhongView::from_terms`]).
     #[inline(always)]
-    pub fn view_terms<F: Real>(&self) -> [F; VIEW_TERMS] {
+    pub(crate) fn view_terms<F: Real>(&self) -> [F; VIEW_TERMS] {
         let n = self.exponent;
         let inv_pi = std::f64::consts::FRAC_1_PI;
         let [d0, d1, d2] = self.diffuse.map(|v| v * inv_pi);
@@ -237,7 +237,7 @@ impl<F: Real> PhongView<F> {
     /// `terms`: [`Phong::view`], without branches (for a batch of views at
     /// SIMD width as for one).
     #[inline(always)]
-    pub fn from_terms(wi: V3<F>, terms: [F; VIEW_TERMS]) -> Self {
+    pub(crate) fn from_terms(wi: V3<F>, terms: [F; VIEW_TERMS]) -> Self {
         let [
             exponent,
             diffuse_probability,
@@ -395,17 +395,21 @@ impl<F: Real> PhongView<F> {
     }
 }
 
-/// One sample at a time, as the renderer draws them: the same densities and
-/// values as [`PhongView::sample`], [`PhongView::eval`] and
-/// [`PhongView::pdf`], with branches where those are branch-free for
-/// vectorised batches. Only the chosen part's direction is drawn, and a BRDF
-/// without a glossy part (`ρs = 0`, so `p_s = 0`) skips its lobe, a power.
+/// One sample at a time, as bidirectional path tracing draws them: the
+/// same densities and values as [`PhongView::sample`], [`PhongView::eval`]
+/// and [`PhongView::pdf`], bit for bit, with branches where those are
+/// branch-free for vectorised batches. Only the chosen part's direction is
+/// drawn, and a BRDF without a glossy part (`ρs = 0`) skips its lobe, a
+/// power.
 impl<F: Real> PhongView<F> {
     /// [`PhongView::lobe`], or 0 without looking when there is no glossy
-    /// part (whose terms it would multiply by 0).
+    /// part (whose terms it would multiply by 0: `ρs = 0`, so `f_r`'s
+    /// glossy constant and `p_s` are 0). Not `p_d = 1`: `p_d` rounds to 1
+    /// in `f32` for a glossy part below about `10⁻⁸` of the diffuse one,
+    /// whose lobe still counts in `f_r`.
     #[inline(always)]
     fn lobe_if_glossy(&self, wo: V3<F>) -> F {
-        if self.diffuse_probability < F::one() {
+        if self.specular.iter().any(|&s| s > F::zero()) {
             self.lobe(wo)
         } else {
             F::zero()
@@ -483,25 +487,39 @@ mod tests {
     /// glossy part and without one.
     #[test]
     fn one_at_a_time_matches_the_batch_forms() {
-        let diffuse_only = Phong::new([0.5, 0.4, 0.3], [0.0; 3], 1.0, Selection::Max).unwrap();
-        for p in [phong(20.0), diffuse_only] {
-            let view = p.view([0.3f64, -0.2, 0.932_737_905_308_881_5]);
+        fn check<F: Real + std::fmt::Debug>(p: &Phong) {
+            let wi = [0.3, -0.2, 0.932_737_905_308_881_5].map(F::c);
+            let view = p.view(wi);
+            assert_eq!(
+                format!("{view:?}"),
+                format!("{:?}", PhongView::from_terms(wi, p.view_terms()))
+            );
             for k in 0..500 {
-                let u = [
-                    (k as f64 * 0.618_034) % 1.0,
-                    (k as f64 * 0.414_214) % 1.0,
-                    (k as f64 * 0.732_051) % 1.0,
-                ];
+                let u = [0.618_034, 0.414_214, 0.732_051].map(|a| F::c((k as f64 * a) % 1.0));
                 let (a, b) = (view.sample(u), view.sample_one(u[2], [u[0], u[1]]));
-                assert_eq!(a.wo, b.wo);
-                assert_eq!(a.component, b.component);
-                assert!((a.pdf - b.pdf).abs() <= 1e-12 * a.pdf);
-                for c in 0..3 {
-                    assert!((a.weight[c] - b.weight[c]).abs() <= 1e-12 * a.weight[c]);
+                assert_eq!(a, b, "{p:?} {u:?}");
+                // Toward the sample and off it (the mirror direction's
+                // neighbourhood, where the lobe is largest).
+                for wo in [a.wo, [F::c(0.01), F::c(-0.02), F::c(0.9997)], reflect(wi)] {
+                    let (f, pdf) = view.eval_pdf_one(wo);
+                    assert_eq!((f, pdf), (view.eval(wo), view.pdf(wo)), "{p:?} {wo:?}");
+                    assert_eq!((f, pdf), view.eval_pdf(wo), "{p:?} {wo:?}");
                 }
-                let (f, pdf) = view.eval_pdf_one(a.wo);
-                assert_eq!((f, pdf), (view.eval(a.wo), view.pdf(a.wo)));
             }
+        }
+        let rho = [0.5, 0.4, 0.3];
+        let with = |specular, n| Phong::new(rho, specular, n, Selection::Max).unwrap();
+        for p in [
+            phong(20.0),
+            with([0.0; 3], 1.0),
+            // A glossy part so small that p_d rounds to 1 in f32.
+            with([1e-9; 3], 1e6),
+            Phong::new([0.0; 3], [0.0; 3], 1.0, Selection::Max).unwrap(),
+            with([0.2; 3], 0.0),
+            with([0.2; 3], MAX_EXPONENT),
+        ] {
+            check::<f32>(&p);
+            check::<f64>(&p);
         }
     }
 

@@ -372,6 +372,14 @@ pub fn skip_emitters(scene: &Scene, ray: &mut Ray, mut hit: Option<Hit>, time: f
     hit
 }
 
+/// Whether a path's vertex at `depth` ends after its light sample: under
+/// emitter sampling the next vertex's emission is not counted, so when it
+/// would be the last, the path stops there (drawing no BSDF sample).
+#[inline]
+pub(super) fn ends_after_light(settings: &Settings, depth: u32) -> bool {
+    settings.strategy == Strategy::Emitter && depth + 2 >= settings.max_depth()
+}
+
 /// The weight of emission found at path depth `depth` (0: seen from the
 /// camera) after a BSDF sample of density `bsdf_pdf`; `light_pdf` gives the
 /// density emitter sampling would have had for it.

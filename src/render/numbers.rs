@@ -5,7 +5,7 @@
 //! paths, will make are drawn for the whole batch beforehand, at SIMD width
 //! ([`crate::sampler::batch`]), and then read.
 
-use super::integrator::{Integrator, Settings, Strategy, dims};
+use super::integrator::{Integrator, Settings, Strategy, dims, ends_after_light};
 use crate::rng::Rng;
 use crate::sampler::batch::Dim;
 use crate::sampler::{Sampler, Stream};
@@ -106,8 +106,9 @@ pub fn draws_light_choice(many_lights: bool, sampler: Sampler) -> bool {
 }
 
 /// The dimensions the shading of each path's vertex at `depth` asks for
-/// (its light sample's in `Wavefront::sample_lights`, then
-/// `Bounce::shade`'s, in this order: [`super::wavefront`]) under a sampler
+/// (its light sample's in `Wavefront::sample_lights`, then its BSDF
+/// sample's in `Bounce::begin` and its roulette's in `Bounce::finish`, in
+/// this order: [`super::wavefront`]) under a sampler
 /// other than the independent one, into `out`: none at the last vertex;
 /// the light's choice (when `many_lights`, [`draws_light_choice`]) and
 /// position unless only the BSDF is sampled; the BSDF's direction and
@@ -130,7 +131,7 @@ pub fn bounce_dims(settings: &Settings, many_lights: bool, depth: u32, out: &mut
             push(dims::LIGHT_CHOICE, false);
         }
         push(dims::LIGHT_POSITION, true);
-        if settings.strategy == Strategy::Emitter && depth + 2 >= max_depth {
+        if ends_after_light(settings, depth) {
             return;
         }
     }

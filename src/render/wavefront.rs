@@ -132,10 +132,12 @@ pub struct Wavefront {
     /// The light sample of each path's vertex at this bounce (none under
     /// BSDF sampling, and at the last vertex).
     light_samples: Vec<Option<LightSample>>,
-    /// The paths shaded at this bounce ([`Bounce::begin`]), and their
-    /// rows into and out of the BSDF kernel.
+    /// What each path that goes on past [`Bounce::begin`] at this bounce
+    /// keeps for [`Bounce::finish`].
     begun: Vec<Begun>,
+    /// Those paths' rows into the BSDF kernel ([`shade::bsdf_kernels`]).
     bsdf_in: Vec<[f32; BSDF_IN]>,
+    /// And its rows out, row for row.
     bsdf_out: Vec<[f32; BSDF_OUT]>,
     /// The numbers of the bounce drawn beforehand (the samplers other than
     /// the independent one): the dimensions every path's vertex asks for,
@@ -394,10 +396,11 @@ impl Wavefront {
     }
 
     /// Shades every path in flight (at bounce `depth`) at its hit, in the
-    /// three steps of [`shade`]: its emission added to `l[slot]`, its light sample's
-    /// light kept with its shadow ray (`self.shadows`, `self.shadow_rays`),
-    /// its next ray (`self.rays`). The paths that end are removed; the
-    /// others keep their order, so that they line up with their rays.
+    /// three steps of [`shade`]: its emission added to `l[slot]`, its
+    /// light sample's light kept with its shadow ray (`self.shadows`,
+    /// `self.shadow_rays`), its next ray (`self.rays`). The paths that end
+    /// are removed; the others keep their order, so that they line up
+    /// with their rays.
     fn shade(
         &mut self,
         scene: &Scene,
@@ -427,9 +430,9 @@ impl Wavefront {
         let light = |k: usize| light_samples.get(k).and_then(Option::as_ref);
         begun.clear();
         bsdf_in.clear();
-        let mut at = hits.iter().zip(&*surfaces).enumerate();
+        let mut vertices = hits.iter().zip(&*surfaces).enumerate();
         paths.retain_mut(|path| {
-            let Some((k, (hit, (shape, sp)))) = at.next() else {
+            let Some((k, (hit, (shape, sp)))) = vertices.next() else {
                 debug_assert!(false, "a path without its hit");
                 return false;
             };
@@ -448,9 +451,9 @@ impl Wavefront {
         bsdf_out.clear();
         bsdf_out.resize(bsdf_in.len(), [0.0; BSDF_OUT]);
         bsdf_kernels(settings, depth, bsdf_in, bsdf_out);
-        let mut done = begun.iter().zip(&*bsdf_out);
+        let mut kernel_rows = begun.iter().zip(&*bsdf_out);
         paths.retain_mut(|path| {
-            let Some((b, out)) = done.next() else {
+            let Some((b, out)) = kernel_rows.next() else {
                 debug_assert!(false, "a path without its BSDF sample");
                 return false;
             };
@@ -458,8 +461,8 @@ impl Wavefront {
             let roulette = |path: &mut Path, dim| {
                 with_numbers(streams, drawn, (k, path), |numbers, _| numbers.get1(dim))
             };
-            let at = (b, &surfaces[k].1, out);
-            let goes_on = bounce.finish(path, at, light(k), (shadows, shadow_rays), roulette);
+            let vertex = (b, &surfaces[k].1, out);
+            let goes_on = bounce.finish(path, vertex, light(k), (shadows, shadow_rays), roulette);
             if goes_on {
                 rays.push(path.ray);
             }

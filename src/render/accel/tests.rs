@@ -299,9 +299,10 @@ fn leaf_batches_are_single_rays_bit_for_bit() {
 }
 
 /// The batch tests skip a sphere for a block of rays none of whose lines
-/// meet it: a small sphere that one ray of a block meets (its last, one
-/// past its first half, or one of a short block's) is still found, by `intersect_many`
-/// and `occluded_many` alike, and the other rays of those blocks pass it.
+/// meet it: a small sphere that one ray of a block meets (its last, one in
+/// its second half, one that only grazes it, or one of a short block's) is
+/// still found, by `intersect_many` and `occluded_many` alike, and the
+/// other rays of those blocks pass it.
 #[test]
 fn a_sphere_met_by_one_ray_of_a_block_is_still_tested() {
     let small = Sphere {
@@ -316,11 +317,16 @@ fn a_sphere_met_by_one_ray_of_a_block_is_still_tested() {
     let prims = [small, far].map(|s| Primitive::Sphere(Box::new(s)));
     let accel = Accel::new(prims.into(), vec![0, 1], Vec::new()).unwrap();
     assert!(accel.bvh.is_none());
-    let toward = [63, 64 + 40, 128 + 1];
-    let rays: Vec<Ray> = (0..130)
+    // The grazing ray's discriminant is 0 exactly: it touches the sphere.
+    let (toward, grazing) = ([63, 64 + 40, 192 + 7], 128 + 20);
+    let rays: Vec<Ray> = (0..200)
         .map(|i| Ray {
-            o: Vec3A::new(0.0, 0.0, i as f32 * 1e-3),
-            d: if toward.contains(&i) {
+            o: if i == grazing {
+                Vec3A::new(0.5, 0.0, 0.0)
+            } else {
+                Vec3A::new(0.0, 0.0, i as f32 * 1e-3)
+            },
+            d: if toward.contains(&i) || i == grazing {
                 Vec3A::Y
             } else {
                 Vec3A::X
@@ -337,10 +343,11 @@ fn a_sphere_met_by_one_ray_of_a_block_is_still_tested() {
         .occluded_many(&rays, &mut stream, &mut blocked)
         .unwrap();
     for (i, (hit, blocked)) in hits.iter().zip(&blocked).enumerate() {
-        let meets = toward.contains(&i);
+        let meets = toward.contains(&i) || i == grazing;
         assert_eq!(hit.map(|h| h.primitive), meets.then_some(0), "ray {i}");
         assert_eq!(*blocked, meets, "ray {i}");
     }
+    assert_eq!(hits[grazing].map(|h| h.t), Some(10.0));
 }
 
 /// A scene's list of primitives holds a triangle as its mesh and face:

@@ -46,8 +46,9 @@ impl Sphere {
     }
 
     /// Whether the line of the ray from `o` along `d` meets the sphere
-    /// (the discriminant of [`Sphere::terms`] is not negative, the same
-    /// bits): where it does not, [`Sphere::hit_branchless`] and
+    /// (the discriminant `h² − a k` of the intersection's quadratic is not
+    /// negative, with the same bits as the hit tests compute it): where it
+    /// does not, [`Sphere::hit_branchless`] and
     /// [`Sphere::occludes_branchless`] are false. Cheaper than either (no
     /// square root, no division), so that a batch can skip a sphere that
     /// no ray of a block comes near.

@@ -10,19 +10,22 @@
 //!         its next ray, roulette
 //! ```
 //!
-//! The kernel holds what costs most per vertex (three powers, a sine and
-//! a cosine, the mirror's frame), which one path at a time would compute
-//! in scalar code. It computes both parts' directions and selects (where
-//! one path at a time would draw only the chosen part's): the same bits.
+//! The kernel holds what costs most per vertex (three powers, two sines
+//! and cosines, the mirror's frame), which one path at a time would
+//! compute in scalar code. It computes both parts' directions and selects,
+//! and the lobe of a BRDF without a glossy part, where one path at a time
+//! draws only the chosen part's direction and skips that lobe: the same
+//! bits (`PhongView::eval_pdf_one`, `PhongView::sample_one`).
 
 use glam::Vec3A;
 
 use super::{Path, Unshadowed};
 use crate::frame::Frame;
+use crate::math::V3;
 use crate::phong::{PhongView, VIEW_TERMS};
 use crate::render::integrator::{
-    Integrator, Settings, Strategy, add_scaled, dims, emission_weight, mul, offset, shading_frame,
-    shadow_ray,
+    Integrator, Settings, Strategy, add_scaled, dims, emission_weight, ends_after_light, mul,
+    offset, shading_frame, shadow_ray,
 };
 use crate::render::numbers::Numbers;
 use crate::render::scene::{LightSample, Scene};
@@ -56,13 +59,31 @@ pub(super) struct Begun {
     pub ends: bool,
 }
 
+/// The row of [`BSDF_IN`] numbers of [`bsdf_kernel`] for the view from
+/// `wi` of the BRDF of `terms`, the light sample's direction `wl` and the
+/// BSDF sample's numbers `u` and `part` (all in the shading frame).
+#[inline]
+fn bsdf_row(
+    (wi, wl): (V3<f32>, V3<f32>),
+    (u, part): ([f32; 2], f32),
+    terms: &[f32; VIEW_TERMS],
+) -> [f32; BSDF_IN] {
+    let mut row = [0.0; BSDF_IN];
+    row[..3].copy_from_slice(&wi);
+    row[3..6].copy_from_slice(&wl);
+    row[6..9].copy_from_slice(&[u[0], u[1], part]);
+    row[9..].copy_from_slice(terms);
+    row
+}
+
 /// The BSDF's part of a vertex's shading, for one row of [`BSDF_IN`]
-/// numbers: with `LIGHT`, `(f_r(wi, wl), p(wl))` toward the light
-/// sample's direction `wl` ([`PhongView::eval_pdf`]); with `SAMPLE`, the
-/// sample [`PhongView::sample`] of `[u0, u1, part]`; as [`BSDF_OUT`]
-/// numbers (zeros for the part not asked for: a bounce whose paths have
-/// no light sample, or all end after it, skips its powers). Branch-free,
-/// for [`crate::simd::map_rows`].
+/// numbers ([`bsdf_row`]): with `LIGHT`, `(f_r(wi, wl), p(wl))` toward
+/// the light sample's direction `wl` ([`PhongView::eval_pdf`]); with
+/// `SAMPLE`, the sample [`PhongView::sample`] of `[u0, u1, part]`; as
+/// [`BSDF_OUT`] numbers (zeros for the part not asked for: under BSDF
+/// sampling the light's power is skipped, and where every path ends
+/// after its light sample, the sample's two). Branch-free, for
+/// [`crate::simd::map_rows`].
 #[inline(always)]
 pub(super) fn bsdf_kernel<const LIGHT: bool, const SAMPLE: bool>(
     row: [f32; BSDF_IN],
@@ -93,31 +114,23 @@ pub(super) fn bsdf_kernels(
     rows: &[[f32; BSDF_IN]],
     out: &mut [[f32; BSDF_OUT]],
 ) {
-    macro_rules! map {
-        ($light:literal, $sample:literal) => {{
-            let kernel = {
-                #[inline(always)]
-                |row| bsdf_kernel::<$light, $sample>(row)
-            };
-            simd::map_rows(out, rows, &kernel, |_| true, false);
-        }};
+    fn map<const LIGHT: bool, const SAMPLE: bool>(
+        rows: &[[f32; BSDF_IN]],
+        out: &mut [[f32; BSDF_OUT]],
+    ) {
+        simd::map_rows(out, rows, &bsdf_kernel::<LIGHT, SAMPLE>, |_| true, false);
     }
     let light = settings.strategy != Strategy::Bsdf;
-    match (light, !ends_after_light(settings, depth)) {
-        (true, true) => map!(true, true),
-        (true, false) => map!(true, false),
-        (false, true) => map!(false, true),
-        // Under BSDF sampling a path always goes on to its next vertex.
-        (false, false) => {}
+    let sample = !ends_after_light(settings, depth);
+    match (light, sample) {
+        (true, true) => map::<true, true>(rows, out),
+        (true, false) => map::<true, false>(rows, out),
+        (false, _) => {
+            // Under BSDF sampling no path ends after a light sample.
+            debug_assert!(sample);
+            map::<false, true>(rows, out);
+        }
     }
-}
-
-/// Whether the paths of a bounce at `depth` end after their light samples:
-/// under emitter sampling the next vertex's emission is not counted, so
-/// when it would be the last they stop there.
-#[inline]
-fn ends_after_light(settings: &Settings, depth: u32) -> bool {
-    settings.strategy == Strategy::Emitter && depth + 2 >= settings.max_depth()
 }
 
 /// What shading a path's vertex needs besides the path.
@@ -165,22 +178,19 @@ impl Bounce<'_> {
         // The direction from the 2D request, the part from the 1D one
         // (drawn in this order, the independent sampler's numbers are
         // those of `PhongView::sample`'s `[u0, u1, part]`).
-        let ([u0, u1], part) = if ends {
+        let bsdf_numbers = if ends {
             ([0.0; 2], 0.0)
         } else {
             let u = numbers.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
             (u, numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT)))
         };
-        let [w0, w1, w2] = frame.to_local(wi.to_array());
-        let [l0, l1, l2] = wl;
-        let [n, pd, d0, d1, d2, s0, s1, s2, gn] = scene.material(shape).bsdf.view_terms();
-        let row = [
-            w0, w1, w2, l0, l1, l2, u0, u1, part, n, pd, d0, d1, d2, s0, s1, s2, gn,
-        ];
+        let wi_local = frame.to_local(wi.to_array());
+        let terms = scene.material(shape).bsdf.view_terms();
+        let row = bsdf_row((wi_local, wl), bsdf_numbers, &terms);
         let begun = Begun {
             k: k as u32,
             frame,
-            wl_z: l2,
+            wl_z: wl[2],
             ends,
         };
         Some((begun, row))
