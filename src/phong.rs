@@ -176,21 +176,13 @@ impl Phong {
     pub(crate) fn view_terms<F: Real>(&self) -> [F; VIEW_TERMS] {
         let n = self.exponent;
         let inv_pi = std::f64::consts::FRAC_1_PI;
-        let [d0, d1, d2] = self.diffuse.map(|v| v * inv_pi);
-        let [s0, s1, s2] = self.specular.map(|v| v * (n + 2.0) * 0.5 * inv_pi);
-        let glossy_norm = (n + 1.0) * 0.5 * inv_pi;
-        [
-            n,
-            self.diffuse_probability,
-            d0,
-            d1,
-            d2,
-            s0,
-            s1,
-            s2,
-            glossy_norm,
-        ]
-        .map(F::c)
+        let mut terms = [0.0; VIEW_TERMS];
+        terms[0] = n;
+        terms[1] = self.diffuse_probability;
+        terms[2..5].copy_from_slice(&self.diffuse.map(|v| v * inv_pi));
+        terms[5..8].copy_from_slice(&self.specular.map(|v| v * (n + 2.0) * 0.5 * inv_pi));
+        terms[8] = (n + 1.0) * 0.5 * inv_pi;
+        terms.map(F::c)
     }
 
     /// The BRDF value `f_r(wi, wo)` per RGB channel (no cosine).
@@ -238,17 +230,8 @@ impl<F: Real> PhongView<F> {
     /// SIMD width as for one).
     #[inline(always)]
     pub(crate) fn from_terms(wi: V3<F>, terms: [F; VIEW_TERMS]) -> Self {
-        let [
-            exponent,
-            diffuse_probability,
-            d0,
-            d1,
-            d2,
-            s0,
-            s1,
-            s2,
-            glossy_norm,
-        ] = terms;
+        let [exponent, diffuse_probability, parts @ .., glossy_norm] = terms;
+        let [d0, d1, d2, s0, s1, s2] = parts;
         let mirror = reflect(wi);
         PhongView {
             wi_above: wi[2] > F::zero(),
