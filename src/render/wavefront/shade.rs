@@ -118,7 +118,13 @@ pub(super) fn bsdf_kernels(
         rows: &[[f32; BSDF_IN]],
         out: &mut [[f32; BSDF_OUT]],
     ) {
-        simd::map_rows(out, rows, &bsdf_kernel::<LIGHT, SAMPLE>, |_| true, false);
+        // Through a closure marked inline: given the function itself, the
+        // kernel ran 50 % slower (demo BSDF sampling 20.4 -> 30.6 ms).
+        let kernel = {
+            #[inline(always)]
+            |row| bsdf_kernel::<LIGHT, SAMPLE>(row)
+        };
+        simd::map_rows(out, rows, &kernel, |_| true, false);
     }
     let light = settings.strategy != Strategy::Bsdf;
     let sample = !ends_after_light(settings, depth);
