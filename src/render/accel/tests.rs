@@ -234,14 +234,7 @@ fn leaf_batches_are_single_rays_bit_for_bit() {
         let (mut on_kind, mut replaced) = ([0; 3], 0);
         for n in [0, 1, 63, 64, 65, 129, 300] {
             let rays = &rays[..n];
-            let (mut many, mut blocked) = (Vec::new(), Vec::new());
-            let mut stream = Default::default();
-            accel
-                .intersect_many(rays, false, &mut stream, &mut many)
-                .unwrap();
-            accel
-                .occluded_many(rays, &mut stream, &mut blocked)
-                .unwrap();
+            let (many, blocked) = streamed(&accel, rays);
             let one: Vec<_> = rays.iter().map(|r| accel.intersect(r)).collect();
             assert!(many.iter().map(bits).eq(one.iter().map(bits)));
             assert!(
@@ -298,6 +291,20 @@ fn leaf_batches_are_single_rays_bit_for_bit() {
     }
 }
 
+/// The nearest hits of `rays` and whether each is blocked, as streams
+/// (incoherent).
+fn streamed(accel: &Accel, rays: &[Ray]) -> (Vec<Option<Hit>>, Vec<bool>) {
+    let (mut hits, mut blocked) = (Vec::new(), Vec::new());
+    let mut stream = Default::default();
+    accel
+        .intersect_many(rays, false, &mut stream, &mut hits)
+        .unwrap();
+    accel
+        .occluded_many(rays, &mut stream, &mut blocked)
+        .unwrap();
+    (hits, blocked)
+}
+
 /// The batch tests skip a sphere for a block of rays none of whose lines
 /// meet it: a small sphere that one ray of a block meets (its last, one in
 /// its second half, one that only grazes it, or one of a short block's) is
@@ -334,14 +341,7 @@ fn a_sphere_met_by_one_ray_of_a_block_is_still_tested() {
             tmax: f32::INFINITY,
         })
         .collect();
-    let (mut hits, mut blocked) = (Vec::new(), Vec::new());
-    let mut stream = Default::default();
-    accel
-        .intersect_many(&rays, false, &mut stream, &mut hits)
-        .unwrap();
-    accel
-        .occluded_many(&rays, &mut stream, &mut blocked)
-        .unwrap();
+    let (hits, blocked) = streamed(&accel, &rays);
     for (i, (hit, blocked)) in hits.iter().zip(&blocked).enumerate() {
         let meets = toward.contains(&i) || i == grazing;
         assert_eq!(hit.map(|h| h.primitive), meets.then_some(0), "ray {i}");
