@@ -104,6 +104,71 @@ impl Rng {
     }
 }
 
+/// PCG32's multiplier (O'Neill's `PCG_DEFAULT_MULTIPLIER_64`).
+const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
+
+/// For each `(seed, stream)` of `starts`, the first `at.len()` floats of
+/// `Rng::new(seed, stream)`, float `k` at `row[at[k]]` of the sample's row
+/// of `out` (`out.len() / starts.len()` floats), and that generator after
+/// them in `after`: bit for bit [`Rng::new`] and [`Rng::next_float`], at
+/// SIMD width.
+///
+/// PCG32 steps its state `s ← s·a + c` (multiplier `a`, increment
+/// `c = 2·stream + 1`), from `s₀ = (seed + c)·a + c`; output `k` is the
+/// XSH-RR permutation of `s_k`:
+/// `((s ⊕ s ≫ 18) ≫ 27) as u32` rotated right by `s ≫ 59`.
+/// `Rng::new(x, stream)` starts at `(x + c)·a + c`, so the generator at
+/// `s_count` is `Rng::new(s_{count−1} − c, stream)` (with `s₋₁ = seed + c`).
+///
+/// # Panics
+/// When `out.len()` is not a multiple of `starts.len()`, an offset is not
+/// within a row, or `after` is not as long as `starts`.
+pub fn first_floats(starts: &[(u64, u64)], at: &[usize], out: &mut [f32], after: &mut [Rng]) {
+    let Some(stride) = out.len().checked_div(starts.len()) else {
+        return;
+    };
+    assert!(out.len() == stride * starts.len() && after.len() == starts.len());
+    assert!(at.iter().all(|&k| k < stride));
+    const BLOCK: usize = crate::simd::BLOCK;
+    crate::simd::dispatch(
+        #[inline(always)]
+        |_| {
+            let blocks = starts.chunks(BLOCK).zip(after.chunks_mut(BLOCK));
+            for (b, (starts, after)) in blocks.enumerate() {
+                let first = b * BLOCK * stride;
+                let rows = &mut out[first..first + starts.len() * stride];
+                let (mut c, mut s, mut last) = ([0; BLOCK], [0; BLOCK], [0; BLOCK]);
+                for (((&(seed, stream), c), s), last) in
+                    starts.iter().zip(&mut c).zip(&mut s).zip(&mut last)
+                {
+                    *c = (stream << 1) | 1;
+                    *last = seed.wrapping_add(*c);
+                    *s = last.wrapping_mul(MULTIPLIER).wrapping_add(*c);
+                }
+                for &k in at {
+                    let mut column = [0.0; BLOCK];
+                    for (((column, s), c), last) in
+                        column.iter_mut().zip(&mut s).zip(&c).zip(&mut last)
+                    {
+                        let xsh = (((*s >> 18) ^ *s) >> 27) as u32;
+                        *column = f32::from_random_bits(xsh.rotate_right((*s >> 59) as u32));
+                        *last = *s;
+                        *s = s.wrapping_mul(MULTIPLIER).wrapping_add(*c);
+                    }
+                    for (row, &v) in rows.chunks_exact_mut(stride).zip(&column) {
+                        row[k] = v;
+                    }
+                }
+                for (((a, &(_, stream)), c), last) in
+                    after.iter_mut().zip(starts).zip(&c).zip(&last)
+                {
+                    *a = Rng::new(last.wrapping_sub(*c), stream);
+                }
+            }
+        },
+    );
+}
+
 /// `n × dim` uniform floats in `[0, 1)`, row-major: the first `n·dim` floats
 /// of `Rng::new(seed, 0)`.
 ///
@@ -132,6 +197,40 @@ mod tests {
         let mut rng = Rng::new(42, 54);
         let got: Vec<u32> = (0..6).map(|_| rng.next_u32()).collect();
         assert_eq!(got, REFERENCE_42_54);
+    }
+
+    #[test]
+    fn first_floats_are_the_generators_draws() {
+        let starts: Vec<(u64, u64)> = (0..150u64)
+            .map(|i| (i.wrapping_mul(0x9E37_79B9_7F4A_7C15), i % 7 + (i << 40)))
+            .chain([(u64::MAX, MAX_STREAM), (0, 0)])
+            .collect();
+        let layouts: [(&[usize], usize); 4] = [
+            (&[], 2),
+            (&[0], 1),
+            (&[0, 1, 2, 3], 4),
+            (&[4, 0, 1, 2, 3], 6),
+        ];
+        for (at, stride) in layouts {
+            let mut out = vec![-1.0; starts.len() * stride];
+            let mut after = vec![Rng::new(0, 0); starts.len()];
+            first_floats(&starts, at, &mut out, &mut after);
+            for ((&(seed, stream), after), row) in
+                starts.iter().zip(&mut after).zip(out.chunks(stride))
+            {
+                let mut rng = Rng::new(seed, stream);
+                let mut expected = vec![-1.0; stride];
+                for &k in at {
+                    expected[k] = rng.next_float();
+                }
+                assert_eq!(row, &expected[..], "seed {seed}, stream {stream}");
+                assert_eq!(
+                    after.next_u64(),
+                    rng.next_u64(),
+                    "seed {seed}, stream {stream}"
+                );
+            }
+        }
     }
 
     #[test]

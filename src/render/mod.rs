@@ -79,7 +79,7 @@ use crate::sampler::zorder::ZOrder;
 use crate::sampler::{Sampler, Stream};
 use accel::Hit;
 use film::{Block, Sums};
-use numbers::{Numbers, camera_dims};
+use numbers::{camera_dims, camera_values};
 use shape::Ray;
 use wavefront::{CameraSample, Wavefront};
 
@@ -184,6 +184,8 @@ struct Batch {
     /// The independent sampler's generator of each sample after its camera
     /// draws.
     resume: Vec<Rng>,
+    /// The seed and stream of each sample's generator, `BATCH` at a time.
+    starts: Vec<(u64, u64)>,
     rays: Vec<Ray>,
     /// Where each camera ray first meets the scene.
     hits: Vec<Option<Hit>>,
@@ -230,9 +232,11 @@ impl Batch {
         alloc::reserve_each!(n, WHAT;
             self.camera_u, self.weights, self.times, self.resume, self.rays, self.hits, self.radiance)?;
         let mut streams: Vec<Stream> = alloc::with_capacity(pixels.len(), WHAT)?;
+        let mut keys: Vec<(u64, u64)> = alloc::with_capacity(pixels.len(), WHAT)?;
         for x in pixels.clone() {
             let pixel = (y * width + x) as u64;
             let key = mix(seed, pixel);
+            keys.push((pixel, key));
             streams.push(Stream::new(
                 settings.sampler,
                 key,
@@ -246,55 +250,48 @@ impl Batch {
         // time (likewise).
         let independent = settings.sampler == Sampler::Independent;
         let lens_drawn = scene.camera().has_lens() || independent;
-        let camera = if independent {
-            Vec::new()
-        } else {
-            camera_dims((lens_drawn, moves))
-        };
-        self.drawn.values.clear();
+        let camera = camera_dims((lens_drawn, moves));
         let spp = spp.max(1) as usize;
-        let index = |i: usize| samples.first + i as u64;
-        // The other samplers' camera numbers drawn together, BATCH
-        // samples at a time (a pixel may have many more); `j` counts the
-        // samples, pixel after pixel.
-        let mut j = 0;
-        for p in 0..streams.len() {
-            let x = pixels.start + p;
-            let pixel = (y * width + x) as u64;
-            let key = mix(seed, pixel);
-            for i in 0..spp {
-                if !independent && j % BATCH == 0 {
-                    // Sample `j + m` is sample `(i + m) mod spp` of pixel
-                    // `p + (i + m) / spp`.
-                    let samples = (0..(j + BATCH).min(n) - j).map(|m| {
-                        let (q, k) = (p + (i + m) / spp, (i + m) % spp);
-                        (q as u32, index(k) as u32)
-                    });
-                    self.drawn.draw(&mut streams, samples, &camera)?;
-                }
-                let stream = &mut streams[p];
-                start_sample(stream, key, pixel, index(i));
-                let drawn = (&camera[..], &self.drawn.values[..]);
-                let mut numbers = Numbers::new(stream, drawn, j % BATCH);
-                let film = numbers.get2(dims::FILM);
-                let lens = if lens_drawn {
-                    numbers.get2(dims::LENS)
-                } else {
-                    [0.5; 2]
-                };
-                let ([px, py], weight) = filter.sample((x, y), film);
+        let index = |k: usize| samples.first + k as u64;
+        // The camera's numbers drawn together, BATCH samples at a time (a
+        // pixel may have many more). `at`: the pixel (from the row's first)
+        // and the number in it of the batch's first sample.
+        let mut at = (0, 0);
+        for first in (0..n).step_by(BATCH) {
+            let start = at;
+            let batch = (0..(first + BATCH).min(n) - first).map(|_| {
+                let sample = at;
+                at = next_sample(at, spp);
+                sample
+            });
+            if independent {
+                // Each sample's own generator, seeded as `start_sample`
+                // seeds it; the paths go on from where these draws leave
+                // it.
+                self.starts.clear();
+                self.starts.extend(batch.map(|(p, k)| {
+                    let (pixel, key) = keys[p];
+                    (mix(key, index(k)), pixel)
+                }));
+                self.drawn.draw_fresh(&self.starts, &camera)?;
+                self.resume.extend_from_slice(&self.drawn.generators);
+            } else {
+                let samples = batch.map(|(p, k)| (p as u32, index(k) as u32));
+                self.drawn.draw(&mut streams, samples, &camera)?;
+            }
+            let mut sample = start;
+            for values in self.drawn.values.chunks_exact(camera.len()) {
+                let (film, lens, time) = camera_values(values, (lens_drawn, moves));
+                let ([px, py], weight) = filter.sample((pixels.start + sample.0, y), film);
                 self.camera_u
                     .push([px * inv_width, py * inv_height, lens[0], lens[1]]);
                 if filter.weighted() {
                     self.weights.push(weight);
                 }
                 if moves {
-                    self.times.push(numbers.get1(dims::TIME));
+                    self.times.push(time);
                 }
-                if let Some(rng) = numbers.independent() {
-                    self.resume.push(rng.clone());
-                }
-                j += 1;
+                sample = next_sample(sample, spp);
             }
         }
         self.rays.resize(self.camera_u.len(), Ray::default());
@@ -323,18 +320,17 @@ impl Batch {
         for first in (0..self.rays.len()).step_by(BATCH) {
             let slots = first..(first + BATCH).min(self.rays.len());
             self.paths.start(slots.len())?;
-            // Slot `s` is sample `k = s mod spp` of pixel `s / spp`,
-            // counted along (not divided for each).
-            let (mut pixel, mut k) = (first / spp, first % spp);
+            // Slot `s` is sample `s mod spp` of pixel `s / spp`.
+            let mut sample = (first / spp, first % spp);
             for slot in slots {
-                let index = samples.first + k as u64;
+                let (pixel, k) = sample;
                 self.paths.push(
                     scene,
                     settings,
                     CameraSample {
                         slot: slot as u32,
                         pixel: pixel as u32,
-                        index: index as u32,
+                        index: index(k) as u32,
                         ray: self.rays[slot],
                         hit: self.hits[slot],
                         time: time(slot),
@@ -343,10 +339,7 @@ impl Batch {
                         rng: self.resume.get(slot).cloned(),
                     },
                 );
-                k += 1;
-                if k == spp {
-                    (pixel, k) = (pixel + 1, 0);
-                }
+                sample = next_sample(sample, spp);
             }
             self.paths
                 .trace(scene, settings, &mut streams, &mut self.radiance)?;
@@ -357,6 +350,14 @@ impl Batch {
         }
         Ok(())
     }
+}
+
+/// The sample after `(p, k)` (sample `k` of pixel `p`) in a row whose
+/// pixels have `spp` samples each: the samples counted along, pixel after
+/// pixel, without a division for each.
+#[inline(always)]
+fn next_sample((p, k): (usize, usize), spp: usize) -> (usize, usize) {
+    if k + 1 == spp { (p + 1, 0) } else { (p, k + 1) }
 }
 
 /// SplitMix64's finaliser: a well-mixed 64-bit state from the seed and the

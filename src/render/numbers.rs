@@ -96,6 +96,20 @@ pub fn camera_dims((lens, time): (bool, bool)) -> Vec<Dim> {
     out
 }
 
+/// One sample's film position, lens position (`[0.5; 2]` when not drawn)
+/// and time (0 when not drawn), from its values of
+/// [`camera_dims`]`((lens, time))`, in their order.
+#[inline(always)]
+pub fn camera_values(values: &[[f32; 2]], (lens, time): (bool, bool)) -> ([f32; 2], [f32; 2], f32) {
+    let lens_u = if lens { values[1] } else { [0.5; 2] };
+    let t = if time {
+        values[1 + usize::from(lens)][0]
+    } else {
+        0.0
+    };
+    (values[0], lens_u, t)
+}
+
 /// Whether the shading draws the light's choice: when the scene has more
 /// than one light (`many_lights`), and always under the independent
 /// sampler, whose draws keep their order (the others' numbers depend only

@@ -928,3 +928,14 @@ fn hits_emitter_agrees_with_the_surface_shape() {
     }
     assert_eq!(seen, [true; 4], "every shape hit");
 }
+
+#[test]
+fn a_row_s_samples_counted_along_are_its_quotients_and_remainders() {
+    for spp in [1, 3, 16] {
+        let mut sample = (0, 0);
+        for j in 0..100 {
+            assert_eq!(sample, (j / spp, j % spp), "spp {spp}, sample {j}");
+            sample = super::next_sample(sample, spp);
+        }
+    }
+}

@@ -22,6 +22,7 @@ use crate::alloc;
 use crate::error::Result;
 use crate::math::Real;
 use crate::qmc::patterns::{kensler_step, rotate, walk};
+use crate::rng::{Rng, first_floats};
 use crate::simd::dispatch;
 
 /// A coordinate every sample of a step asks for: `dim` (and `dim + 1`
@@ -52,6 +53,8 @@ pub struct Drawn {
     /// [`Sampler::Sobol`], [`Sampler::LowDiscrepancy`]: the permutation's seed, its rotation and the
     /// stream's count.
     permutation: Vec<[u32; 3]>,
+    /// [`Drawn::draw_fresh`]: each sample's generator after its draws.
+    pub generators: Vec<Rng>,
 }
 
 impl Drawn {
@@ -106,6 +109,7 @@ impl Drawn {
             index,
             seed,
             permutation,
+            ..
         } = self;
         // Sized first, then written through slices (no length kept up to
         // date per request).
@@ -159,6 +163,42 @@ impl Drawn {
                     *v = pair.map(f32::from_random_bits);
                 }
             },
+        );
+        Ok(())
+    }
+
+    /// The independent sampler's requests `dims` of samples that each start
+    /// a generator of their own, `Rng::new(seed, stream)` for each of
+    /// `starts`: what asking them in order of that generator gives, laid out
+    /// as [`Drawn::draw`] lays them out, drawn at SIMD width
+    /// ([`crate::rng::first_floats`]). [`Drawn::generators`] holds each
+    /// sample's generator after them.
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when the memory for the values cannot be
+    /// had.
+    pub fn draw_fresh(&mut self, starts: &[(u64, u64)], dims: &[Dim]) -> Result<()> {
+        const WHAT: &str = "a batch of sample numbers";
+        let n = starts.len();
+        self.values.clear();
+        self.generators.clear();
+        alloc::reserve(&mut self.values, n * dims.len(), WHAT)?;
+        alloc::reserve(&mut self.generators, n, WHAT)?;
+        self.values.resize(n * dims.len(), [0.0; 2]);
+        self.generators.resize(n, Rng::new(0, 0));
+        // Each request's floats, at their places in its sample's values.
+        let at: Vec<usize> = (0..dims.len())
+            .flat_map(|k| {
+                [2 * k, 2 * k + 1]
+                    .into_iter()
+                    .take(1 + usize::from(dims[k].two))
+            })
+            .collect();
+        first_floats(
+            starts,
+            &at,
+            self.values.as_flattened_mut(),
+            &mut self.generators,
         );
         Ok(())
     }
