@@ -12,41 +12,71 @@
 //! chunk of the batch a copy advanced to the chunk's first index, so a batch
 //! is bit-identical to drawing its numbers one after another, on any number
 //! of threads.
+//!
+//! The generator's two words are its own (not `rand_pcg`'s, which the tests
+//! check it against) so that [`first_floats`] steps many generators at SIMD
+//! width with the same two functions ([`step`], [`output`]), and so that a
+//! path's generator is handed back to it by its state alone
+//! ([`Rng::resume`]).
 
 use crate::error::Result;
 use crate::math::Real;
 use crate::parallel;
-use rand_core::Rng as _;
 
 /// The largest stream id: PCG32 uses `2·stream + 1` as its increment, so
 /// the top bit of a 64-bit stream id would be lost.
 pub const MAX_STREAM: u64 = (1 << 63) - 1;
 
-/// A PCG32 generator (state and stream).
-#[derive(Clone, Debug)]
+/// PCG32's multiplier (O'Neill's `PCG_DEFAULT_MULTIPLIER_64`).
+const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
+
+/// The LCG's step: `s·a + c` (multiplier `a`, increment `c`).
+#[inline(always)]
+fn step(state: u64, increment: u64) -> u64 {
+    state.wrapping_mul(MULTIPLIER).wrapping_add(increment)
+}
+
+/// XSH-RR, the output of state `s`: `((s ⊕ s ≫ 18) ≫ 27) as u32` rotated
+/// right by `s ≫ 59`.
+#[inline(always)]
+fn output(state: u64) -> u32 {
+    let xsh = (((state >> 18) ^ state) >> 27) as u32;
+    xsh.rotate_right((state >> 59) as u32)
+}
+
+/// A PCG32 generator: the LCG's state, and its increment `2·stream + 1`.
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Rng {
-    pcg: rand_pcg::Pcg32,
+    state: u64,
+    increment: u64,
 }
 
 impl Rng {
-    /// Seeds as `pcg32_srandom_r(seed, stream)`. `stream` is taken modulo
-    /// 2^63 (see [`MAX_STREAM`]); callers reject larger values.
+    /// Seeds as `pcg32_srandom_r(seed, stream)`: the state
+    /// `(seed + c)·a + c`. `stream` is taken modulo 2^63 (see
+    /// [`MAX_STREAM`]); callers reject larger values.
+    #[inline]
     pub fn new(seed: u64, stream: u64) -> Self {
+        let increment = (stream << 1) | 1;
         Rng {
-            pcg: rand_pcg::Pcg32::new(seed, stream),
+            state: step(seed.wrapping_add(increment), increment),
+            increment,
         }
     }
 
-    /// The next 32-bit output.
+    /// The next 32-bit output: that of the state, which then steps.
     #[inline(always)]
     pub fn next_u32(&mut self) -> u32 {
-        self.pcg.next_u32()
+        let state = self.state;
+        self.state = step(state, self.increment);
+        output(state)
     }
 
-    /// The next 64 bits: two 32-bit outputs.
+    /// The next 64 bits: two 32-bit outputs, the first the low half.
     #[inline(always)]
     pub fn next_u64(&mut self) -> u64 {
-        self.pcg.next_u64()
+        let low = u64::from(self.next_u32());
+        (u64::from(self.next_u32()) << 32) | low
     }
 
     /// The next float in `[0, 1)`, from one 32-bit output.
@@ -55,9 +85,31 @@ impl Rng {
         F::from_random_bits(self.next_u32())
     }
 
-    /// Skips `delta` outputs in `O(log delta)`.
+    /// Goes on from where `copy`, a copy of this generator, left its
+    /// draws: only the state is copied (one word, which the draws wrote
+    /// last; a copy of both would wait on those writes).
+    #[inline(always)]
+    pub fn resume(&mut self, copy: &Rng) {
+        debug_assert_eq!(self.increment, copy.increment, "not a copy");
+        self.state = copy.state;
+    }
+
+    /// Skips `delta` outputs in `O(log delta)`: `delta` steps compose into
+    /// one affine map `s ↦ A·s + C`, built by squaring.
     pub fn advance(&mut self, delta: u64) {
-        self.pcg.advance(delta);
+        let (mut a, mut c) = (1u64, 0u64);
+        let (mut square_a, mut square_c) = (MULTIPLIER, self.increment);
+        let mut left = delta;
+        while left > 0 {
+            if left & 1 == 1 {
+                a = a.wrapping_mul(square_a);
+                c = c.wrapping_mul(square_a).wrapping_add(square_c);
+            }
+            square_c = square_a.wrapping_add(1).wrapping_mul(square_c);
+            square_a = square_a.wrapping_mul(square_a);
+            left >>= 1;
+        }
+        self.state = a.wrapping_mul(self.state).wrapping_add(c);
     }
 
     /// This generator advanced by `delta` outputs (self is unchanged).
@@ -104,21 +156,13 @@ impl Rng {
     }
 }
 
-/// PCG32's multiplier (O'Neill's `PCG_DEFAULT_MULTIPLIER_64`).
-const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
-
 /// For each `(seed, stream)` of `starts`, the first `at.len()` floats of
 /// `Rng::new(seed, stream)`, float `k` at `row[at[k]]` of the sample's row
 /// of `out` (`out.len() / starts.len()` floats), and that generator after
 /// them in `after`: bit for bit [`Rng::new`] and [`Rng::next_float`], at
 /// SIMD width.
 ///
-/// PCG32 steps its state `s ← s·a + c` (multiplier `a`, increment
-/// `c = 2·stream + 1`), from `s₀ = (seed + c)·a + c`; output `k` is the
-/// XSH-RR permutation of `s_k`:
-/// `((s ⊕ s ≫ 18) ≫ 27) as u32` rotated right by `s ≫ 59`.
-/// `Rng::new(x, stream)` starts at `(x + c)·a + c`, so the generator at
-/// `s_count` is `Rng::new(s_{count−1} − c, stream)` (with `s₋₁ = seed + c`).
+/// Each sample's generator is stepped in one lane ([`step`], [`output`]).
 ///
 /// # Panics
 /// When `out.len()` is not a multiple of `starts.len()`, an offset is not
@@ -137,32 +181,23 @@ pub fn first_floats(starts: &[(u64, u64)], at: &[usize], out: &mut [f32], after:
             for (b, (starts, after)) in blocks.enumerate() {
                 let first = b * BLOCK * stride;
                 let rows = &mut out[first..first + starts.len() * stride];
-                let (mut c, mut s, mut last) = ([0; BLOCK], [0; BLOCK], [0; BLOCK]);
-                for (((&(seed, stream), c), s), last) in
-                    starts.iter().zip(&mut c).zip(&mut s).zip(&mut last)
-                {
+                let (mut c, mut s) = ([0; BLOCK], [0; BLOCK]);
+                for ((&(seed, stream), c), s) in starts.iter().zip(&mut c).zip(&mut s) {
                     *c = (stream << 1) | 1;
-                    *last = seed.wrapping_add(*c);
-                    *s = last.wrapping_mul(MULTIPLIER).wrapping_add(*c);
+                    *s = step(seed.wrapping_add(*c), *c);
                 }
                 for &k in at {
                     let mut column = [0.0; BLOCK];
-                    for (((column, s), c), last) in
-                        column.iter_mut().zip(&mut s).zip(&c).zip(&mut last)
-                    {
-                        let xsh = (((*s >> 18) ^ *s) >> 27) as u32;
-                        *column = f32::from_random_bits(xsh.rotate_right((*s >> 59) as u32));
-                        *last = *s;
-                        *s = s.wrapping_mul(MULTIPLIER).wrapping_add(*c);
+                    for ((column, s), c) in column.iter_mut().zip(&mut s).zip(&c) {
+                        *column = f32::from_random_bits(output(*s));
+                        *s = step(*s, *c);
                     }
                     for (row, &v) in rows.chunks_exact_mut(stride).zip(&column) {
                         row[k] = v;
                     }
                 }
-                for (((a, &(_, stream)), c), last) in
-                    after.iter_mut().zip(starts).zip(&c).zip(&last)
-                {
-                    *a = Rng::new(last.wrapping_sub(*c), stream);
+                for ((a, &state), &increment) in after.iter_mut().zip(&s).zip(&c) {
+                    *a = Rng { state, increment };
                 }
             }
         },
@@ -246,6 +281,42 @@ mod tests {
             Rng::new(state, stream).next_float::<f64>(),
             0.108_378_705_102_950_33
         );
+    }
+
+    #[test]
+    fn equals_rand_pcg() {
+        use rand_core::Rng as _;
+        let seeds = [0, 1, 42, u64::MAX, 0x853c_49e6_748f_ea9b];
+        let streams = [0, 1, 54, MAX_STREAM, u64::MAX];
+        for (&seed, &stream) in seeds
+            .iter()
+            .flat_map(|s| streams.iter().map(move |t| (s, t)))
+        {
+            let (mut ours, mut theirs) =
+                (Rng::new(seed, stream), rand_pcg::Pcg32::new(seed, stream));
+            for _ in 0..100 {
+                assert_eq!(ours.next_u32(), theirs.next_u32());
+            }
+            assert_eq!(ours.next_u64(), theirs.next_u64());
+            for delta in [0, 1, 2, 1000, 1 << 40, u64::MAX] {
+                ours.advance(delta);
+                theirs.advance(delta);
+                assert_eq!(ours.next_u32(), theirs.next_u32(), "advance({delta})");
+            }
+        }
+    }
+
+    #[test]
+    fn resumes_where_its_copy_left() {
+        let mut rng = Rng::new(9, 4);
+        let mut copy = rng.clone();
+        let drawn: Vec<u32> = (0..3).map(|_| copy.next_u32()).collect();
+        assert_ne!(rng, copy);
+        rng.resume(&copy);
+        assert_eq!(rng, copy);
+        let mut fresh = Rng::new(9, 4);
+        assert_eq!((0..3).map(|_| fresh.next_u32()).collect::<Vec<_>>(), drawn);
+        assert_eq!(rng.next_u32(), fresh.next_u32());
     }
 
     #[test]

@@ -462,11 +462,12 @@ impl Wavefront {
                 with_numbers(streams, drawn, (k, path), |numbers, _| numbers.get1(dim))
             };
             let vertex = (b, &surfaces[k].1, out);
-            let goes_on = bounce.finish(path, vertex, light(k), (shadows, shadow_rays), roulette);
-            if goes_on {
-                rays.push(path.ray);
-            }
-            goes_on
+            let next = bounce.finish(path, vertex, light(k), (shadows, shadow_rays), roulette);
+            let Some(ray) = next else {
+                return false;
+            };
+            rays.push(ray);
+            true
         });
     }
 
@@ -532,9 +533,9 @@ fn escape(scene: &Scene, settings: &Settings, escaped: &mut Escaped, path: &Path
 
 /// `f` of `path` and the numbers of its vertex (`k`: its index among the
 /// bounce's paths, whose numbers `drawn` were drawn beforehand), its
-/// pixel's stream set to its sample, and the generator the path carries
-/// swapped in for the call (the independent sampler's: its draws go on
-/// where the path left them).
+/// pixel's stream set to its sample. The independent sampler draws from a
+/// copy of the generator the path carries, in the stream, and the path
+/// then goes on from where the copy left ([`Rng::resume`]).
 #[inline(always)]
 fn with_numbers<T>(
     streams: &mut [Stream],
@@ -544,20 +545,15 @@ fn with_numbers<T>(
 ) -> T {
     let stream = &mut streams[path.pixel as usize];
     stream.start(path.index);
-    swap_generators(stream, path);
+    if let (Some(rng), Some(own)) = (stream.independent(), &path.rng) {
+        rng.clone_from(own);
+    }
     let mut numbers = Numbers::new(stream, drawn, k);
     let out = f(&mut numbers, path);
-    swap_generators(numbers.stream, path);
-    out
-}
-
-/// Swaps the generator of `stream` (the independent sampler's) with the
-/// one `path` carries: before and after its draws.
-#[inline]
-fn swap_generators(stream: &mut Stream, path: &mut Path) {
-    if let (Some(rng), Some(own)) = (stream.independent(), path.rng.as_mut()) {
-        std::mem::swap(rng, own);
+    if let (Some(rng), Some(own)) = (numbers.stream.independent(), path.rng.as_mut()) {
+        own.resume(rng);
     }
+    out
 }
 
 /// The paths (their indices in the bounce) whose environment-map light

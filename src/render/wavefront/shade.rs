@@ -237,7 +237,10 @@ impl Bounce<'_> {
     /// `begun`, with the kernel's numbers `out`): its light sample `ls`
     /// connected, and the path moved on along its BSDF sample, after
     /// roulette (whose number `roulette` draws for the path and a
-    /// dimension). Whether the path goes on.
+    /// dimension). The path's next ray when it goes on (also its
+    /// `ray`: handed back by value, as the caller stores it too,
+    /// because reading it back from the path would wait on the stores
+    /// that just wrote it).
     #[inline]
     pub fn finish(
         &self,
@@ -246,7 +249,7 @@ impl Bounce<'_> {
         ls: Option<&LightSample>,
         shadows: (&mut Vec<Unshadowed>, &mut Vec<Ray>),
         roulette: impl FnOnce(&mut Path, u32) -> f32,
-    ) -> bool {
+    ) -> Option<Ray> {
         let settings = self.settings;
         let [f0, f1, f2, pdf_wl, x, y, z, pdf, r, g, b] = *out;
         if settings.strategy != Strategy::Bsdf
@@ -255,26 +258,27 @@ impl Bounce<'_> {
             self.connect(path, sp, (begun.wl_z, [f0, f1, f2], pdf_wl), ls, shadows);
         }
         if begun.ends || [r, g, b].iter().all(|&v| v <= 0.0) {
-            return false;
+            return None;
         }
         let depth = path.depth;
         path.beta = mul(path.beta, [r, g, b]);
         path.bsdf_pdf = pdf;
         let d = Vec3A::from(begun.frame.to_world([x, y, z])).normalize();
         path.from = sp.p;
-        path.ray = Ray {
+        let ray = Ray {
             o: offset(sp.p, sp.ng, d),
             d,
             tmax: f32::INFINITY,
         };
+        path.ray = ray;
         path.depth += 1;
         if settings.integrator == Integrator::Path && path.depth >= settings.rr_depth {
             let q = path.beta.iter().copied().fold(0.0f32, f32::max).min(0.95);
             if roulette(path, dims::bounce(depth, dims::ROULETTE)) >= q {
-                return false;
+                return None;
             }
             path.beta = path.beta.map(|b| b / q);
         }
-        true
+        Some(ray)
     }
 }
