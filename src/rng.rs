@@ -15,7 +15,7 @@
 //!
 //! The generator's two words are its own (not `rand_pcg`'s, which the tests
 //! check it against) so that [`first_floats`] steps many generators at SIMD
-//! width with the same two functions ([`step`], [`output`]), and so that a
+//! width with the same two functions (`step`, `output`), and so that a
 //! path's generator is handed back to it by its state alone
 //! ([`Rng::resume`]).
 
@@ -162,7 +162,8 @@ impl Rng {
 /// them in `after`: bit for bit [`Rng::new`] and [`Rng::next_float`], at
 /// SIMD width.
 ///
-/// Each sample's generator is stepped in one lane ([`step`], [`output`]).
+/// Each sample's generator is seeded by [`Rng::new`] and stepped in one
+/// lane (`step`, `output`).
 ///
 /// # Panics
 /// When `out.len()` is not a multiple of `starts.len()`, an offset is not
@@ -183,8 +184,8 @@ pub fn first_floats(starts: &[(u64, u64)], at: &[usize], out: &mut [f32], after:
                 let rows = &mut out[first..first + starts.len() * stride];
                 let (mut c, mut s) = ([0; BLOCK], [0; BLOCK]);
                 for ((&(seed, stream), c), s) in starts.iter().zip(&mut c).zip(&mut s) {
-                    *c = (stream << 1) | 1;
-                    *s = step(seed.wrapping_add(*c), *c);
+                    let rng = Rng::new(seed, stream);
+                    (*c, *s) = (rng.increment, rng.state);
                 }
                 for &k in at {
                     let mut column = [0.0; BLOCK];

@@ -20,8 +20,8 @@
 //! decision takes are listed in [`integrator::dims`].
 //!
 //! Samples are rendered in batches of about `BATCH` (whole pixels of one
-//! row): each pixel's film and lens positions are drawn first, the camera
-//! rays of the batch are made at SIMD width, the paths are traced together
+//! row): each sample's film and lens positions are drawn first, the
+//! camera rays of the batch are made at SIMD width, the paths are traced together
 //! one bounce at a time, in groups of at most `BATCH` ([`wavefront`]: every
 //! shadow ray and every next ray of a group in one stream), and the light
 //! of every ray of a group that left the scene is looked up at its end
@@ -31,7 +31,10 @@
 //! on the sample and the dimension, so the numbers the camera samples of a
 //! batch, and then each bounce of its paths, will ask for are drawn
 //! together beforehand at SIMD width ([`crate::sampler::batch`], the same
-//! bits as one at a time).
+//! bits as one at a time). The independent sampler's camera numbers are
+//! too: each sample starts a generator of its own, whose first draws they
+//! are ([`crate::rng::first_floats`]); its paths' numbers are drawn as
+//! they are asked for.
 //!
 //! Emitter sampling draws an environment map with the density of its own
 //! [`crate::envmap::EnvMap::pdf`] (under MIS in the direct and path
@@ -146,8 +149,16 @@ fn start_sample(stream: &mut Stream, key: u64, pixel: u64, index: u64) {
     // most u32::MAX samples, `Sampler::max_count`).
     stream.start(index as u32);
     if let Some(rng) = stream.independent() {
-        *rng = Rng::new(mix(key, index), pixel);
+        let (seed, stream) = sample_seed(key, pixel, index);
+        *rng = Rng::new(seed, stream);
     }
+}
+
+/// The seed and stream of the independent generator of sample `index` of
+/// pixel `pixel`, whose stream's key is `key`.
+#[inline(always)]
+fn sample_seed(key: u64, pixel: u64, index: u64) -> (u64, u64) {
+    (mix(key, index), pixel)
 }
 
 /// State shared with whoever watches a render from another thread.
@@ -191,9 +202,8 @@ struct Batch {
     hits: Vec<Option<Hit>>,
     /// Embree's records of the camera rays.
     stream: embree::Stream,
-    /// The camera's numbers drawn beforehand, `BATCH` samples at a time
-    /// (the samplers other than the independent one): the `j`-th sample's
-    /// are the `(j mod BATCH)`-th of the batch.
+    /// The camera's numbers drawn beforehand, `BATCH` samples at a time:
+    /// the `j`-th sample's are the `(j mod BATCH)`-th of the batch.
     drawn: Drawn,
     /// One pixel's sums per block at a time.
     block_sums: Vec<Sums>,
@@ -202,7 +212,8 @@ struct Batch {
 impl Batch {
     /// The `spp` samples of each pixel `(x, y)`, `x` in `pixels`, into
     /// [`Batch::radiance`]: film and lens positions first (from the pixel's
-    /// own stream, which then drives its paths), the camera rays of the
+    /// own stream, or, under the independent sampler, from each sample's
+    /// own generator, which its path then carries), the camera rays of the
     /// whole batch at SIMD width, then the paths bounce by bounce in groups
     /// of at most `BATCH`, each group's escaped rays' light looked up
     /// together at its end.
@@ -254,11 +265,11 @@ impl Batch {
         let spp = spp.max(1) as usize;
         let index = |k: usize| samples.first + k as u64;
         // The camera's numbers drawn together, BATCH samples at a time (a
-        // pixel may have many more). `at`: the pixel (from the row's first)
-        // and the number in it of the batch's first sample.
-        let mut at = (0, 0);
+        // pixel may have many more). `start`: the pixel (from the row's
+        // first) and the number in it of the batch's first sample.
         for first in (0..n).step_by(BATCH) {
-            let start = at;
+            let start = (first / spp, first % spp);
+            let mut at = start;
             let batch = (0..(first + BATCH).min(n) - first).map(|_| {
                 let sample = at;
                 at = next_sample(at, spp);
@@ -271,7 +282,7 @@ impl Batch {
                 self.starts.clear();
                 self.starts.extend(batch.map(|(p, k)| {
                     let (pixel, key) = keys[p];
-                    (mix(key, index(k)), pixel)
+                    sample_seed(key, pixel, index(k))
                 }));
                 self.drawn.draw_fresh(&self.starts, &camera)?;
                 self.resume.extend_from_slice(&self.drawn.generators);

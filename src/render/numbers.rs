@@ -1,8 +1,11 @@
-//! Where a sample's numbers come from. The independent sampler's are
-//! drawn as the camera and the shading ask for them (their order is their
-//! meaning). The other samplers' depend only on the sample and the
-//! dimension, so the requests a batch's camera samples, or a bounce of its
-//! paths, will make are drawn for the whole batch beforehand, at SIMD width
+//! Where a sample's numbers come from. The camera's are drawn for a whole
+//! batch of samples beforehand, at SIMD width, and read by position
+//! ([`camera_dims`], [`camera_values`]): under the independent sampler as
+//! the first draws of each sample's own generator. The shading's are
+//! [`Numbers`]: the independent sampler's drawn as the shading asks for
+//! them (their order is their meaning); the other samplers' depend only on
+//! the sample and the dimension, so the requests a bounce of a batch's
+//! paths will make are drawn for the whole batch beforehand
 //! ([`crate::sampler::batch`]), and then read.
 
 use super::integrator::{Integrator, Settings, Strategy, dims, ends_after_light};
@@ -10,7 +13,7 @@ use crate::rng::Rng;
 use crate::sampler::batch::Dim;
 use crate::sampler::{Sampler, Stream};
 
-/// The numbers of one camera sample, or of one path's bounce.
+/// The numbers of one path's bounce.
 pub struct Numbers<'a> {
     /// The pixel's stream, at the sample.
     pub stream: &'a mut Stream,
@@ -57,8 +60,7 @@ impl<'a> Numbers<'a> {
     }
 
     /// The value drawn beforehand for the 1D or 2D (`two`) request of
-    /// `dim`, if it was. A request that [`camera_dims`] or [`bounce_dims`]
-    /// did not foresee is asked of the stream: the same bits, only slower;
+    /// `dim`, if it was. A request that [`bounce_dims`] did not foresee is asked of the stream: the same bits, only slower;
     /// debug builds check that none is missed.
     #[inline]
     fn find(&self, dim: u32, two: bool) -> Option<[f32; 2]> {
@@ -73,8 +75,7 @@ impl<'a> Numbers<'a> {
 }
 
 /// The dimensions the camera asks each sample for (`Batch::run`, in its
-/// order) under a sampler other than the independent one: the film
-/// position, the lens position when the camera has a lens, the time when
+/// order): the film position, the lens position when the camera has a lens, the time when
 /// something moves.
 pub fn camera_dims((lens, time): (bool, bool)) -> Vec<Dim> {
     let mut out = vec![Dim {

@@ -11,7 +11,9 @@
 //! requests in loops the compiler vectorises ([`crate::simd::dispatch`]):
 //! the Kensler step of every shuffled index (all but [`Sampler::ZSobol`]), the cycle walk
 //! and rotation (no step when the count is a power of two above 1), then
-//! the scrambled points. The other samplers' requests are drawn one by one.
+//! the scrambled points. The other samplers' requests are drawn one by one,
+//! but for the independent sampler's first requests of samples that each
+//! start a generator of their own ([`Drawn::draw_fresh`]: the camera's).
 //!
 //! A 1D request of the Sobol' family is the first coordinate of the 2D
 //! request of the same dimension ([`Stream::get1`] scrambles the same first
@@ -63,7 +65,7 @@ impl Drawn {
     /// `streams[stream].start(index)` followed by `get1::<f32>` or
     /// `get2::<f32>` of `dims[k]` gives. Nothing is drawn for
     /// [`Sampler::Independent`], whose numbers depend on the order they
-    /// are asked in. The streams of the samplers other than Sobol's are
+    /// are asked in (but see [`Drawn::draw_fresh`]). The streams of the samplers other than Sobol's are
     /// left at the last sample ([`Stream::start`] them again before
     /// asking).
     ///
@@ -187,12 +189,8 @@ impl Drawn {
         self.values.resize(n * dims.len(), [0.0; 2]);
         self.generators.resize(n, Rng::new(0, 0));
         // Each request's floats, at their places in its sample's values.
-        let at: Vec<usize> = (0..dims.len())
-            .flat_map(|k| {
-                [2 * k, 2 * k + 1]
-                    .into_iter()
-                    .take(1 + usize::from(dims[k].two))
-            })
+        let at: Vec<usize> = (dims.iter().enumerate())
+            .flat_map(|(k, d)| [2 * k, 2 * k + 1].into_iter().take(1 + usize::from(d.two)))
             .collect();
         first_floats(
             starts,
