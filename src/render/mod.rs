@@ -21,9 +21,10 @@
 //!
 //! Samples are rendered in batches of about `BATCH` (whole pixels of one
 //! row): each sample's film and lens positions are drawn first, the
-//! camera rays of the batch are made at SIMD width, the paths are traced together
-//! one bounce at a time, in groups of at most `BATCH` ([`wavefront`]: every
-//! shadow ray and every next ray of a group in one stream), and the light
+//! camera rays of the batch are made at SIMD width, the paths are traced
+//! together one bounce at a time, in groups of at most `BATCH`
+//! ([`wavefront`]: every shadow ray and every next ray of a group in one
+//! stream), and the light
 //! of every ray of a group that left the scene is looked up at its end
 //! (vectorised, with the texel reads overlapping). The draws of a pixel
 //! thus come in a fixed order, whatever the batch size or thread. The

@@ -60,7 +60,8 @@ impl<'a> Numbers<'a> {
     }
 
     /// The value drawn beforehand for the 1D or 2D (`two`) request of
-    /// `dim`, if it was. A request that [`bounce_dims`] did not foresee is asked of the stream: the same bits, only slower;
+    /// `dim`, if it was. A request that [`bounce_dims`] did not foresee
+    /// is asked of the stream: the same bits, only slower;
     /// debug builds check that none is missed.
     #[inline]
     fn find(&self, dim: u32, two: bool) -> Option<[f32; 2]> {
@@ -75,8 +76,8 @@ impl<'a> Numbers<'a> {
 }
 
 /// The dimensions the camera asks each sample for (`Batch::run`, in its
-/// order): the film position, the lens position when the camera has a lens, the time when
-/// something moves.
+/// order): the film position, the lens position when the camera has a
+/// lens, the time when something moves.
 pub fn camera_dims((lens, time): (bool, bool)) -> Vec<Dim> {
     let mut out = vec![Dim {
         dim: dims::FILM,

@@ -65,9 +65,9 @@ impl Drawn {
     /// `streams[stream].start(index)` followed by `get1::<f32>` or
     /// `get2::<f32>` of `dims[k]` gives. Nothing is drawn for
     /// [`Sampler::Independent`], whose numbers depend on the order they
-    /// are asked in (but see [`Drawn::draw_fresh`]). The streams of the samplers other than Sobol's are
-    /// left at the last sample ([`Stream::start`] them again before
-    /// asking).
+    /// are asked in (but see [`Drawn::draw_fresh`]). The streams of the
+    /// samplers other than Sobol's are left at the last sample
+    /// ([`Stream::start`] them again before asking).
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the memory for the values cannot be
