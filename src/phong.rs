@@ -161,6 +161,15 @@ impl Phong {
         self.diffuse_probability
     }
 
+    /// Whether the BRDF has a glossy part (`ρs ≠ 0`). Without one, `p_d =
+    /// 1` and the lobe's terms are multiplied by 0, so that
+    /// [`PhongView::eval_pdf_diffuse`] and [`PhongView::sample_diffuse`]
+    /// give its values.
+    #[inline]
+    pub fn is_glossy(&self) -> bool {
+        self.specular.iter().any(|&s| s != 0.0)
+    }
+
     /// The BRDF seen from `wi`: what every evaluation and sample for that
     /// `wi` shares, computed once in the kernel's float type.
     #[inline(always)]
@@ -356,6 +365,29 @@ impl<F: Real> PhongView<F> {
                 out.component[k] = C::from(u8::from(s[7] > F::zero()));
             }
         }
+    }
+
+    /// [`PhongView::eval_pdf`] of a BRDF without a glossy part
+    /// ([`Phong::is_glossy`]), bit for bit, without the lobe: `f_r = ρd/π`
+    /// above the surface, `pdf = max(cos θ_o, 0)/π`. (Its terms are 0
+    /// there: `ρs·lobe = 0` and `(1 − p_d)·lobe = 0` for the lobe's finite
+    /// values, so that no power is taken.)
+    #[inline(always)]
+    pub(crate) fn eval_pdf_diffuse(&self, wo: V3<F>) -> (V3<F>, F) {
+        (
+            self.eval_with_lobe(wo, F::zero()),
+            self.pdf_with_lobe(wo, F::zero()),
+        )
+    }
+
+    /// [`PhongView::sample`] of `[u[0], u[1], part]` for a BRDF without a
+    /// glossy part, bit for bit: `p_d = 1` picks the diffuse part for
+    /// every `part < 1`, the cosine-weighted direction of `u`, of density
+    /// `cos θ_o/π` and weight `ρd` (neither the glossy candidate nor the
+    /// lobe computed).
+    #[inline(always)]
+    pub(crate) fn sample_diffuse(&self, u: [F; 2]) -> PhongSample<F> {
+        self.finish_sample(warp::square_to_cosine_hemisphere(u), F::zero(), true)
     }
 
     /// The sample at `wo`, drawn by the diffuse part or not, where the lobe

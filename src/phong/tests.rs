@@ -29,7 +29,7 @@ fn errors() {
 }
 
 /// The one-at-a-time forms give what the batch forms give, with a
-/// glossy part and without one.
+/// glossy part and without one; without one, so do the diffuse forms.
 #[test]
 fn one_at_a_time_matches_the_batch_forms() {
     fn check<F: Real + std::fmt::Debug>(p: &Phong) {
@@ -45,10 +45,16 @@ fn one_at_a_time_matches_the_batch_forms() {
             assert_eq!(a, b, "{p:?} {u:?}");
             // Toward the sample and off it (the mirror direction's
             // neighbourhood, where the lobe is largest).
+            if !p.is_glossy() {
+                assert_eq!(a, view.sample_diffuse([u[0], u[1]]), "{p:?} {u:?}");
+            }
             for wo in [a.wo, [F::c(0.01), F::c(-0.02), F::c(0.9997)], reflect(wi)] {
                 let (f, pdf) = view.eval_pdf_one(wo);
                 assert_eq!((f, pdf), (view.eval(wo), view.pdf(wo)), "{p:?} {wo:?}");
                 assert_eq!((f, pdf), view.eval_pdf(wo), "{p:?} {wo:?}");
+                if !p.is_glossy() {
+                    assert_eq!((f, pdf), view.eval_pdf_diffuse(wo), "{p:?} {wo:?}");
+                }
             }
         }
     }

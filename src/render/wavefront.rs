@@ -47,7 +47,7 @@ use crate::error::Result;
 use crate::rng::Rng;
 use crate::sampler::batch::{Dim, Drawn};
 use crate::sampler::{Sampler, Stream};
-use shade::{BSDF_IN, BSDF_OUT, Begun, Bounce, bsdf_kernels};
+use shade::{Begun, Bounce, KernelRows};
 
 /// A path between two bounces.
 #[derive(Clone, Debug)]
@@ -135,10 +135,8 @@ pub struct Wavefront {
     /// What each path that goes on past [`Bounce::begin`] at this bounce
     /// keeps for [`Bounce::finish`].
     begun: Vec<Begun>,
-    /// Those paths' rows into the BSDF kernel ([`shade::bsdf_kernels`]).
-    bsdf_in: Vec<[f32; BSDF_IN]>,
-    /// And its rows out, row for row.
-    bsdf_out: Vec<[f32; BSDF_OUT]>,
+    /// Those paths' rows into the BSDF kernels, and their rows out.
+    kernel_rows: KernelRows,
     /// The numbers of the bounce drawn beforehand (the samplers other than
     /// the independent one): the dimensions every path's vertex asks for,
     /// and their values, path after path.
@@ -178,10 +176,9 @@ impl Wavefront {
             self.by_inversion.draws,
             self.env_samples,
             self.light_samples,
-            self.begun,
-            self.bsdf_in,
-            self.bsdf_out
+            self.begun
         )?;
+        self.kernel_rows.reserve(n, WHAT)?;
         self.escaped.clear();
         self.escaped.reserve(n)
     }
@@ -416,8 +413,7 @@ impl Wavefront {
             dims: wanted,
             drawn,
             begun,
-            bsdf_in,
-            bsdf_out,
+            kernel_rows,
             shadows,
             shadow_rays,
             rays,
@@ -429,7 +425,7 @@ impl Wavefront {
         let drawn = (&wanted[..], &drawn.values[..]);
         let light = |k: usize| light_samples.get(k).and_then(Option::as_ref);
         begun.clear();
-        bsdf_in.clear();
+        kernel_rows.clear();
         let mut vertices = hits.iter().zip(&*surfaces).enumerate();
         paths.retain_mut(|path| {
             let Some((k, (hit, (shape, sp)))) = vertices.next() else {
@@ -444,16 +440,15 @@ impl Wavefront {
             let Some((b, row)) = started else {
                 return false;
             };
+            kernel_rows.push(&b, row);
             begun.push(b);
-            bsdf_in.push(row);
             true
         });
-        bsdf_out.clear();
-        bsdf_out.resize(bsdf_in.len(), [0.0; BSDF_OUT]);
-        bsdf_kernels(settings, depth, bsdf_in, bsdf_out);
-        let mut kernel_rows = begun.iter().zip(&*bsdf_out);
+        kernel_rows.run(settings, depth);
+        let mut rows_out = kernel_rows.out();
+        let mut begun = begun.iter();
         paths.retain_mut(|path| {
-            let Some((b, out)) = kernel_rows.next() else {
+            let Some((b, out)) = begun.next().and_then(|b| Some((b, rows_out.next(b)?))) else {
                 debug_assert!(false, "a path without its BSDF sample");
                 return false;
             };

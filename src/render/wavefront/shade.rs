@@ -13,13 +13,17 @@
 //! The kernel holds what costs most per vertex (three powers, two sines
 //! and cosines, the mirror's frame), which one path at a time would
 //! compute in scalar code. It computes both parts' directions and selects,
-//! and the lobe of a BRDF without a glossy part, where one path at a time
-//! draws only the chosen part's direction and skips that lobe: the same
-//! bits (`PhongView::eval_pdf_one`, `PhongView::sample_one`).
+//! where one path at a time draws only the chosen part's direction: the
+//! same bits (`PhongView::eval_pdf_one`, `PhongView::sample_one`). The
+//! rows of BRDFs without a glossy part (diffuse surfaces) go to a kernel
+//! of their own, without the lobe and the glossy direction (one sine and
+//! cosine, no power): the same bits again
+//! (`PhongView::eval_pdf_diffuse`, `PhongView::sample_diffuse`).
 
 use glam::Vec3A;
 
 use super::{Path, Unshadowed};
+use crate::error::Result;
 use crate::frame::Frame;
 use crate::math::V3;
 use crate::phong::{PhongView, VIEW_TERMS};
@@ -57,6 +61,9 @@ pub(super) struct Begun {
     /// Whether it ends after its light sample (emitter sampling, whose
     /// next vertex's emission would not count).
     pub ends: bool,
+    /// Whether its BRDF has no glossy part (its row goes to the diffuse
+    /// kernel: [`KernelRows`]).
+    pub diffuse: bool,
 }
 
 /// The row of [`BSDF_IN`] numbers of [`bsdf_kernel`] for the view from
@@ -82,21 +89,27 @@ fn bsdf_row(
 /// `SAMPLE`, the sample [`PhongView::sample`] of `[u0, u1, part]`; as
 /// [`BSDF_OUT`] numbers (zeros for the part not asked for: under BSDF
 /// sampling the light's power is skipped, and where every path ends
-/// after its light sample, the sample's two). Branch-free, for
-/// [`crate::simd::map_rows`].
+/// after its light sample, the sample's two). Without `GLOSSY`, for rows
+/// of BRDFs without a glossy part, by their diffuse forms
+/// ([`PhongView::eval_pdf_diffuse`], [`PhongView::sample_diffuse`]).
+/// Branch-free, for [`crate::simd::map_rows`].
 #[inline(always)]
-pub(super) fn bsdf_kernel<const LIGHT: bool, const SAMPLE: bool>(
+pub(super) fn bsdf_kernel<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: bool>(
     row: [f32; BSDF_IN],
 ) -> [f32; BSDF_OUT] {
     let [w0, w1, w2, l0, l1, l2, u0, u1, part, terms @ ..] = row;
     let view = PhongView::from_terms([w0, w1, w2], terms);
-    let ([f0, f1, f2], pdf_l) = if LIGHT {
-        view.eval_pdf([l0, l1, l2])
-    } else {
-        ([0.0; 3], 0.0)
+    let ([f0, f1, f2], pdf_l) = match (LIGHT, GLOSSY) {
+        (false, _) => ([0.0; 3], 0.0),
+        (true, true) => view.eval_pdf([l0, l1, l2]),
+        (true, false) => view.eval_pdf_diffuse([l0, l1, l2]),
     };
     let ([x, y, z], pdf, [r, g, b]) = if SAMPLE {
-        let s = view.sample([u0, u1, part]);
+        let s = if GLOSSY {
+            view.sample([u0, u1, part])
+        } else {
+            view.sample_diffuse([u0, u1])
+        };
         (s.wo, s.pdf, s.weight)
     } else {
         ([0.0; 3], 0.0, [0.0; 3])
@@ -104,37 +117,104 @@ pub(super) fn bsdf_kernel<const LIGHT: bool, const SAMPLE: bool>(
     [f0, f1, f2, pdf_l, x, y, z, pdf, r, g, b]
 }
 
-/// [`bsdf_kernel`] of every row of `rows` into `out` (of one length), for
-/// a bounce of `settings` at `depth`: the light's part where the strategy
-/// draws light samples, the BSDF sample's where the paths go on after
-/// them.
-pub(super) fn bsdf_kernels(
-    settings: &Settings,
-    depth: u32,
-    rows: &[[f32; BSDF_IN]],
-    out: &mut [[f32; BSDF_OUT]],
-) {
-    fn map<const LIGHT: bool, const SAMPLE: bool>(
-        rows: &[[f32; BSDF_IN]],
-        out: &mut [[f32; BSDF_OUT]],
-    ) {
-        // Through a closure marked inline: given the function itself, the
-        // kernel ran 50 % slower (demo BSDF sampling 20.4 -> 30.6 ms).
-        let kernel = {
-            #[inline(always)]
-            |row| bsdf_kernel::<LIGHT, SAMPLE>(row)
-        };
-        simd::map_rows(out, rows, &kernel, |_| true, false);
+/// A bounce's rows of [`bsdf_kernel`] and its rows out, in two groups of
+/// their own kernel each: the rows of BRDFs without a glossy part
+/// ([`Begun::diffuse`]) and the others, each group in the paths' order.
+#[derive(Default)]
+pub(super) struct KernelRows {
+    diffuse: Rows,
+    glossy: Rows,
+}
+
+#[derive(Default)]
+struct Rows {
+    rows: Vec<[f32; BSDF_IN]>,
+    out: Vec<[f32; BSDF_OUT]>,
+}
+
+impl KernelRows {
+    /// Room for `n` rows in each group (`what`: the rows' owner, for
+    /// the error).
+    ///
+    /// # Errors
+    /// [`crate::Error::Memory`] when the memory cannot be had.
+    pub fn reserve(&mut self, n: usize, what: &'static str) -> Result<()> {
+        self.clear();
+        let (d, g) = (&mut self.diffuse, &mut self.glossy);
+        crate::alloc::reserve_each!(n, what; d.rows, d.out, g.rows, g.out)
     }
-    let light = settings.strategy != Strategy::Bsdf;
-    let sample = !ends_after_light(settings, depth);
-    match (light, sample) {
-        (true, true) => map::<true, true>(rows, out),
-        (true, false) => map::<true, false>(rows, out),
-        (false, _) => {
-            // Under BSDF sampling no path ends after a light sample.
-            debug_assert!(sample);
-            map::<false, true>(rows, out);
+
+    /// Every row forgotten (a bounce's start).
+    pub fn clear(&mut self) {
+        self.diffuse.rows.clear();
+        self.glossy.rows.clear();
+    }
+
+    /// The row of a path begun as `begun`, after the rows before it.
+    #[inline]
+    pub fn push(&mut self, begun: &Begun, row: [f32; BSDF_IN]) {
+        let group = if begun.diffuse {
+            &mut self.diffuse
+        } else {
+            &mut self.glossy
+        };
+        group.rows.push(row);
+    }
+
+    /// [`bsdf_kernel`] of every row, for a bounce of `settings` at
+    /// `depth`: the light's part where the strategy draws light samples,
+    /// the BSDF sample's where the paths go on after them.
+    pub fn run(&mut self, settings: &Settings, depth: u32) {
+        fn map<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: bool>(group: &mut Rows) {
+            // Through a closure marked inline: given the function itself,
+            // the kernel ran 50 % slower (demo BSDF sampling 20.4 -> 30.6
+            // ms).
+            let kernel = {
+                #[inline(always)]
+                |row| bsdf_kernel::<LIGHT, SAMPLE, GLOSSY>(row)
+            };
+            group.out.clear();
+            group.out.resize(group.rows.len(), [0.0; BSDF_OUT]);
+            simd::map_rows(&mut group.out, &group.rows, &kernel, |_| true, false);
+        }
+        let light = settings.strategy != Strategy::Bsdf;
+        let sample = !ends_after_light(settings, depth);
+        let (d, g) = (&mut self.diffuse, &mut self.glossy);
+        match (light, sample) {
+            (true, true) => (map::<true, true, false>(d), map::<true, true, true>(g)),
+            (true, false) => (map::<true, false, false>(d), map::<true, false, true>(g)),
+            (false, _) => {
+                // Under BSDF sampling no path ends after a light sample.
+                debug_assert!(sample);
+                (map::<false, true, false>(d), map::<false, true, true>(g))
+            }
+        };
+    }
+
+    /// The rows out, to be read in the order the rows went in
+    /// ([`RowsOut::next`]).
+    pub fn out(&self) -> RowsOut<'_> {
+        RowsOut {
+            diffuse: self.diffuse.out.iter(),
+            glossy: self.glossy.out.iter(),
+        }
+    }
+}
+
+/// The rows out of [`KernelRows`], path after path.
+pub(super) struct RowsOut<'a> {
+    diffuse: std::slice::Iter<'a, [f32; BSDF_OUT]>,
+    glossy: std::slice::Iter<'a, [f32; BSDF_OUT]>,
+}
+
+impl<'a> RowsOut<'a> {
+    /// The row out of the next path, begun as `begun`.
+    #[inline]
+    pub fn next(&mut self, begun: &Begun) -> Option<&'a [f32; BSDF_OUT]> {
+        if begun.diffuse {
+            self.diffuse.next()
+        } else {
+            self.glossy.next()
         }
     }
 }
@@ -191,13 +271,14 @@ impl Bounce<'_> {
             (u, numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT)))
         };
         let wi_local = frame.to_local(wi.to_array());
-        let terms = scene.material(shape).bsdf.view_terms();
-        let row = bsdf_row((wi_local, wl), bsdf_numbers, &terms);
+        let bsdf = &scene.material(shape).bsdf;
+        let row = bsdf_row((wi_local, wl), bsdf_numbers, &bsdf.view_terms());
         let begun = Begun {
             k: k as u32,
             frame,
             wl_z: wl[2],
             ends,
+            diffuse: !bsdf.is_glossy(),
         };
         Some((begun, row))
     }

@@ -4,24 +4,30 @@ use super::*;
 use std::sync::Arc;
 
 use crate::envmap::{EnvMap, Options};
+use crate::phong::{Phong, Selection};
 use crate::render::geometry::Geometry;
 use crate::render::integrator::{Integrator, add_escaped};
-use crate::render::scene::{Environment, Shape};
+use crate::render::scene::{Environment, Material, Shape};
 use crate::render::tests::{camera, cube, diffuse, light, rectangle, settings};
 use crate::sampler::Sampler;
 use crate::sampler::zorder::ZOrder;
 
-/// A floor, a box on it, a spherical light over it and a sky: a
-/// constant one, or a map (whose samples are drawn by the batch), dim
-/// enough that emitter sampling draws it and the light about equally
-/// often (so that the paths that wait for the map's samples are not all
-/// of them).
+/// A diffuse floor, a glossy box on it (the BSDF kernels' two groups of
+/// rows, [`shade::KernelRows`], mixed in every bounce), a spherical light
+/// over it and a sky: a constant one, or a map (whose samples are drawn
+/// by the batch), dim enough that emitter sampling draws it and the
+/// light about equally often (so that the paths that wait for the map's
+/// samples are not all of them).
 fn scene(map: bool) -> Scene {
-    let still = |geometry, rho| Shape {
+    let still = |geometry, material| Shape {
         geometry,
-        material: diffuse(rho),
+        material,
         emission: None,
         motion: None,
+    };
+    let glossy = Material {
+        bsdf: Phong::new([0.5; 3], [0.3; 3], 20.0, Selection::Max).unwrap(),
+        two_sided: false,
     };
     let turned = Affine3A::from_scale_rotation_translation(
         Vec3::splat(0.5),
@@ -29,8 +35,11 @@ fn scene(map: bool) -> Scene {
         Vec3::new(0.3, 0.0, 0.5),
     );
     let shapes = vec![
-        still(rectangle(Affine3A::from_scale(Vec3::splat(20.0))), 0.6),
-        still(cube(turned), 0.8),
+        still(
+            rectangle(Affine3A::from_scale(Vec3::splat(20.0))),
+            diffuse(0.6),
+        ),
+        still(cube(turned), glossy),
         light(Geometry::sphere([-0.5, 0.4, 1.6], 0.3, false).unwrap(), 6.0),
     ];
     let sky = if map {
