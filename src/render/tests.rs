@@ -819,8 +819,10 @@ fn camera_samples_draw_their_own_numbers() {
         motion: Some(Motion::new("to_world", DAffine3::IDENTITY, moved).unwrap()),
     };
     let scene = Scene::new(vec![moving], None, cam, 4, 4).unwrap();
-    // Three pixels of 5 samples; two of 300, in more than one group.
-    let cases = [(5, 11, 3, 1..4), (300, 600, 7, 2..4)];
+    // Three pixels of 5 samples; two of more than half a batch each, in
+    // more than one group.
+    let many = super::BATCH as u32 / 2 + 88;
+    let cases = [(5, 11, 3, 1..4), (many, 2 * u64::from(many), 7, 2..4)];
     for &(_, sampler) in Sampler::NAMES {
         for (count, total, first, pixels) in cases.clone() {
             let settings = Settings {
