@@ -162,11 +162,14 @@ impl Phong {
     }
 
     /// Whether the BRDF has a glossy part (`ρs ≠ 0`). Without one, `p_d =
-    /// 1` and the lobe's terms are multiplied by 0, so that
+    /// 1` and the lobe's terms are multiplied by ±0, so that
     /// [`PhongView::eval_pdf_diffuse`] and [`PhongView::sample_diffuse`]
-    /// give its values.
+    /// give its values. (A `ρs` so small that its terms round to 0 in
+    /// `f32` is glossy here, though [`PhongView::lobe_if_glossy`] skips
+    /// its lobe: its rows take the general kernel, which is right for any
+    /// row.)
     #[inline]
-    pub fn is_glossy(&self) -> bool {
+    pub(crate) fn is_glossy(&self) -> bool {
         self.specular.iter().any(|&s| s != 0.0)
     }
 
@@ -369,9 +372,10 @@ impl<F: Real> PhongView<F> {
 
     /// [`PhongView::eval_pdf`] of a BRDF without a glossy part
     /// ([`Phong::is_glossy`]), bit for bit, without the lobe: `f_r = ρd/π`
-    /// above the surface, `pdf = max(cos θ_o, 0)/π`. (Its terms are 0
-    /// there: `ρs·lobe = 0` and `(1 − p_d)·lobe = 0` for the lobe's finite
-    /// values, so that no power is taken.)
+    /// above the surface, `pdf = max(cos θ_o, 0)/π`. (The lobe's terms
+    /// vanish there whatever its value, which is finite: `ρs·lobe = ±0`
+    /// as `ρs·0`, and `(1 − p_d)·norm·lobe = +0` with `p_d = 1` and the
+    /// finite `norm = (n + 1)/(2π)`, so that no power is taken.)
     #[inline(always)]
     pub(crate) fn eval_pdf_diffuse(&self, wo: V3<F>) -> (V3<F>, F) {
         (
@@ -381,10 +385,11 @@ impl<F: Real> PhongView<F> {
     }
 
     /// [`PhongView::sample`] of `[u[0], u[1], part]` for a BRDF without a
-    /// glossy part, bit for bit: `p_d = 1` picks the diffuse part for
-    /// every `part < 1`, the cosine-weighted direction of `u`, of density
-    /// `cos θ_o/π` and weight `ρd` (neither the glossy candidate nor the
-    /// lobe computed).
+    /// glossy part, bit for bit for every `part < 1` (which every sampler's
+    /// numbers are): `p_d = 1` picks the diffuse part, the
+    /// cosine-weighted direction of `u`, of density `cos θ_o/π` and weight
+    /// `ρd` (neither the glossy candidate nor the lobe computed). A `part`
+    /// of 1 or more, or NaN, would have `sample` take the glossy one.
     #[inline(always)]
     pub(crate) fn sample_diffuse(&self, u: [F; 2]) -> PhongSample<F> {
         self.finish_sample(warp::square_to_cosine_hemisphere(u), F::zero(), true)

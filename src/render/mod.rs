@@ -175,11 +175,11 @@ pub struct Progress {
 /// together ([`wavefront`], in groups of at most this many, whose escaped
 /// rays' environment light is looked up together:
 /// [`integrator::add_escaped`]). Larger groups keep the later bounces'
-/// streams and kernels wide as paths end: against 256, 1024 renders the
-/// path integrator 6–9 % faster (the sphere on a plane, 256², 64 spp: 375
-/// → 343 ms; the 2·10^5-triangle mesh: 839–884 → 800–806 ms) and `direct`
-/// 2–4 % faster; 2048 and 4096 were slower again (direct MIS 290, 301 ms
-/// against 275).
+/// streams and kernels wide as paths end. Against 256 (min of 7 renders,
+/// two rounds alternated): the sphere on a plane (256², 64 spp), direct
+/// MIS 287 → 275 ms and path 373–377 → 343 ms; the 2·10^5-triangle mesh,
+/// direct 488–503 → 474–485 ms and path 839–884 → 800–806 ms. At 2048
+/// and 4096 the plane's direct MIS took 290 and 301 ms.
 const BATCH: usize = 1024;
 
 /// One thread's buffers for a batch of camera samples (reused from batch

@@ -11,7 +11,8 @@
 //!   shade   each path at its hit: emission, its light sample's light
 //!           (the shadow ray kept for later), a BSDF sample (the next
 //!           ray), roulette; the BSDF's evaluation and sample of every
-//!           path by one kernel at SIMD width (`shade`)
+//!           path by kernels at SIMD width, one for the BRDFs without a
+//!           glossy part and one for the others (`shade`)
 //!   occlude every shadow ray of the batch, one stream; add the light of
 //!           those that reach it
 //!   trace   every next ray, one stream; rays that leave the scene go to
@@ -440,15 +441,14 @@ impl Wavefront {
             let Some((b, row)) = started else {
                 return false;
             };
-            kernel_rows.push(&b, row);
+            kernel_rows.push(b.diffuse, row);
             begun.push(b);
             true
         });
         kernel_rows.run(settings, depth);
-        let mut rows_out = kernel_rows.out();
-        let mut begun = begun.iter();
+        let mut rows_out = kernel_rows.out(begun);
         paths.retain_mut(|path| {
-            let Some((b, out)) = begun.next().and_then(|b| Some((b, rows_out.next(b)?))) else {
+            let Some((b, out)) = rows_out.next() else {
                 debug_assert!(false, "a path without its BSDF sample");
                 return false;
             };

@@ -61,8 +61,8 @@ pub(super) struct Begun {
     /// Whether it ends after its light sample (emitter sampling, whose
     /// next vertex's emission would not count).
     pub ends: bool,
-    /// Whether its BRDF has no glossy part (its row goes to the diffuse
-    /// kernel: [`KernelRows`]).
+    /// Whether its BRDF has no glossy part (`ρs = 0`: its row goes to
+    /// the kernel without the lobe, [`KernelRows`]).
     pub diffuse: bool,
 }
 
@@ -70,7 +70,7 @@ pub(super) struct Begun {
 /// `wi` of the BRDF of `terms`, the light sample's direction `wl` and the
 /// BSDF sample's numbers `u` and `part` (all in the shading frame).
 #[inline]
-fn bsdf_row(
+pub(super) fn bsdf_row(
     (wi, wl): (V3<f32>, V3<f32>),
     (u, part): ([f32; 2], f32),
     terms: &[f32; VIEW_TERMS],
@@ -89,9 +89,10 @@ fn bsdf_row(
 /// `SAMPLE`, the sample [`PhongView::sample`] of `[u0, u1, part]`; as
 /// [`BSDF_OUT`] numbers (zeros for the part not asked for: under BSDF
 /// sampling the light's power is skipped, and where every path ends
-/// after its light sample, the sample's two). Without `GLOSSY`, for rows
-/// of BRDFs without a glossy part, by their diffuse forms
-/// ([`PhongView::eval_pdf_diffuse`], [`PhongView::sample_diffuse`]).
+/// after its light sample, the sample's two). `GLOSSY` is the general
+/// kernel, right for every row; without it, for rows of BRDFs without a
+/// glossy part only, by their diffuse forms (no lobe: the same bits,
+/// [`PhongView::eval_pdf_diffuse`], [`PhongView::sample_diffuse`]).
 /// Branch-free, for [`crate::simd::map_rows`].
 #[inline(always)]
 pub(super) fn bsdf_kernel<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: bool>(
@@ -119,13 +120,15 @@ pub(super) fn bsdf_kernel<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: b
 
 /// A bounce's rows of [`bsdf_kernel`] and its rows out, in two groups of
 /// their own kernel each: the rows of BRDFs without a glossy part
-/// ([`Begun::diffuse`]) and the others, each group in the paths' order.
+/// ([`Begun::diffuse`], the kernel without the lobe) and the others (the
+/// general kernel, right for any row), each group in the paths' order.
 #[derive(Default)]
 pub(super) struct KernelRows {
     diffuse: Rows,
     glossy: Rows,
 }
 
+/// One group's rows in and out.
 #[derive(Default)]
 struct Rows {
     rows: Vec<[f32; BSDF_IN]>,
@@ -133,27 +136,29 @@ struct Rows {
 }
 
 impl KernelRows {
-    /// Room for `n` rows in each group (`what`: the rows' owner, for
-    /// the error).
+    /// Every row forgotten, and room for `n` rows in each group (either
+    /// may hold them all; `what`: the rows' owner, for the error).
     ///
     /// # Errors
     /// [`crate::Error::Memory`] when the memory cannot be had.
     pub fn reserve(&mut self, n: usize, what: &'static str) -> Result<()> {
         self.clear();
         let (d, g) = (&mut self.diffuse, &mut self.glossy);
+        d.out.clear();
+        g.out.clear();
         crate::alloc::reserve_each!(n, what; d.rows, d.out, g.rows, g.out)
     }
 
-    /// Every row forgotten (a bounce's start).
+    /// Every row in forgotten (a bounce's start).
     pub fn clear(&mut self) {
         self.diffuse.rows.clear();
         self.glossy.rows.clear();
     }
 
-    /// The row of a path begun as `begun`, after the rows before it.
+    /// The row of the next path, in the diffuse group or not.
     #[inline]
-    pub fn push(&mut self, begun: &Begun, row: [f32; BSDF_IN]) {
-        let group = if begun.diffuse {
+    pub fn push(&mut self, diffuse: bool, row: [f32; BSDF_IN]) {
+        let group = if diffuse {
             &mut self.diffuse
         } else {
             &mut self.glossy
@@ -165,57 +170,68 @@ impl KernelRows {
     /// `depth`: the light's part where the strategy draws light samples,
     /// the BSDF sample's where the paths go on after them.
     pub fn run(&mut self, settings: &Settings, depth: u32) {
-        fn map<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: bool>(group: &mut Rows) {
-            // Through a closure marked inline: given the function itself,
-            // the kernel ran 50 % slower (demo BSDF sampling 20.4 -> 30.6
-            // ms).
-            let kernel = {
-                #[inline(always)]
-                |row| bsdf_kernel::<LIGHT, SAMPLE, GLOSSY>(row)
-            };
-            group.out.clear();
-            group.out.resize(group.rows.len(), [0.0; BSDF_OUT]);
-            simd::map_rows(&mut group.out, &group.rows, &kernel, |_| true, false);
+        fn map<const LIGHT: bool, const SAMPLE: bool>(d: &mut Rows, g: &mut Rows) {
+            fn one<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: bool>(group: &mut Rows) {
+                // Through a closure marked inline: given the function
+                // itself, the kernel ran 50 % slower (demo BSDF sampling
+                // 20.4 -> 30.6 ms).
+                let kernel = {
+                    #[inline(always)]
+                    |row| bsdf_kernel::<LIGHT, SAMPLE, GLOSSY>(row)
+                };
+                group.out.clear();
+                group.out.resize(group.rows.len(), [0.0; BSDF_OUT]);
+                simd::map_rows(&mut group.out, &group.rows, &kernel, |_| true, false);
+            }
+            one::<LIGHT, SAMPLE, false>(d);
+            one::<LIGHT, SAMPLE, true>(g);
         }
         let light = settings.strategy != Strategy::Bsdf;
         let sample = !ends_after_light(settings, depth);
         let (d, g) = (&mut self.diffuse, &mut self.glossy);
         match (light, sample) {
-            (true, true) => (map::<true, true, false>(d), map::<true, true, true>(g)),
-            (true, false) => (map::<true, false, false>(d), map::<true, false, true>(g)),
+            (true, true) => map::<true, true>(d, g),
+            (true, false) => map::<true, false>(d, g),
             (false, _) => {
                 // Under BSDF sampling no path ends after a light sample.
                 debug_assert!(sample);
-                (map::<false, true, false>(d), map::<false, true, true>(g))
+                map::<false, true>(d, g);
             }
-        };
+        }
     }
 
-    /// The rows out, to be read in the order the rows went in
-    /// ([`RowsOut::next`]).
-    pub fn out(&self) -> RowsOut<'_> {
+    /// The paths `begun` (in the order their rows went in) with their
+    /// rows out.
+    pub fn out<'a>(&'a self, begun: &'a [Begun]) -> RowsOut<'a> {
+        debug_assert_eq!(begun.len(), self.diffuse.out.len() + self.glossy.out.len());
         RowsOut {
+            begun: begun.iter(),
             diffuse: self.diffuse.out.iter(),
             glossy: self.glossy.out.iter(),
         }
     }
 }
 
-/// The rows out of [`KernelRows`], path after path.
+/// The paths of a bounce with their rows out of [`KernelRows`], path
+/// after path.
 pub(super) struct RowsOut<'a> {
+    begun: std::slice::Iter<'a, Begun>,
     diffuse: std::slice::Iter<'a, [f32; BSDF_OUT]>,
     glossy: std::slice::Iter<'a, [f32; BSDF_OUT]>,
 }
 
-impl<'a> RowsOut<'a> {
-    /// The row out of the next path, begun as `begun`.
+impl<'a> Iterator for RowsOut<'a> {
+    type Item = (&'a Begun, &'a [f32; BSDF_OUT]);
+
     #[inline]
-    pub fn next(&mut self, begun: &Begun) -> Option<&'a [f32; BSDF_OUT]> {
-        if begun.diffuse {
+    fn next(&mut self) -> Option<Self::Item> {
+        let begun = self.begun.next()?;
+        let out = if begun.diffuse {
             self.diffuse.next()
         } else {
             self.glossy.next()
-        }
+        };
+        Some((begun, out?))
     }
 }
 

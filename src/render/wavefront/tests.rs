@@ -11,6 +11,7 @@ use crate::render::scene::{Environment, Material, Shape};
 use crate::render::tests::{camera, cube, diffuse, light, rectangle, settings};
 use crate::sampler::Sampler;
 use crate::sampler::zorder::ZOrder;
+use shade::{Begun, KernelRows};
 
 /// A diffuse floor, a glossy box on it (the BSDF kernels' two groups of
 /// rows, [`shade::KernelRows`], mixed in every bounce), a spherical light
@@ -135,4 +136,100 @@ fn a_path_in_a_batch_is_the_path_alone() {
     }
     // Most samples see light (the sky, the light, lit surfaces).
     assert!(lit > 1000, "{lit}");
+}
+
+/// The BSDF kernels' rows come back to their own paths, in order, from
+/// the two groups mixed, and the kernel without the lobe gives the
+/// general kernel's bits for every BRDF without a glossy part (exponents
+/// 0 and the largest, both selections, `ρs = −0`, a black one; directions
+/// above and below the surface; the largest `part` below 1), in each of
+/// the three forms a bounce runs.
+#[test]
+fn kernel_rows_give_each_path_the_general_kernel_s_bits() {
+    use crate::frame::Frame;
+    use crate::phong::MAX_EXPONENT;
+    use crate::warp::square_to_uniform_sphere;
+    use shade::{BSDF_IN, BSDF_OUT, bsdf_kernel, bsdf_row};
+    let phong = |d, s, n, selection| Phong::new(d, s, n, selection).unwrap();
+    let brdfs = [
+        phong([0.6; 3], [0.0; 3], 0.0, Selection::Max),
+        phong([0.5, 0.4, 0.3], [0.3, 0.2, 0.1], 20.0, Selection::Max),
+        phong(
+            [0.2, 0.7, 0.1],
+            [0.0; 3],
+            MAX_EXPONENT,
+            Selection::Luminance,
+        ),
+        phong([0.5; 3], [-0.0; 3], 5.0, Selection::Max),
+        phong([0.1; 3], [0.8; 3], 1000.0, Selection::Luminance),
+        phong([0.0; 3], [0.0; 3], 1.0, Selection::Max),
+        phong([0.3; 3], [0.0; 3], 1.0, Selection::Max),
+    ];
+    let mut rng = Rng::new(5, 9);
+    let mut direction = || square_to_uniform_sphere::<f32>([rng.next_float(), rng.next_float()]);
+    // Rows for 300 paths, of the BRDFs in turn (diffuse and glossy
+    // interleaved), every 7th with the largest part below 1.
+    let paths: Vec<(Begun, [f32; BSDF_IN])> = (0..300)
+        .map(|k| {
+            let bsdf = &brdfs[k % brdfs.len()];
+            let (wi, wl) = (direction(), direction());
+            let [u0, u1, part] = direction().map(|v| 0.5 * (v + 1.0));
+            let part = if k % 7 == 3 {
+                1.0 - f32::EPSILON / 2.0
+            } else {
+                part.min(0.99)
+            };
+            let row = bsdf_row((wi, wl), ([u0, u1], part), &bsdf.view_terms());
+            let begun = Begun {
+                k: k as u32,
+                frame: Frame::from_normal([0.0, 0.0, 1.0]),
+                wl_z: wl[2],
+                ends: false,
+                diffuse: !bsdf.is_glossy(),
+            };
+            (begun, row)
+        })
+        .collect();
+    let (begun, rows): (Vec<Begun>, Vec<_>) = paths.iter().copied().unzip();
+    assert!(begun.iter().any(|b| b.diffuse) && begun.iter().any(|b| !b.diffuse));
+    // The general kernel over every row, in the paths' order.
+    fn general<const LIGHT: bool, const SAMPLE: bool>(
+        rows: &[[f32; BSDF_IN]],
+    ) -> Vec<[f32; BSDF_OUT]> {
+        let kernel = {
+            #[inline(always)]
+            |row| bsdf_kernel::<LIGHT, SAMPLE, true>(row)
+        };
+        let mut out = vec![[0.0; BSDF_OUT]; rows.len()];
+        crate::simd::map_rows(&mut out, rows, &kernel, |_| true, false);
+        out
+    }
+    // (light, sample): MIS with a next bounce, emitter sampling at the
+    // last (no BSDF sample), BSDF sampling (no light sample).
+    let forms = [
+        (Strategy::Mis, general::<true, true>(&rows)),
+        (Strategy::Emitter, general::<true, false>(&rows)),
+        (Strategy::Bsdf, general::<false, true>(&rows)),
+    ];
+    for (strategy, expected) in forms {
+        let s = settings(Integrator::Direct, strategy);
+        let mut kernel_rows = KernelRows::default();
+        kernel_rows.reserve(rows.len(), "rows").unwrap();
+        for (b, row) in &paths {
+            kernel_rows.push(b.diffuse, *row);
+        }
+        kernel_rows.run(&s, 0);
+        let out: Vec<_> = kernel_rows.out(&begun).collect();
+        assert_eq!(out.len(), rows.len(), "{strategy:?}");
+        for (k, ((b, row), want)) in out.iter().zip(&expected).enumerate() {
+            assert_eq!(b.k, k as u32, "{strategy:?}");
+            assert_eq!(
+                row.map(f32::to_bits),
+                want.map(f32::to_bits),
+                "{strategy:?} {k}"
+            );
+        }
+        // Not all zeros: the light's part and the sample's are there.
+        assert!(expected.iter().filter(|o| o[3] > 0.0 || o[7] > 0.0).count() > 100);
+    }
 }
