@@ -142,9 +142,10 @@ impl KernelRows {
     /// # Errors
     /// [`crate::Error::Memory`] when the memory cannot be had.
     pub fn reserve(&mut self, n: usize, what: &'static str) -> Result<()> {
-        self.clear();
         let (d, g) = (&mut self.diffuse, &mut self.glossy);
+        d.rows.clear();
         d.out.clear();
+        g.rows.clear();
         g.out.clear();
         crate::alloc::reserve_each!(n, what; d.rows, d.out, g.rows, g.out)
     }

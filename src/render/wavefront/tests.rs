@@ -13,8 +13,8 @@ use crate::sampler::Sampler;
 use crate::sampler::zorder::ZOrder;
 use shade::{Begun, KernelRows};
 
-/// A diffuse floor, a glossy box on it (the BSDF kernels' two groups of
-/// rows, [`shade::KernelRows`], mixed in every bounce), a spherical light
+/// A diffuse floor, a glossy box on it (so that a bounce's rows go to
+/// both of the BSDF kernels' groups, [`shade::KernelRows`]), a spherical light
 /// over it and a sky: a constant one, or a map (whose samples are drawn
 /// by the batch), dim enough that emitter sampling draws it and the
 /// light about equally often (so that the paths that wait for the map's
