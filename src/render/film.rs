@@ -232,20 +232,32 @@ pub fn block_sums(samples: &[[f32; 3]], blocks: &[Block], out: &mut Vec<Sums>) {
     let mut rest = samples;
     for block in blocks {
         let (inside, after) = rest.split_at(block.len as usize);
-        out.push(pairwise(inside));
+        push_pairwise(inside, out);
         rest = after;
     }
 }
 
-/// The tree sum of `samples`, a power-of-two count of them.
-fn pairwise(samples: &[[f32; 3]]) -> Sums {
-    match samples {
-        [a] => sums_of(*a),
-        [a, b] => add(&sums_of(*a), &sums_of(*b)),
-        _ => {
-            let (left, right) = samples.split_at(samples.len() / 2);
-            add(&pairwise(left), &pairwise(right))
+/// Appends to `out` the tree sum of `samples`, a power-of-two count of
+/// them, without recursion: the samples are summed in pairs, and the sums
+/// of the left subtrees still waiting for their right siblings wait on
+/// `out`, one per level (the pairs counted in binary: the pair whose count
+/// ends in `m` zeros closes `m` subtrees). Each node is `left + right`, as
+/// [`Tree::push`] adds siblings, so the bits are the recursive split's.
+fn push_pairwise(samples: &[[f32; 3]], out: &mut Vec<Sums>) {
+    if let [a] = samples {
+        out.push(sums_of(*a));
+        return;
+    }
+    let below = out.len();
+    for (pairs, pair) in (1usize..).zip(samples.chunks_exact(2)) {
+        let mut sum = add(&sums_of(pair[0]), &sums_of(pair[1]));
+        for _ in 0..pairs.trailing_zeros() {
+            debug_assert!(out.len() > below, "a subtree closed twice");
+            if let Some(left) = out.pop() {
+                sum = add(&left, &sum);
+            }
         }
+        out.push(sum);
     }
 }
 

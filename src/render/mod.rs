@@ -295,12 +295,16 @@ impl Batch {
                 let samples = batch.map(|(p, k)| (p as u32, index(k) as u32));
                 self.drawn.draw(&mut streams, samples, &camera)?;
             }
+            // Written in place (the room is reserved): no capacity check
+            // per sample.
+            let values = self.drawn.values.chunks_exact(camera.len());
+            let at = self.camera_u.len();
+            self.camera_u.resize(at + values.len(), [0.0; 4]);
             let mut sample = start;
-            for values in self.drawn.values.chunks_exact(camera.len()) {
+            for (u, values) in self.camera_u[at..].iter_mut().zip(values) {
                 let (film, lens, time) = camera_values(values, (lens_drawn, moves));
                 let ([px, py], weight) = filter.sample((pixels.start + sample.0, y), film);
-                self.camera_u
-                    .push([px * inv_width, py * inv_height, lens[0], lens[1]]);
+                *u = [px * inv_width, py * inv_height, lens[0], lens[1]];
                 if filter.weighted() {
                     self.weights.push(weight);
                 }
