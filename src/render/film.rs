@@ -242,8 +242,14 @@ pub fn block_sums(samples: &[[f32; 3]], blocks: &[Block], out: &mut Vec<Sums>) {
 /// of the left subtrees still waiting for their right siblings wait on
 /// `out`, one per level (the pairs counted in binary: the pair whose count
 /// ends in `m` zeros closes `m` subtrees). Each node is `left + right`, as
-/// [`Tree::push`] adds siblings, so the bits are the recursive split's.
+/// [`Tree::push`] adds siblings: the bits of summing each half apart and
+/// adding the two.
 fn push_pairwise(samples: &[[f32; 3]], out: &mut Vec<Sums>) {
+    debug_assert!(
+        samples.len().is_power_of_two(),
+        "a block of {}",
+        samples.len()
+    );
     if let [a] = samples {
         out.push(sums_of(*a));
         return;

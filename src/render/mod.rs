@@ -298,10 +298,10 @@ impl Batch {
             // Written in place (the room is reserved): no capacity check
             // per sample.
             let values = self.drawn.values.chunks_exact(camera.len());
-            let at = self.camera_u.len();
-            self.camera_u.resize(at + values.len(), [0.0; 4]);
+            let base = self.camera_u.len();
+            self.camera_u.resize(base + values.len(), [0.0; 4]);
             let mut sample = start;
-            for (u, values) in self.camera_u[at..].iter_mut().zip(values) {
+            for (u, values) in self.camera_u[base..].iter_mut().zip(values) {
                 let (film, lens, time) = camera_values(values, (lens_drawn, moves));
                 let ([px, py], weight) = filter.sample((pixels.start + sample.0, y), film);
                 *u = [px * inv_width, py * inv_height, lens[0], lens[1]];
