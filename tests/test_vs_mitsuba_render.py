@@ -150,6 +150,42 @@ def test_mis_beats_each_strategy_on_glossy_spheres_under_the_sun(mi):
     assert errors["mis"] < errors["emitter"]
 
 
+def test_meshes_export_to_mitsubas_scalar_variant(mi):
+    """A scene's meshes (here a rectangle and a mesh with vertex normals)
+    go to Mitsuba's scalar variant, the fallback where no libLLVM runs,
+    with the same buffers as to the caller's variant, and Mitsuba's scalar
+    render of the scene agrees with mcsample's. (Before, their buffers
+    went in as ``mi.Point3f`` of all the rows, which a scalar variant's
+    single point cannot take: a TypeError.)"""
+    v, f = icosphere(2)
+    blob = {"type": "mesh", "vertices": v * 0.4 + [0.9, 0.4, 0.3], "faces": f, "normals": v,
+            "bsdf": {"type": "diffuse", "reflectance": 0.6}}
+    d = dict(sphere_on_plane(sunless_sky()), blob=blob,
+             sensor=sensor(width=24, height=18))
+    scene = mcs.Scene.from_mitsuba(d)
+
+    def buffers(variant):
+        with mcs.mitsuba.variant_set(variant) as m:
+            meshes = [v for v in scene.to_mitsuba().values() if isinstance(v, m.Mesh)]
+            return [{k: np.array(p[k]) for k in ("vertex_positions", "faces", "vertex_normals")
+                     if k in p and (k != "vertex_normals" or mesh.has_vertex_normals())}
+                    for mesh in meshes for p in [m.traverse(mesh)]]
+
+    scalar, jit = buffers("scalar_rgb"), buffers(mi.variant())
+    assert [sorted(b) for b in scalar] == [["faces", "vertex_positions"]] * 2 + [
+        ["faces", "vertex_normals", "vertex_positions"]]
+    for a, b in zip(scalar, jit):
+        for key in a:
+            assert np.array_equal(a[key], b[key]), key
+    ours = mcs.render(scene, 1024, integrator="direct", seed=3, progress=False)
+    ref = mcs.mitsuba.render_reference(scene, 1024, seed=4, integrator="direct",
+                                       variant="scalar_rgb")
+    t = stats.render_ztest(ours, ref)
+    print("scalar export:", t.message)
+    assert t.passed, t.message
+    assert not stats.render_ztest(_scaled(ours, 1.02), ref).passed
+
+
 def test_reference_renders_leave_the_callers_variant_set(mi):
     """render_reference picks its own variant and sets the caller's back,
     also when Mitsuba raises on the way."""

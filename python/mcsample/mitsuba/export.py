@@ -37,9 +37,8 @@ def _bsdf(material: "Material", phong_type: str) -> dict[str, Any]:
 def _mesh(mi: Any, name: str, shape: "ShapeRecord", bsdf: dict[str, Any],
           emitter: dict[str, Any] | None) -> Any:
     """A ``mi.Mesh`` of the shape's world-space triangles (and vertex
-    normals unless it has face normals), with its BSDF and emitter."""
-    import drjit as dr
-
+    normals unless it has face normals), with its BSDF and emitter, in any
+    variant (JIT or scalar)."""
     v = np.ascontiguousarray(shape.vertices, dtype=np.float32)
     f = np.ascontiguousarray(shape.faces, dtype=np.uint32)
     normals = None if shape.face_normals or shape.normals is None else shape.normals
@@ -50,11 +49,15 @@ def _mesh(mi: Any, name: str, shape: "ShapeRecord", bsdf: dict[str, Any],
     props["face_normals"] = normals is None
     mesh = mi.Mesh(name, len(v), len(f), props=props, has_vertex_normals=normals is not None)
     params = mi.traverse(mesh)
-    params["vertex_positions"] = dr.ravel(mi.Point3f(v.T))
-    params["faces"] = dr.ravel(mi.Vector3u(f.T))
+    buffers = {"vertex_positions": v, "faces": f}
     if normals is not None:
-        n = np.ascontiguousarray(normals, dtype=np.float32)
-        params["vertex_normals"] = dr.ravel(mi.Normal3f(n.T))
+        buffers["vertex_normals"] = np.ascontiguousarray(normals, dtype=np.float32)
+    for key, rows in buffers.items():
+        # The rows one after the other (x0, y0, z0, x1, ...), as the flat
+        # array type the variant keeps the buffer in: a Dr.Jit array in
+        # a JIT variant, a dynamic scalar array in a scalar one (where
+        # `mi.Point3f` is one point and cannot take them all).
+        params[key] = type(params[key])(rows.ravel())
     params.update()
     return mesh
 
