@@ -34,29 +34,49 @@ def light_scene(sensor, radiance=2.0):
 @pytest.mark.mitsuba
 @pytest.mark.parametrize("kind, fov_axis", [("perspective", "x"), ("perspective", "smaller"),
                                             ("thinlens", "y")])
-def test_sample_sensor_is_mitsubas(mi, kind, fov_axis):
+@pytest.mark.parametrize("variant", [None, "scalar_rgb"], ids=["suite", "scalar_rgb"])
+def test_sample_sensor_is_mitsubas(mi, kind, fov_axis, variant):
+    """The same numbers as Mitsuba's, in the suite's variant and in the
+    scalar one (the fallback where no libLLVM runs)."""
     g = np.random.default_rng(3)
     x = g.uniform([-3, -2, -1], [3, 3, 6], (4000, 3))
     u = g.random((4000, 2))
     d, _ = light_scene(camera(kind, fov_axis))
     ours = mcs.Scene.from_mitsuba(d).sample_sensor(x, u)
-    cam = camera(kind, fov_axis)
-    cam["to_world"] = mi.ScalarTransform4f(cam["to_world"].tolist())
-    sensor = mi.load_dict(cam)
-    it = mi.Interaction3f()
-    it.p = mi.Point3f(*x.T)
-    ds, weight = sensor.sample_direction(it, mi.Point2f(*u.T))
-    pdf = np.asarray(ds.pdf)
+    with mcs.mitsuba.variant_set(variant) as m:
+        cam = camera(kind, fov_axis)
+        cam["to_world"] = m.ScalarTransform4f(cam["to_world"].tolist())
+        uv, d, dist, pdf, w = _mitsuba_sensor_samples(m, m.load_dict(cam), x, u)
     valid = pdf > 0
     assert 500 < valid.sum() < 3900
     assert np.array_equal(valid, ours.pdf > 0)
-    assert np.allclose(ours.pixel[valid], np.asarray(ds.uv).T[valid], atol=2e-3)
-    assert np.allclose(ours.direction[valid], np.asarray(ds.d).T[valid], atol=1e-5)
-    assert np.allclose(ours.distance[valid], np.asarray(ds.dist)[valid], rtol=1e-5)
+    assert np.allclose(ours.pixel[valid], uv[valid], atol=2e-3)
+    assert np.allclose(ours.direction[valid], d[valid], atol=1e-5)
+    assert np.allclose(ours.distance[valid], dist[valid], rtol=1e-5)
     assert np.allclose(ours.pdf[valid], pdf[valid], rtol=1e-4)
-    w = np.asarray(weight).T[:, 0] if np.ndim(weight) == 2 else np.asarray(weight)
-    assert np.allclose(ours.weight[valid], np.ravel(w)[valid] if w.ndim == 1 else w[valid],
-                       rtol=1e-4)
+    assert np.allclose(ours.weight[valid], w[valid], rtol=1e-4)
+
+
+def _mitsuba_sensor_samples(mi, sensor, x, u):
+    """Mitsuba's ``sensor.sample_direction`` from each point ``x`` (n, 3)
+    with the numbers ``u`` (n, 2): the film positions (n, 2), directions
+    (n, 3), distances, densities and the weights' first channel (n): in
+    one call in a JIT variant, one call per row in a scalar variant (the
+    fallback where no libLLVM runs), whose points are single points."""
+    if not mi.variant().startswith("scalar"):
+        it = mi.Interaction3f()
+        it.p = mi.Point3f(*x.T)
+        ds, weight = sensor.sample_direction(it, mi.Point2f(*u.T))
+        w = np.asarray(weight)
+        return (np.asarray(ds.uv).T, np.asarray(ds.d).T, np.asarray(ds.dist),
+                np.asarray(ds.pdf), np.ravel(w.T[:, 0] if w.ndim == 2 else w))
+    rows = []
+    for xi, ui in zip(x, u):
+        it = mi.Interaction3f()
+        it.p = mi.Point3f(*xi)
+        ds, weight = sensor.sample_direction(it, mi.Point2f(*ui))
+        rows.append((list(ds.uv), list(ds.d), ds.dist, ds.pdf, weight[0]))
+    return tuple(np.array(column, dtype=np.float64) for column in zip(*rows))
 
 
 @pytest.mark.parametrize("kind", ["perspective", "thinlens"])
