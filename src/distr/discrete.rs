@@ -190,11 +190,19 @@ impl Discrete1D {
     /// `out[i] = sample(us[i])` for a batch. Groups of draws go in three
     /// sweeps: locate their guide cells (prefetched), prefetch the running
     /// sums each search reads, then search; so the cache misses of a group
-    /// overlap rather than queue.
+    /// overlap rather than queue. Compiled for the widest vector unit.
     pub fn sample_into<F: Real, I: From<u32>>(&self, us: &[F], out: &mut [I]) {
-        self.searched_in_groups(us, out, |search, u, k| {
-            I::from(search.index(u.f64(), k) as u32)
-        });
+        simd::dispatch(
+            #[inline(always)]
+            |_| {
+                self.searched_in_groups(
+                    us,
+                    out,
+                    #[inline(always)]
+                    |search, u, k| I::from(search.index(u.f64(), k) as u32),
+                )
+            },
+        )
     }
 
     /// The sweeps of [`Discrete1D::sample_into`], each group's last one
@@ -244,7 +252,12 @@ impl Discrete1D {
     /// loops of samplers built on this table (which dispatch themselves).
     #[inline(always)]
     pub(crate) fn sample_reuse_groups<F: Real>(&self, us: &[F], out: &mut [(usize, F)]) {
-        self.searched_in_groups(us, out, |search, u, k| search.index_reuse(u, k));
+        self.searched_in_groups(
+            us,
+            out,
+            #[inline(always)]
+            |search, u, k| search.index_reuse(u, k),
+        );
     }
 
     /// The tables as slices, for the steps of a draw.
