@@ -1,6 +1,6 @@
 //! [`Discrete2D`]: a discrete distribution over the cells of a table.
 
-use super::search::{Place, Search, fill_table, guide_len};
+use super::search::{Lanes, Place, Search, fill_table, guide_len, search_group};
 use super::{Discrete1D, GROUP, check_weights};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
@@ -54,6 +54,18 @@ struct Rows<'a> {
 }
 
 impl<'a> Rows<'a> {
+    /// A table of the store (the first row's place, of no weight): the
+    /// flat tables and a row's length, for [`search_group`].
+    #[inline(always)]
+    fn store(&self) -> Search<'a> {
+        let place = Place {
+            start: 0,
+            guide_start: 0,
+            len: self.cols,
+        };
+        Search::within((self.weights, self.cdf, self.guide), place, (0.0, 0, 0))
+    }
+
     /// The conditional of `row` (`None` for a row of weight 0): its place
     /// in the flat tables, found by arithmetic.
     #[inline(always)]
@@ -208,14 +220,12 @@ impl Discrete2D {
         }
     }
 
-    /// `out[i] = sample_reuse(us[i])` for a batch, in groups whose steps are
-    /// interleaved as [`Discrete1D::sample_into`]'s: the marginal's guide
-    /// cells, its search windows, the rows, their rescaled `u` (and the
-    /// conditionals' guide cells), their windows, the columns (prefetching
-    /// their weights), then the rescaled `u` of each column. The cache
-    /// misses of a group overlap, and each step is a short loop of
-    /// independent draws (faster than a row's search and its division in
-    /// one loop; see benches/README.md).
+    /// `out[i] = sample_reuse(us[i])` for a batch, in groups: the rows of a
+    /// group searched side by side ([`search_group`]), their rescaled `u`
+    /// ([`Lanes::rescale`]), then the columns, each in its row's tables,
+    /// and their rescaled `u` the same way. Each step is a loop over the
+    /// group at SIMD width, its table reads by gathers, so that the cache
+    /// misses of a group overlap.
     pub fn sample_reuse_into<F: Real>(&self, us: &[[F; 2]], out: &mut [((usize, usize), [F; 2])]) {
         simd::dispatch(
             #[inline(always)]
@@ -260,52 +270,34 @@ impl Discrete2D {
     fn groups<F: Real>(&self, us: &[[F; 2]], out: &mut [((usize, usize), [F; 2])], rescale: bool) {
         let marginal = self.marginal.search();
         let tables = self.tables();
+        let store = tables.store();
+        let mut lanes = Lanes::new();
+        let (mut rows, mut cols) = ([0; GROUP], [0; GROUP]);
+        let (mut u_row, mut u_col) = ([F::zero(); GROUP], [F::zero(); GROUP]);
         for (us, out) in us.chunks(GROUP).zip(out.chunks_mut(GROUP)) {
-            let mut cells = [0; GROUP];
-            for (k, u) in cells.iter_mut().zip(us) {
-                *k = marginal.locate(u[1].f64());
+            let n = us.len();
+            let row_draw = {
+                #[inline(always)]
+                |k: usize| Some((marginal, us[k][1].f64()))
+            };
+            search_group(n, &marginal, row_draw, &mut lanes, &mut rows);
+            for ((r, c), u) in u_row.iter_mut().zip(u_col.iter_mut()).zip(us) {
+                (*c, *r) = (u[0], u[1]);
             }
-            for &k in &cells[..us.len()] {
-                marginal.prefetch_window(k);
+            if rescale {
+                lanes.rescale(&marginal, &rows, &mut u_row);
             }
-            for ((o, u), &k) in out.iter_mut().zip(us).zip(&cells) {
-                o.0.0 = marginal.index(u[1].f64(), k);
+            // Each row's search is found by arithmetic on its index.
+            let col_draw = {
+                #[inline(always)]
+                |k: usize| Some((tables.search(rows[k] as usize)?, us[k][0].f64()))
+            };
+            search_group(n, &store, col_draw, &mut lanes, &mut cols);
+            if rescale {
+                lanes.rescale(&store, &cols, &mut u_col);
             }
-            // Each row's search is found by arithmetic on its index, in each
-            // step (no per-draw copy of it to store and reload).
-            for ((o, u), k) in out.iter_mut().zip(us).zip(&mut cells) {
-                let row = o.0.0;
-                let v = if rescale {
-                    marginal.rescale(u[1], row)
-                } else {
-                    u[1]
-                };
-                *o = ((row, 0), [u[0], v]);
-                if let Some(c) = tables.search(row) {
-                    *k = c.locate(u[0].f64());
-                }
-            }
-            for (o, &k) in out.iter().zip(&cells) {
-                if let Some(c) = tables.search(o.0.0) {
-                    c.prefetch_window(k);
-                }
-            }
-            for ((o, u), &k) in out.iter_mut().zip(us).zip(&cells) {
-                // The marginal never draws a row of weight 0.
-                if let Some(c) = tables.search(o.0.0) {
-                    o.0.1 = c.index(u[0].f64(), k);
-                    if rescale {
-                        c.prefetch_weight(o.0.1);
-                    }
-                }
-            }
-            if !rescale {
-                continue;
-            }
-            for (o, u) in out.iter_mut().zip(us) {
-                if let Some(c) = tables.search(o.0.0) {
-                    o.1[0] = c.rescale(u[0], o.0.1);
-                }
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = ((rows[k] as usize, cols[k] as usize), [u_col[k], u_row[k]]);
             }
         }
     }
@@ -353,6 +345,24 @@ mod tests {
         for ((&u, &o), &c) in us.iter().zip(&out).zip(&cells) {
             assert_eq!(o, d.sample_reuse(u), "u = {u:?}");
             assert_eq!(c, d.sample(u), "u = {u:?}");
+        }
+    }
+
+    #[test]
+    fn a_window_past_its_row_is_not_read_into_the_next() {
+        // Row 0's last guide cell starts at its last entry, whose window
+        // runs into row 1, whose running sums (1, 2, 102, ...) straddle
+        // the value: read as row 0's, they would answer past the row.
+        let cols = 64;
+        let mut w = vec![1.0; 2 * cols];
+        w[cols - 1] = 10.0;
+        w[cols + 2] = 100.0;
+        let d = Discrete2D::new(&w, 2, cols).unwrap();
+        let us: Vec<[f64; 2]> = (0..=2000).map(|k| [k as f64 / 2000.0, 0.1]).collect();
+        let mut cells = vec![(0, 0); us.len()];
+        d.sample_into(&us, &mut cells);
+        for (&u, &c) in us.iter().zip(&cells) {
+            assert_eq!(c, (0, linear(&w[..cols], u[0])), "u = {u:?}");
         }
     }
 

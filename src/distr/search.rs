@@ -3,7 +3,7 @@
 //! cutpoint method of Chen and Asau) that narrows the search to an expected
 //! O(1) entries, and the search itself.
 
-use super::is_weight;
+use super::{GROUP, is_weight};
 use crate::math::Real;
 use crate::simd;
 
@@ -228,10 +228,10 @@ fn count_below(window: &[f64; SCAN], value: f64) -> usize {
 
 /// A table's weights, running sums and guide cells, as plain slices of a
 /// store that may hold several tables (the rows of a
-/// [`super::Discrete2D`], row after row), and a draw in steps that a batch
-/// can interleave: [`Search::locate`] the guide cell (prefetched),
-/// [`Search::prefetch_window`], then [`Search::index`] or
-/// [`Search::index_reuse`]. Indices are the table's own (from 0); the
+/// [`super::Discrete2D`], row after row), and one draw's search: its
+/// [`Search::guide_cell`], then [`Search::index`] and
+/// [`Search::rescale`] (a batch runs these steps side by side in
+/// [`Lanes`]). Indices are the table's own (from 0); the
 /// table starts at `start` in `weights` and `cdf`, and its guide at
 /// `guide_start` in `guide`, so that cutting one table out of the store
 /// is arithmetic on its place (no sub-slices to cut and check per draw).
@@ -298,6 +298,12 @@ impl<'a> Search<'a> {
         }
     }
 
+    /// Whether the table has a guide table (see [`guide_len`]).
+    #[inline(always)]
+    pub(crate) fn guided(&self) -> bool {
+        self.guide_len > 0
+    }
+
     /// The sum of the weights.
     #[inline(always)]
     pub(crate) fn sum(&self) -> f64 {
@@ -339,33 +345,12 @@ impl<'a> Search<'a> {
     /// [`Discrete1D::sample_reuse`]).
     #[inline(always)]
     pub(crate) fn sample_reuse<F: Real>(&self, u: F) -> (usize, F) {
-        self.index_reuse(u, self.guide_cell(u.f64()))
+        let i = self.index(u.f64(), self.guide_cell(u.f64()));
+        (i, self.rescale(u, i))
     }
 
-    /// Step 1: the guide cell of `u`, prefetched.
-    #[inline(always)]
-    pub(crate) fn locate(&self, u: f64) -> usize {
-        let k = self.guide_cell(u);
-        simd::prefetch(self.guide, self.guide_start + k);
-        k
-    }
-
-    /// Step 2: prefetches what [`Search::index`] reads for guide cell `k`:
-    /// the running sum before its first entry `lo`, the window of [`SCAN`]
-    /// sums from `lo` (at most two cache lines with it), and the weight at
-    /// `lo`.
-    #[inline(always)]
-    pub(crate) fn prefetch_window(&self, k: usize) {
-        if let Some(lo) = self.guide_entry(k) {
-            let lo = self.start + lo;
-            simd::prefetch(self.cdf, lo.saturating_sub(1));
-            simd::prefetch(self.cdf, lo + SCAN - 1);
-            simd::prefetch(self.weights, lo);
-        }
-    }
-
-    /// Step 3: the index for `u`, starting from the first entry `lo` of
-    /// guide cell `k`. Where the sum before `lo` is below `u·Σw` (or `lo`
+    /// The index for `u`, starting from the first entry `lo` of guide cell
+    /// `k` ([`Search::guide_cell`]). Where the sum before `lo` is below `u·Σw` (or `lo`
     /// is the first entry of positive weight), the answer is the first of
     /// the [`SCAN`] sums from `lo` that reaches `u·Σw`, found by counting
     /// those below it in one vector compare; they are sorted, and past the
@@ -389,21 +374,6 @@ impl<'a> Search<'a> {
         }
         let (lo, hi) = self.bracket(k, value);
         lo + self.cdf[self.start + lo..self.start + hi].partition_point(|&c| c < value)
-    }
-
-    /// Step 3 of [`Discrete1D::sample_reuse`]: the index and the rescaled
-    /// `u`.
-    #[inline(always)]
-    pub(crate) fn index_reuse<F: Real>(&self, u: F, k: usize) -> (usize, F) {
-        let i = self.index(u.f64(), k);
-        (i, self.rescale(u, i))
-    }
-
-    /// Prefetches the weight of index `i`, which [`Search::rescale`] reads
-    /// (the running sum before it is among those just searched).
-    #[inline(always)]
-    pub(crate) fn prefetch_weight(&self, i: usize) {
-        simd::prefetch(self.weights, self.start + i);
     }
 
     /// The leftover of `u` past the running sum before index `i`, rescaled
@@ -439,5 +409,175 @@ impl<'a> Search<'a> {
         let lo_ok = lo == self.first || self.running(lo - 1) < value;
         let hi_ok = hi == self.last || self.running(hi) >= value;
         if lo_ok && hi_ok { (lo, hi) } else { full }
+    }
+}
+
+/// A group of draws searched side by side, each in a table of its own
+/// (with a guide) in one store of tables: one column per quantity, so that
+/// each step of [`Search::index`] runs over the group at SIMD width, its
+/// table reads by gathers ([`simd::gather`]). Positions are the store's.
+pub(crate) struct Lanes {
+    /// `u·Σw` of each draw's table.
+    value: [f64; GROUP],
+    /// The guide cell of `u`.
+    cell: [u64; GROUP],
+    /// The table's first entry.
+    start: [u64; GROUP],
+    /// Its first entry of positive weight.
+    first: [u64; GROUP],
+    /// One past its last entry.
+    end: [u64; GROUP],
+}
+
+const _: () = assert!(GROUP == simd::BLOCK && SCAN == 8);
+
+impl Lanes {
+    /// A group whose draws are all [`Lanes::empty`] ones.
+    pub(crate) fn new() -> Self {
+        Lanes {
+            value: [0.0; GROUP],
+            cell: [0; GROUP],
+            start: [0; GROUP],
+            first: [0; GROUP],
+            end: [0; GROUP],
+        }
+    }
+
+    /// Draw `k` is `u` in `table` (which has a guide).
+    #[inline(always)]
+    pub(crate) fn set(&mut self, k: usize, table: &Search<'_>, u: f64) {
+        self.value[k] = u * table.sum;
+        self.cell[k] = (table.guide_start + table.guide_cell(u)) as u64;
+        self.start[k] = table.start as u64;
+        self.first[k] = (table.start + table.first) as u64;
+        self.end[k] = (table.start + table.len) as u64;
+    }
+
+    /// Draw `k` has no table: [`Lanes::search`] leaves it to its caller.
+    #[inline(always)]
+    pub(crate) fn empty(&mut self, k: usize) {
+        (self.value[k], self.cell[k], self.start[k]) = (0.0, 0, 0);
+        (self.first[k], self.end[k]) = (0, 0);
+    }
+
+    /// The index each draw's [`Search::index`] finds by its guide cell's
+    /// window, into `index` (the table's own, from 0): the cell's first
+    /// entry `lo`, the running sum before it, then the count of the
+    /// [`SCAN`] sums from `lo` below `u·Σw` by a binary search of 4
+    /// steps, a gather each (the window is sorted). Returns the draws
+    /// (bit `k` for draw `k`) for which the window does not settle the
+    /// answer (the cell missed by round-off, the answer past the window,
+    /// the window past the table, no table): for those, `index` holds
+    /// nothing, and [`Search::index`] finds it. `store` is any table of
+    /// the store (its slices are the store's).
+    #[inline(always)]
+    pub(crate) fn search(&self, store: &Search<'_>, index: &mut [u64; GROUP]) -> u64 {
+        let below = {
+            #[inline(always)]
+            |c: f64, value: f64| c.to_bits().wrapping_sub(value.abs().to_bits()) >> 63
+        };
+        let simd::OnLines(lo) = &mut simd::OnLines([0u32; GROUP]);
+        simd::gather(store.guide, &self.cell, lo);
+        let simd::OnLines(at) = &mut simd::OnLines([0u64; GROUP]);
+        let simd::OnLines(read) = &mut simd::OnLines([0u64; GROUP]);
+        for ((a, r), (&lo, &start)) in at
+            .iter_mut()
+            .zip(read.iter_mut())
+            .zip(lo.iter().zip(&self.start))
+        {
+            *a = start + u64::from(lo);
+            *r = a.saturating_sub(1);
+        }
+        let simd::OnLines(c) = &mut simd::OnLines([0.0; GROUP]);
+        simd::gather(store.cdf, read, c);
+        let simd::OnLines(ok) = &mut simd::OnLines([0u64; GROUP]);
+        for k in 0..GROUP {
+            let lo_ok = (at[k] == self.first[k]) as u64 | below(c[k], self.value[k]);
+            ok[k] = lo_ok & u64::from(at[k] + SCAN as u64 <= self.end[k]);
+        }
+        index.fill(0);
+        for half in [4, 2, 1, 0] {
+            for (r, (&a, &pos)) in read.iter_mut().zip(at.iter().zip(index.iter())) {
+                *r = a + pos + half.max(1) - 1;
+            }
+            simd::gather(store.cdf, read, c);
+            for (pos, (&c, &value)) in index.iter_mut().zip(c.iter().zip(&self.value)) {
+                *pos += half.max(1) * below(c, value);
+            }
+        }
+        let mut redo = 0;
+        for (k, (i, (&lo, &ok))) in index.iter_mut().zip(lo.iter().zip(ok.iter())).enumerate() {
+            redo |= u64::from(ok == 0 || *i >= SCAN as u64) << k;
+            *i += u64::from(lo);
+        }
+        redo
+    }
+
+    /// `rescaled[k] = table.rescale(u_k, index[k])` for each draw (as
+    /// [`Lanes::set`] gave it, `index` its answer), the running sum before
+    /// each index and its weight read by gathers and the divisions at SIMD
+    /// width; draws without a table ([`Lanes::empty`]) keep their
+    /// `rescaled[k]`. `store` as for [`Lanes::search`].
+    #[inline(always)]
+    pub(crate) fn rescale<F: Real>(
+        &self,
+        store: &Search<'_>,
+        index: &[u64; GROUP],
+        rescaled: &mut [F; GROUP],
+    ) {
+        let simd::OnLines(at) = &mut simd::OnLines([0u64; GROUP]);
+        let simd::OnLines(before) = &mut simd::OnLines([0u64; GROUP]);
+        for ((a, b), (&i, &start)) in at
+            .iter_mut()
+            .zip(before.iter_mut())
+            .zip(index.iter().zip(&self.start))
+        {
+            *a = start + i;
+            *b = a.saturating_sub(1);
+        }
+        let simd::OnLines(c) = &mut simd::OnLines([0.0; GROUP]);
+        let simd::OnLines(w) = &mut simd::OnLines([0.0; GROUP]);
+        simd::gather(store.cdf, before, c);
+        simd::gather(store.weights, at, w);
+        for k in 0..GROUP {
+            let before = if index[k] == 0 { 0.0 } else { c[k] };
+            let r = F::c(((self.value[k] - before) / w[k]).max(0.0)).min(F::ONE_MINUS_EPSILON);
+            if self.end[k] > 0 {
+                rescaled[k] = r;
+            }
+        }
+    }
+}
+
+/// For each of the first `n` draws of a group, `index[k]` = the index
+/// [`Search::index`] finds for `u` in `table` where `draw(k)` is `Some((table,
+/// u))`, else 0: side by side ([`Lanes::search`]) if the tables have
+/// guides (all the store's tables have the same length as `store`, in
+/// whose store they lie), the draws it leaves one at a time. `lanes`
+/// keeps the draws' columns, for [`Lanes::rescale`].
+#[inline(always)]
+pub(crate) fn search_group<'a>(
+    n: usize,
+    store: &Search<'a>,
+    draw: impl Fn(usize) -> Option<(Search<'a>, f64)>,
+    lanes: &mut Lanes,
+    index: &mut [u64; GROUP],
+) {
+    for k in 0..n {
+        match draw(k) {
+            Some((table, u)) => lanes.set(k, &table, u),
+            None => lanes.empty(k),
+        }
+    }
+    let all = if store.guided() {
+        lanes.search(store, index)
+    } else {
+        u64::MAX
+    };
+    let mut redo = all & (u64::MAX >> (GROUP - n.max(1)));
+    while redo != 0 {
+        let k = redo.trailing_zeros() as usize;
+        redo &= redo - 1;
+        index[k] = draw(k).map_or(0, |(table, u)| table.index(u, table.guide_cell(u)) as u64);
     }
 }

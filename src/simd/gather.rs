@@ -1,7 +1,8 @@
 //! [`gather_columns`]: the entries of a table of `[f32; C]` at a block of
-//! indices, one column per component, read by the CPU's gather
-//! instructions where it has them (a loop of indexed reads is not
-//! vectorised by the compiler).
+//! indices, one column per component, and [`gather`]: the entries of a
+//! table of `f64` or `u32` at a block of 64-bit indices; both read by the
+//! CPU's gather instructions where it has them (a loop of indexed reads is
+//! not vectorised by the compiler).
 
 use super::{BLOCK, Level, OnLines, detected, level};
 
@@ -125,6 +126,137 @@ gather_with!(
     _mm256_storeu_ps
 );
 
+/// `out[i] = table[index[i]]` for a block of [`BLOCK`] indices: on AVX-512
+/// one gather instruction per 8 indices, on AVX2 per 4, else one read at a
+/// time (the same values on every path). An index past the table reads its
+/// last entry; an empty table leaves `out` as it is.
+#[inline(always)]
+pub fn gather<T: Gathered>(table: &[T], index: &[u64; BLOCK], out: &mut [T; BLOCK]) {
+    gather_one_at(level(), table, index, out);
+}
+
+/// The types [`gather`] reads: 8-byte floats and 4-byte integers.
+pub trait Gathered: Copy + sealed::Sealed {
+    /// [`gather`] on AVX-512.
+    ///
+    /// # Safety
+    /// The CPU has AVX-512 F, and every index is below `table.len()`.
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    unsafe fn gather_avx512(table: &[Self], index: &[u64; BLOCK], out: &mut [Self; BLOCK]);
+    /// [`gather`] on AVX2.
+    ///
+    /// # Safety
+    /// The CPU has AVX2, and every index is below `table.len()`.
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    unsafe fn gather_avx2(table: &[Self], index: &[u64; BLOCK], out: &mut [Self; BLOCK]);
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for f64 {}
+    impl Sealed for u32 {}
+}
+
+/// [`gather`] with the instruction set `level` (at most the one the CPU
+/// has: a wider one is capped).
+#[inline(always)]
+fn gather_one_at<T: Gathered>(
+    level: Level,
+    table: &[T],
+    index: &[u64; BLOCK],
+    out: &mut [T; BLOCK],
+) {
+    let Some(last) = table.len().checked_sub(1) else {
+        return;
+    };
+    let OnLines(at) = &mut OnLines([0u64; BLOCK]);
+    for (a, &i) in at.iter_mut().zip(index) {
+        *a = i.min(last as u64);
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        let level = level.min(detected());
+        #[allow(unsafe_code)]
+        // SAFETY: `level` is at most what the CPU has ([`detected`]); every
+        // index was just capped to the table's last.
+        unsafe {
+            match level {
+                Level::Avx512 => return T::gather_avx512(table, at, out),
+                Level::Avx2 => return T::gather_avx2(table, at, out),
+                Level::Baseline => {}
+            }
+        }
+    }
+    let _ = level;
+    for (o, &i) in out.iter_mut().zip(at.iter()) {
+        *o = table[i as usize];
+    }
+}
+
+/// Implements [`Gathered`] for `$t` with the gathers of 64-bit indices
+/// `$wide` (AVX-512, `[offsets, base]`) and `$narrow` (AVX2, `[base,
+/// offsets]`), each vector of lanes stored by `$store_wide` /
+/// `$store_narrow` (`$base`: the pointer type the gathers take).
+macro_rules! gathered {
+    ($t:ty, $base:ty, $wide:ident, $store_wide:ident, $narrow:ident, $store_narrow:ident) => {
+        impl Gathered for $t {
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx512f")]
+            #[allow(unsafe_code)]
+            #[inline]
+            unsafe fn gather_avx512(table: &[$t], index: &[u64; BLOCK], out: &mut [$t; BLOCK]) {
+                use std::arch::x86_64::{_mm512_loadu_si512, $store_wide, $wide};
+                let base = table.as_ptr().cast::<$base>();
+                for g in (0..BLOCK).step_by(8) {
+                    // SAFETY: lanes `g..g + 8` of the block (a multiple of
+                    // 8); `loadu` and `storeu` need no alignment; each
+                    // index lies in the table (the caller's).
+                    unsafe {
+                        let at = _mm512_loadu_si512(index.as_ptr().add(g).cast());
+                        let v = $wide::<{ size_of::<$t>() as i32 }>(at, base);
+                        $store_wide(out.as_mut_ptr().add(g).cast(), v);
+                    }
+                }
+            }
+
+            #[cfg(target_arch = "x86_64")]
+            #[target_feature(enable = "avx2")]
+            #[allow(unsafe_code)]
+            #[inline]
+            unsafe fn gather_avx2(table: &[$t], index: &[u64; BLOCK], out: &mut [$t; BLOCK]) {
+                use std::arch::x86_64::{_mm256_loadu_si256, $narrow, $store_narrow};
+                let base = table.as_ptr().cast::<$base>();
+                for g in (0..BLOCK).step_by(4) {
+                    // SAFETY: as on AVX-512, 4 lanes at a time.
+                    unsafe {
+                        let at = _mm256_loadu_si256(index.as_ptr().add(g).cast());
+                        let v = $narrow::<{ size_of::<$t>() as i32 }>(base, at);
+                        $store_narrow(out.as_mut_ptr().add(g).cast(), v);
+                    }
+                }
+            }
+        }
+    };
+}
+gathered!(
+    f64,
+    f64,
+    _mm512_i64gather_pd,
+    _mm512_storeu_pd,
+    _mm256_i64gather_pd,
+    _mm256_storeu_pd
+);
+gathered!(
+    u32,
+    i32,
+    _mm512_i64gather_epi32,
+    _mm256_storeu_si256,
+    _mm256_i64gather_epi32,
+    _mm_storeu_si128
+);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -154,6 +286,38 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// [`gather`] on every path this CPU has against the entries
+    /// themselves, indices past the end reading the last.
+    fn check_one<T: Gathered + PartialEq + std::fmt::Debug>(table: &[T]) {
+        let len = table.len() as u64;
+        let index: [u64; BLOCK] = std::array::from_fn(|i| match i {
+            0 => 0,
+            1 => len - 1,
+            2 => len,
+            3 => u64::MAX,
+            _ => (i as u64 * 7919) % len,
+        });
+        for level in [Level::Baseline, Level::Avx2, Level::Avx512] {
+            let mut out = [table[0]; BLOCK];
+            gather_one_at(level, table, &index, &mut out);
+            for (o, &k) in out.iter().zip(&index) {
+                assert_eq!(*o, table[k.min(len - 1) as usize], "{level:?}: index {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn single_gathers_are_the_entries() {
+        let floats: Vec<f64> = (0..1000).map(|k| k as f64 * 0.5 - 7.0).collect();
+        let ints: Vec<u32> = (0..1000).map(|k| 3 * k + u32::MAX - 5000).collect();
+        check_one(&floats);
+        check_one(&ints);
+        check_one(&[2.5f64]);
+        let mut out = [-1.0; BLOCK];
+        gather::<f64>(&[], &[0; BLOCK], &mut out);
+        assert_eq!(out, [-1.0; BLOCK]);
     }
 
     #[test]

@@ -14,7 +14,7 @@ mod gather;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
 
-pub use gather::gather_columns;
+pub use gather::{Gathered, gather, gather_columns};
 
 /// Name of the environment variable that caps the instruction set batch
 /// loops use: `avx512`, `avx2` or `baseline` (for tests and debugging;
