@@ -188,8 +188,8 @@ impl Discrete1D {
     }
 
     /// `out[i] = sample(us[i])` for a batch, in groups whose searches run
-    /// side by side ([`search_group`]), compiled for the widest vector
-    /// unit.
+    /// side by side (guide-table windows read by gathers at SIMD width),
+    /// compiled for the widest vector unit.
     pub fn sample_into<F: Real, I: From<u32>>(&self, us: &[F], out: &mut [I]) {
         simd::dispatch(
             #[inline(always)]
@@ -240,7 +240,7 @@ impl Discrete1D {
 
     /// `out[i] = sample_reuse(us[i])` for a batch, in the groups of
     /// [`Discrete1D::sample_into`], each group's rescaled numbers side by
-    /// side ([`Lanes::rescale`]), compiled for the widest vector unit.
+    /// side, compiled for the widest vector unit.
     pub fn sample_reuse_into<F: Real>(&self, us: &[F], out: &mut [(usize, F)]) {
         simd::dispatch(
             #[inline(always)]

@@ -221,11 +221,10 @@ impl Discrete2D {
     }
 
     /// `out[i] = sample_reuse(us[i])` for a batch, in groups: the rows of a
-    /// group searched side by side ([`search_group`]), their rescaled `u`
-    /// ([`Lanes::rescale`]), then the columns, each in its row's tables,
-    /// and their rescaled `u` the same way. Each step is a loop over the
-    /// group at SIMD width, its table reads by gathers, so that the cache
-    /// misses of a group overlap.
+    /// group searched side by side and their rescaled `u`, then the
+    /// columns, each in its row's tables, and theirs. Each step is a loop
+    /// over the group at SIMD width, its table reads by gathers, so that
+    /// the cache misses of a group overlap.
     pub fn sample_reuse_into<F: Real>(&self, us: &[[F; 2]], out: &mut [((usize, usize), [F; 2])]) {
         simd::dispatch(
             #[inline(always)]
