@@ -219,11 +219,7 @@ const SCAN: usize = 8;
 /// AVX-512).
 #[inline(always)]
 fn count_below(window: &[f64; SCAN], value: f64) -> usize {
-    let value = value.abs().to_bits();
-    window
-        .iter()
-        .map(|&c| c.to_bits().wrapping_sub(value) >> 63)
-        .sum::<u64>() as usize
+    window.iter().map(|&c| below(c, value)).sum::<u64>() as usize
 }
 
 /// A table's weights, running sums and guide cells, as plain slices of a
@@ -431,6 +427,13 @@ pub(crate) struct Lanes {
 
 const _: () = assert!(GROUP == simd::BLOCK && SCAN == 8);
 
+/// Whether running sum `c` lies below `value` (1 or 0), for the values of
+/// [`count_below`], by their bits.
+#[inline(always)]
+fn below(c: f64, value: f64) -> u64 {
+    c.to_bits().wrapping_sub(value.abs().to_bits()) >> 63
+}
+
 impl Lanes {
     /// A group whose draws are all [`Lanes::empty`] ones.
     pub(crate) fn new() -> Self {
@@ -464,51 +467,45 @@ impl Lanes {
     /// window, into `index` (the table's own, from 0): the cell's first
     /// entry `lo`, the running sum before it, then the count of the
     /// [`SCAN`] sums from `lo` below `u·Σw` by a binary search of 4
-    /// steps, a gather each (the window is sorted). Returns the draws
-    /// (bit `k` for draw `k`) for which the window does not settle the
-    /// answer (the cell missed by round-off, the answer past the window,
-    /// the window past the table, no table): for those, `index` holds
-    /// nothing, and [`Search::index`] finds it. `store` is any table of
-    /// the store (its slices are the store's).
+    /// steps, a gather each (the window is sorted; its reads past the
+    /// table's end read its last sum, `Σw`, as the sums past its last
+    /// entry of positive weight are). Returns the draws (bit `k` for draw
+    /// `k`) for which the window does not settle the answer (the cell
+    /// missed by round-off, the answer past the window, no table): for
+    /// those, `index` holds nothing, and [`Search::index`] finds it.
+    /// `store` is any table of the store (its slices are the store's).
     #[inline(always)]
     pub(crate) fn search(&self, store: &Search<'_>, index: &mut [u64; GROUP]) -> u64 {
-        let below = {
-            #[inline(always)]
-            |c: f64, value: f64| c.to_bits().wrapping_sub(value.abs().to_bits()) >> 63
-        };
         let simd::OnLines(lo) = &mut simd::OnLines([0u32; GROUP]);
         simd::gather(store.guide, &self.cell, lo);
         let simd::OnLines(at) = &mut simd::OnLines([0u64; GROUP]);
         let simd::OnLines(read) = &mut simd::OnLines([0u64; GROUP]);
-        for ((a, r), (&lo, &start)) in at
-            .iter_mut()
-            .zip(read.iter_mut())
-            .zip(lo.iter().zip(&self.start))
-        {
-            *a = start + u64::from(lo);
-            *r = a.saturating_sub(1);
+        for k in 0..GROUP {
+            at[k] = self.start[k] + u64::from(lo[k]);
+            read[k] = at[k].saturating_sub(1);
         }
-        let simd::OnLines(c) = &mut simd::OnLines([0.0; GROUP]);
-        simd::gather(store.cdf, read, c);
+        let simd::OnLines(got) = &mut simd::OnLines([0.0; GROUP]);
+        simd::gather(store.cdf, read, got);
         let simd::OnLines(ok) = &mut simd::OnLines([0u64; GROUP]);
         for k in 0..GROUP {
-            let lo_ok = (at[k] == self.first[k]) as u64 | below(c[k], self.value[k]);
-            ok[k] = lo_ok & u64::from(at[k] + SCAN as u64 <= self.end[k]);
+            let lo_ok = u64::from(at[k] == self.first[k]) | below(got[k], self.value[k]);
+            ok[k] = lo_ok & u64::from(at[k] < self.end[k]);
         }
         index.fill(0);
         for half in [4, 2, 1, 0] {
-            for (r, (&a, &pos)) in read.iter_mut().zip(at.iter().zip(index.iter())) {
-                *r = a + pos + half.max(1) - 1;
+            for (k, &pos) in index.iter().enumerate() {
+                let last = self.end[k].saturating_sub(1);
+                read[k] = (at[k] + pos + half.max(1) - 1).min(last);
             }
-            simd::gather(store.cdf, read, c);
-            for (pos, (&c, &value)) in index.iter_mut().zip(c.iter().zip(&self.value)) {
+            simd::gather(store.cdf, read, got);
+            for (pos, (&c, &value)) in index.iter_mut().zip(got.iter().zip(&self.value)) {
                 *pos += half.max(1) * below(c, value);
             }
         }
         let mut redo = 0;
-        for (k, (i, (&lo, &ok))) in index.iter_mut().zip(lo.iter().zip(ok.iter())).enumerate() {
-            redo |= u64::from(ok == 0 || *i >= SCAN as u64) << k;
-            *i += u64::from(lo);
+        for (k, i) in index.iter_mut().enumerate() {
+            redo |= u64::from(ok[k] == 0 || *i >= SCAN as u64) << k;
+            *i += u64::from(lo[k]);
         }
         redo
     }
@@ -526,24 +523,20 @@ impl Lanes {
         rescaled: &mut [F; GROUP],
     ) {
         let simd::OnLines(at) = &mut simd::OnLines([0u64; GROUP]);
-        let simd::OnLines(before) = &mut simd::OnLines([0u64; GROUP]);
-        for ((a, b), (&i, &start)) in at
-            .iter_mut()
-            .zip(before.iter_mut())
-            .zip(index.iter().zip(&self.start))
-        {
-            *a = start + i;
-            *b = a.saturating_sub(1);
-        }
-        let simd::OnLines(c) = &mut simd::OnLines([0.0; GROUP]);
-        let simd::OnLines(w) = &mut simd::OnLines([0.0; GROUP]);
-        simd::gather(store.cdf, before, c);
-        simd::gather(store.weights, at, w);
+        let simd::OnLines(read) = &mut simd::OnLines([0u64; GROUP]);
         for k in 0..GROUP {
-            let before = if index[k] == 0 { 0.0 } else { c[k] };
-            let r = F::c(((self.value[k] - before) / w[k]).max(0.0)).min(F::ONE_MINUS_EPSILON);
+            at[k] = self.start[k] + index[k];
+            read[k] = at[k].saturating_sub(1);
+        }
+        let simd::OnLines(got) = &mut simd::OnLines([0.0; GROUP]);
+        let simd::OnLines(weight) = &mut simd::OnLines([0.0; GROUP]);
+        simd::gather(store.cdf, read, got);
+        simd::gather(store.weights, at, weight);
+        for k in 0..GROUP {
+            let before = if index[k] == 0 { 0.0 } else { got[k] };
+            let r = F::c(((self.value[k] - before) / weight[k]).max(0.0));
             if self.end[k] > 0 {
-                rescaled[k] = r;
+                rescaled[k] = r.min(F::ONE_MINUS_EPSILON);
             }
         }
     }
