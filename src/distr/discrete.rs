@@ -379,7 +379,8 @@ mod tests {
 
     /// Tables whose guide-cell windows fail: a cluster of tiny weights in
     /// one cell (answers past the window), lengths just over the guide's
-    /// minimum (windows past the table's end), zeros first and last.
+    /// minimum (windows past the table's end, read as its last sum), zeros
+    /// first and last (one table's first entry a window from its end).
     fn window_tables() -> Vec<Vec<f64>> {
         let mut cluster: Vec<f64> = (0..400).map(|i| 1.0 + (i % 5) as f64).collect();
         cluster[150..250].fill(1e-9);
@@ -389,12 +390,15 @@ mod tests {
         let ramp = (0..1000)
             .map(|i| ((i * i) % 97) as f64 * (i % 13) as f64)
             .collect();
-        [vec![cluster, ramp], short].concat()
+        let late = [vec![0.0; 60], vec![1.0; 4]].concat();
+        [vec![cluster, ramp, late], short].concat()
     }
 
-    /// `u` on a grid, on every running sum and its neighbours.
+    /// `u` on a grid, on every running sum and its neighbours, and
+    /// negative (drawn as 0, by the single search).
     fn window_us(d: &Discrete1D) -> Vec<f64> {
         let mut us: Vec<f64> = (0..=3000).map(|k| k as f64 / 3000.0).collect();
+        us.extend([-0.5, -0.0, -1e-300]);
         for &c in d.cdf.iter() {
             let u = c / d.sum();
             us.extend([u, u.next_down().max(0.0), u.next_up().min(1.0)]);
@@ -457,7 +461,7 @@ mod tests {
             let search = Search::new((d.weights(), &d.cdf, &late), (d.sum(), d.first, d.last));
             redone += lanes_redone(&d, &search);
         }
-        // The cluster's draws, the windows past the end and the late cells'.
+        // The cluster's draws and the late cells'.
         assert!(redone > 1000, "{redone}");
     }
 

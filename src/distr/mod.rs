@@ -30,9 +30,10 @@ use crate::error::{Error, Result};
 use crate::parallel;
 use rayon::prelude::*;
 
-/// Draws per group of the batch samplers (`sample_into`): each group first
-/// locates and prefetches the table entries its draws will read, then reads
-/// them, so that the cache misses of a group overlap.
+/// Draws per group of the batch samplers (`sample_into`): each step of a
+/// group's draws runs over the whole group (the alias table's reads
+/// prefetched first, the searches of the CDF tables side by side), so that
+/// the cache misses of a group overlap.
 pub(crate) const GROUP: usize = 64;
 
 /// The largest number of entries a table may have (indices are `u32`).

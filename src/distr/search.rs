@@ -427,8 +427,10 @@ pub(crate) struct Lanes {
 
 const _: () = assert!(GROUP == simd::BLOCK && SCAN == 8);
 
-/// Whether running sum `c` lies below `value` (1 or 0), for the values of
-/// [`count_below`], by their bits.
+/// Whether running sum `c` lies below `value` (1 or 0), by their bits: for
+/// `c` finite and `>= 0` as `c < value` for `value >= 0` (`-0.0` as
+/// `+0.0`), 1 for a NaN `value` (the callers redo those draws, and those
+/// of negative values, by [`Search::index`]).
 #[inline(always)]
 fn below(c: f64, value: f64) -> u64 {
     c.to_bits().wrapping_sub(value.abs().to_bits()) >> 63
@@ -471,8 +473,9 @@ impl Lanes {
     /// table's end read its last sum, `Σw`, as the sums past its last
     /// entry of positive weight are). Returns the draws (bit `k` for draw
     /// `k`) for which the window does not settle the answer (the cell
-    /// missed by round-off, the answer past the window, no table): for
-    /// those, `index` holds nothing, and [`Search::index`] finds it.
+    /// missed by round-off, the answer past the window, no table, a
+    /// negative `u`): for those, `index` holds no answer, and
+    /// [`Search::index`] finds it.
     /// `store` is any table of the store (its slices are the store's).
     #[inline(always)]
     pub(crate) fn search(&self, store: &Search<'_>, index: &mut [u64; GROUP]) -> u64 {
@@ -489,7 +492,8 @@ impl Lanes {
         let simd::OnLines(ok) = &mut simd::OnLines([0u64; GROUP]);
         for k in 0..GROUP {
             let lo_ok = u64::from(at[k] == self.first[k]) | below(got[k], self.value[k]);
-            ok[k] = lo_ok & u64::from(at[k] < self.end[k]);
+            let signed = self.value[k].is_sign_negative();
+            ok[k] = lo_ok & u64::from(at[k] < self.end[k] && !signed);
         }
         index.fill(0);
         for half in [4, 2, 1, 0] {

@@ -311,7 +311,7 @@ mod tests {
     #[test]
     fn single_gathers_are_the_entries() {
         let floats: Vec<f64> = (0..1000).map(|k| k as f64 * 0.5 - 7.0).collect();
-        let ints: Vec<u32> = (0..1000).map(|k| 3 * k + u32::MAX - 5000).collect();
+        let ints: Vec<u32> = (0..1000).map(|k| u32::MAX - 5000 + 3 * k).collect();
         check_one(&floats);
         check_one(&ints);
         check_one(&[2.5f64]);
