@@ -346,13 +346,14 @@ impl<'a> Search<'a> {
     }
 
     /// The index for `u`, starting from the first entry `lo` of guide cell
-    /// `k` ([`Search::guide_cell`]). Where the sum before `lo` is below `u·Σw` (or `lo`
-    /// is the first entry of positive weight), the answer is the first of
-    /// the [`SCAN`] sums from `lo` that reaches `u·Σw`, found by counting
-    /// those below it in one vector compare; they are sorted, and past the
-    /// last entry of positive weight every sum is `Σw`. Otherwise (the
-    /// guide cell missed by round-off, or an answer further on) a binary
-    /// search of the cell's bracket (see [`Search::bracket`]).
+    /// `k` ([`Search::guide_cell`]). Where the sum before `lo` is below
+    /// `u·Σw` (or `lo` is the first entry of positive weight), the answer
+    /// is the first of the [`SCAN`] sums from `lo` that reaches `u·Σw`,
+    /// found by counting those below it in one vector compare; they are
+    /// sorted, and past the last entry of positive weight every sum is
+    /// `Σw`. Otherwise (the guide cell missed by round-off, or an answer
+    /// further on) a binary search of the cell's bracket (see
+    /// [`Search::bracket`]).
     #[inline(always)]
     pub(crate) fn index(&self, u: f64, k: usize) -> usize {
         let value = u * self.sum;
