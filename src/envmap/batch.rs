@@ -7,7 +7,8 @@
 use super::cell_sampler::CellSampler;
 use super::distribution::Distribution;
 use super::image::Corners;
-use super::luminance::LuminanceDensity;
+use super::image::bilinear_weights;
+use super::luminance::{LuminanceDensity, PlacedCells};
 use super::mapping::Mapping;
 use super::polar::TableFloat;
 use super::sample::{PdfQuery, Placed};
@@ -254,7 +255,8 @@ impl EnvMap {
 
     /// The pipeline of [`EnvMap::sample_rows`], group by group: the draw
     /// of [`EnvMap::sample_at`] in its two halves, the first for a whole
-    /// group at SIMD width.
+    /// group at SIMD width. Maps drawn by cells run in
+    /// [`EnvMap::sample_cell_groups`].
     #[inline(always)]
     fn sample_groups<F: Real, R>(
         &self,
@@ -262,58 +264,184 @@ impl EnvMap {
         mut prepare: impl FnMut(&R) -> [F; 2],
         mut out: EnvSamples<'_, F>,
     ) {
+        let grid = match &self.distribution {
+            Distribution::Luminance(density) => {
+                return self.sample_cell_groups(Cells::Luminance(density), rows, prepare, out);
+            }
+            Distribution::Piecewise(table) => {
+                return self.sample_cell_groups(Cells::Piecewise(table), rows, prepare, out);
+            }
+            Distribution::Bilinear(grid) => grid,
+            Distribution::Black => {
+                for (k, row) in rows.iter().enumerate() {
+                    out.set(k, self.sample_black(prepare(row).map(F::f64)).cast());
+                }
+                return;
+            }
+        };
         let zero = F::zero();
-        let mut cells = [((0, 0), [zero; 2]); GROUP];
         let simd::OnLines(points) = &mut simd::OnLines([[zero; 3]; GROUP]);
         let simd::OnLines(frames) = &mut simd::OnLines([[zero; 5]; GROUP]);
         let mut corners = [([0; 4], [zero; 4]); GROUP];
         let mut bilinear = [([0.0; 2], 0.0); GROUP];
-        let mut group = [[zero; 2]; GROUP];
+        let mut us = [[0.0; 2]; GROUP];
         for (g, rows) in rows.chunks(GROUP).enumerate() {
             let n = rows.len();
-            let first = g * GROUP;
-            let us = &mut group[..n];
+            let (us, b) = (&mut us[..n], &mut bilinear[..n]);
+            for (u, row) in us.iter_mut().zip(rows) {
+                *u = prepare(row).map(F::f64);
+            }
+            grid.sample_into(us, b);
+            for (k, &(q, pdf)) in b.iter().enumerate() {
+                let placed = self.place_at(q.map(F::c), F::c(pdf));
+                self.stage(placed, &mut points[k], &mut corners[k]);
+            }
+            self.finish_group(&points[..n], &corners, frames, |k, s| {
+                out.set(g * GROUP + k, s);
+            });
+        }
+    }
+
+    /// [`EnvMap::sample_groups`] of a map drawn by the cells of `table`,
+    /// two groups in flight: a group's cells are drawn and the lines that
+    /// placing its points and reading their texels will read are
+    /// prefetched ([`Cells::prefetch`]), then the group before is placed
+    /// and finished ([`EnvMap::finish_cells`]), its lines by now in the
+    /// caches.
+    #[inline(always)]
+    fn sample_cell_groups<F: Real, R>(
+        &self,
+        table: Cells<'_>,
+        rows: &[R],
+        mut prepare: impl FnMut(&R) -> [F; 2],
+        mut out: EnvSamples<'_, F>,
+    ) {
+        let zero = F::zero();
+        let mut cells = [[((0, 0), [zero; 2]); GROUP]; 2];
+        let mut staged = Staged::new();
+        let mut us = [[zero; 2]; GROUP];
+        // The group waiting to be finished: its index and size.
+        let mut previous: Option<(usize, usize)> = None;
+        for (g, rows) in rows.chunks(GROUP).enumerate() {
+            let us = &mut us[..rows.len()];
             for (u, row) in us.iter_mut().zip(rows) {
                 *u = prepare(row);
             }
-            let us = &*us;
-            // Each point's domain point and density, and its texels
-            // (prefetched).
-            let mut stage = |k: usize, placed| self.stage(placed, &mut points[k], &mut corners[k]);
-            match &self.distribution {
-                Distribution::Luminance(density) => {
-                    let cells = &mut cells[..n];
-                    density.cells().sample_groups(us, cells);
-                    for &(cell, _) in cells.iter() {
-                        density.prefetch_cell(cell);
-                    }
-                    self.place_cells(Cells::Luminance(density), cells, &mut stage);
-                }
-                Distribution::Piecewise(table) => {
-                    let cells = &mut cells[..n];
-                    table.table().sample_groups(us, cells);
-                    self.place_cells(Cells::Piecewise(table), cells, &mut stage);
-                }
-                Distribution::Bilinear(grid) => {
-                    let (u64s, b) = (&mut [[0.0; 2]; GROUP][..n], &mut bilinear[..n]);
-                    for (u, x) in u64s.iter_mut().zip(us) {
-                        *u = x.map(F::f64);
-                    }
-                    grid.sample_into(u64s, b);
-                    for (k, &(q, pdf)) in b.iter().enumerate() {
-                        stage(k, self.place_at(q.map(F::c), F::c(pdf)));
-                    }
-                }
-                Distribution::Black => {
-                    for (k, &u) in (first..).zip(us) {
-                        out.set(k, self.sample_black(u.map(F::f64)).cast());
-                    }
-                    continue;
-                }
+            let drawn = &mut cells[g % 2][..rows.len()];
+            table.draw(us, drawn);
+            for &(cell, _) in drawn.iter() {
+                self.prefetch_cell(table, cell);
             }
-            self.finish_group(&points[..n], &corners, frames, |k, s| {
-                out.set(first + k, s);
+            if let Some((p, n)) = previous.replace((g, rows.len())) {
+                self.finish_cells(table, &cells[p % 2][..n], &mut staged, |k, s| {
+                    out.set(p * GROUP + k, s);
+                });
+            }
+        }
+        if let Some((p, n)) = previous {
+            self.finish_cells(table, &cells[p % 2][..n], &mut staged, |k, s| {
+                out.set(p * GROUP + k, s);
             });
+        }
+    }
+
+    /// Asks the CPU for the lines that placing a point in `cell` of
+    /// `table` reads: a luminance density's table lines and the cell's
+    /// texels (its corners); a piecewise table's cells read none.
+    #[inline(always)]
+    fn prefetch_cell(&self, table: Cells<'_>, cell: (usize, usize)) {
+        if let Cells::Luminance(density) = table {
+            density.prefetch_cell(cell);
+            self.image
+                .prefetch_cell(cell.0 * self.image.width() + cell.1);
+        }
+    }
+
+    /// The second half of the draws of `cells` (at most [`GROUP`]), each
+    /// sample handed to `emit` with its index in the group: from a
+    /// luminance density by [`EnvMap::finish_luminance`]; from a piecewise
+    /// table, each point placed in its cell and its texels prefetched, then
+    /// [`EnvMap::finish_group`].
+    #[inline(always)]
+    fn finish_cells<F: Real>(
+        &self,
+        table: Cells<'_>,
+        cells: &[((usize, usize), [F; 2])],
+        staged: &mut Staged<F>,
+        emit: impl FnMut(usize, EnvSample<F>),
+    ) {
+        let Staged {
+            points: simd::OnLines(points),
+            frames: simd::OnLines(frames),
+            corners,
+            placed,
+        } = staged;
+        match table {
+            Cells::Luminance(density) => self.finish_luminance(density, cells, placed, emit),
+            Cells::Piecewise(table) => {
+                for (k, &(cell, r)) in cells.iter().enumerate() {
+                    let placed = self.place_in_cell(table, cell, r);
+                    self.stage(placed, &mut points[k], &mut corners[k]);
+                }
+                self.finish_group(&points[..cells.len()], corners, frames, emit);
+            }
+        }
+    }
+
+    /// The second half of the draws of `cells` (at most [`GROUP`]) from a
+    /// luminance `density` (this map's), in columns: the points placed in
+    /// their cells ([`LuminanceDensity::place_columns`]); their directions,
+    /// densities and texel weights at SIMD width; their texels read by
+    /// gathers and blended ([`Image::blend_texels`](super::image::Image::blend_texels)).
+    /// Each sample is handed to `emit` with its index in the group: the
+    /// same bits as [`EnvMap::place_luminance`] then [`EnvMap::sample_at`].
+    #[inline(always)]
+    fn finish_luminance<F: Real>(
+        &self,
+        density: &LuminanceDensity,
+        cells: &[((usize, usize), [F; 2])],
+        placed: &mut PlacedCells,
+        mut emit: impl FnMut(usize, EnvSample<F>),
+    ) {
+        const B: usize = simd::BLOCK;
+        density.place_columns(cells, placed);
+        let (w, h) = (self.image.width() as f64, (self.image.height() - 1) as f64);
+        let zero = F::zero();
+        let simd::OnLines(points) = &mut simd::OnLines([[zero; B]; 3]);
+        let simd::OnLines(weights) = &mut simd::OnLines([[zero; B]; 4]);
+        for i in 0..B {
+            let [x, y, pdf_q] = std::array::from_fn(|m| placed.place[m][i]);
+            let q = [(placed.cell[0][i] + x) / w, (placed.cell[1][i] + y) / h];
+            let [s, t] = self.lat_long_uv(q.map(F::c));
+            (points[0][i], points[1][i], points[2][i]) = (s, t, F::c(pdf_q));
+            for (column, wt) in weights.iter_mut().zip(bilinear_weights(F::c(x), F::c(y))) {
+                column[i] = wt;
+            }
+        }
+        let frame = {
+            #[inline(always)]
+            |[s, t, pdf_q]: [F; 3]| self.frame_at(Mapping::LatLong, [s, t], pdf_q)
+        };
+        let simd::OnLines(frames) = &mut simd::OnLines([[zero; B]; 5]);
+        simd::map_columns(frames, points, &frame, &|_| true);
+        let [w00, w10, w01, w11] = &*weights;
+        let simd::OnLines(rgb) = &self
+            .image
+            .blend_texels(&placed.texels, [w00, w10, w01, w11]);
+        let scale = F::c(self.options.scale);
+        for i in 0..cells.len() {
+            let radiance: [F; 3] = std::array::from_fn(|c| rgb[c][i] * scale);
+            let [x, y, z, pdf, inv_pdf] = std::array::from_fn(|m| frames[m][i]);
+            let weight = radiance.map(|l| l * inv_pdf);
+            emit(
+                i,
+                EnvSample {
+                    direction: [x, y, z],
+                    pdf,
+                    weight,
+                    radiance,
+                },
+            );
         }
     }
 
@@ -351,35 +479,6 @@ impl EnvMap {
         (*point, *corners) = ([s, t, placed.pdf_q], placed.corners);
     }
 
-    /// The point at fractions `r` of each `(cell, r)` of `cells` (at most
-    /// [`GROUP`]) placed on the map, handed to `emit` with its index: a
-    /// luminance density's warps together at SIMD width
-    /// ([`LuminanceDensity::place_group`](super::luminance::LuminanceDensity::place_group)),
-    /// a piecewise table's one by one.
-    #[inline(always)]
-    fn place_cells<F: Real>(
-        &self,
-        table: Cells<'_>,
-        cells: &[((usize, usize), [F; 2])],
-        mut emit: impl FnMut(usize, Placed<F>),
-    ) {
-        match table {
-            Cells::Luminance(density) => {
-                let simd::OnLines(placed) = &mut simd::OnLines([[0.0; 3]; GROUP]);
-                let placed = &mut placed[..cells.len()];
-                density.place_group(cells, placed);
-                for (k, (&(cell, _), &p)) in cells.iter().zip(&*placed).enumerate() {
-                    emit(k, self.luminance_point(cell, p));
-                }
-            }
-            Cells::Piecewise(table) => {
-                for (k, &(cell, r)) in cells.iter().enumerate() {
-                    emit(k, self.place_in_cell(table, cell, r));
-                }
-            }
-        }
-    }
-
     /// [`CellSampler::sample`] by `sampler` (built for this map) of each
     /// `(bits, r)` of `draws`, appended to `out`, group by group as
     /// [`EnvMap::sample_rows`] draws: the cells (their alias-table reads
@@ -407,9 +506,10 @@ impl EnvMap {
         }
     }
 
-    /// [`EnvMap::sample_cells`] of a map whose cells are `table`'s, the
-    /// table lines that placing a point in a cell reads (a luminance
-    /// density's) prefetched as the cells are drawn.
+    /// [`EnvMap::sample_cells`] of a map whose cells are `table`, group by
+    /// group: the cells (their alias-table reads overlap) and the lines
+    /// that placing points in them reads prefetched, then
+    /// [`EnvMap::finish_cells`].
     #[inline(always)]
     fn sample_cells_by<F: Real>(
         &self,
@@ -418,23 +518,39 @@ impl EnvMap {
         out: &mut Vec<EnvSample<F>>,
         table: Cells<'_>,
     ) {
-        let zero = F::zero();
-        let mut cells = [((0, 0), [zero; 2]); GROUP];
-        let simd::OnLines(points) = &mut simd::OnLines([[zero; 3]; GROUP]);
-        let simd::OnLines(frames) = &mut simd::OnLines([[zero; 5]; GROUP]);
-        let mut corners = [([0; 4], [zero; 4]); GROUP];
+        let mut cells = [((0, 0), [F::zero(); 2]); GROUP];
+        let mut staged = Staged::new();
         for draws in draws.chunks(GROUP) {
             for (cell, &(bits, r)) in cells.iter_mut().zip(draws) {
                 *cell = (sampler.cell(bits), r);
-                if let Cells::Luminance(density) = table {
-                    density.prefetch_cell(cell.0);
-                }
+                self.prefetch_cell(table, cell.0);
             }
-            self.place_cells(table, &cells[..draws.len()], |k, placed| {
-                self.stage(placed, &mut points[k], &mut corners[k]);
+            self.finish_cells(table, &cells[..draws.len()], &mut staged, |_, s| {
+                out.push(s)
             });
-            let points = &points[..draws.len()];
-            self.finish_group(points, &corners, frames, |_, s| out.push(s));
+        }
+    }
+}
+
+/// A group's scratch columns for [`EnvMap::finish_cells`]: a piecewise
+/// table's points (`[s, t, p_q]`), their frames and texels, and a
+/// luminance density's placed cells.
+struct Staged<F> {
+    points: simd::OnLines<[[F; 3]; GROUP]>,
+    frames: simd::OnLines<[[F; 5]; GROUP]>,
+    corners: [Corners<F>; GROUP],
+    placed: PlacedCells,
+}
+
+impl<F: Real> Staged<F> {
+    #[inline(always)]
+    fn new() -> Self {
+        let zero = F::zero();
+        Staged {
+            points: simd::OnLines([[zero; 3]; GROUP]),
+            frames: simd::OnLines([[zero; 5]; GROUP]),
+            corners: [([0; 4], [zero; 4]); GROUP],
+            placed: PlacedCells::new(),
         }
     }
 }
@@ -444,6 +560,18 @@ impl EnvMap {
 enum Cells<'a> {
     Luminance(&'a LuminanceDensity),
     Piecewise(&'a PiecewiseConstant2D),
+}
+
+impl Cells<'_> {
+    /// The cell and the fractions in it of each of `us`, by the table's
+    /// batch sampler (whose cache misses overlap).
+    #[inline(always)]
+    fn draw<F: Real>(self, us: &[[F; 2]], out: &mut [((usize, usize), [F; 2])]) {
+        match self {
+            Cells::Luminance(density) => density.cells().sample_groups(us, out),
+            Cells::Piecewise(table) => table.table().sample_groups(us, out),
+        }
+    }
 }
 
 /// `out[i] = read(q, locate(q))` with `q = query(d[i])`: [`pipelined_blocks`]

@@ -320,13 +320,27 @@ impl Image {
                 column[i] = t;
             }
         }
+        let weights = [&q[2], &q[3], &q[4], &q[5]];
+        self.blend_texels(texels, weights)
+    }
+
+    /// The texels `texels[j][i]` blended by `weights[j][i]` over the four
+    /// corners `j` of each of a block's places `i`, one column per RGB
+    /// channel: read by gathers and blended at SIMD width, in the same
+    /// order as [`Image::blend`] (the same bits).
+    #[inline(always)]
+    pub(crate) fn blend_texels<F: Real>(
+        &self,
+        texels: &[[u32; simd::BLOCK]; 4],
+        weights: [&[F; simd::BLOCK]; 4],
+    ) -> simd::OnLines<[[F; simd::BLOCK]; 3]> {
         let mut blended = simd::OnLines([[F::zero(); simd::BLOCK]; 3]);
-        for (j, texels) in texels.iter().enumerate() {
+        for (texels, w) in texels.iter().zip(weights) {
             let simd::OnLines(t) = &mut simd::OnLines([[0.0; simd::BLOCK]; 3]);
             simd::gather_columns(&self.texels, texels, t);
             for (rgb, t) in blended.0.iter_mut().zip(t.iter()) {
                 for i in 0..simd::BLOCK {
-                    rgb[i] = rgb[i] + q[2 + j][i] * F::c(f64::from(t[i]));
+                    rgb[i] = rgb[i] + w[i] * F::c(f64::from(t[i]));
                 }
             }
         }
@@ -434,7 +448,7 @@ fn quad<F: Real>(xs: [usize; 2], ys: [usize; 2], width: usize, fx: F, fy: F) -> 
 /// The weights of the texels `(x₀, y₀)`, `(x₁, y₀)`, `(x₀, y₁)`, `(x₁, y₁)`
 /// at fractions `(f_x, f_y)` of the way from `(x₀, y₀)` to `(x₁, y₁)`.
 #[inline(always)]
-fn bilinear_weights<F: Real>(fx: F, fy: F) -> [F; 4] {
+pub(super) fn bilinear_weights<F: Real>(fx: F, fy: F) -> [F; 4] {
     let one = F::one();
     [
         (one - fx) * (one - fy),

@@ -148,31 +148,41 @@ impl LuminanceDensity {
         ([x, y], bilerp * self.scale[k])
     }
 
-    /// `[x, y, p_q]` of [`LuminanceDensity::place`] for each `(cell, r)`
-    /// of `cells` (at most [`GROUP`]), into `out`: the cells' corners read
-    /// one by one (their lines prefetched by then), the warps in `f64` at
-    /// SIMD width, the same bits as one by one.
+    /// [`LuminanceDensity::place`] of each `(cell, r)` of `cells` (at most
+    /// [`GROUP`]) into the columns of `out`: the cells' corners and scales
+    /// read by gathers, the warps in `f64` at SIMD width, the same bits as
+    /// one by one. Lanes past the group's draws are left holding values of
+    /// no draw.
     #[inline(always)]
-    pub(super) fn place_group<F: Real>(
+    pub(super) fn place_columns<F: Real>(
         &self,
         cells: &[((usize, usize), [F; 2])],
-        out: &mut [[f64; 3]],
+        out: &mut PlacedCells,
     ) {
-        debug_assert_eq!(out.len(), cells.len());
-        let OnLines(rows) = &mut OnLines([[0.0; 6]; GROUP]);
-        let rows = &mut rows[..cells.len()];
-        let index = |(row, col): (usize, usize)| row * self.width + col;
-        for (row, &(cell, r)) in rows.iter_mut().zip(cells) {
-            let [a, b, c, d] = corners(&self.lum, self.width, index(cell));
-            *row = [a, b, c, d, r[0].f64(), r[1].f64()];
+        debug_assert!(cells.len() <= GROUP);
+        let width = self.width;
+        let OnLines(at) = &mut OnLines([[0u64; BLOCK]; 4]);
+        let OnLines(r) = &mut OnLines([[0.0; BLOCK]; 2]);
+        for (i, &((row, col), [r0, r1])) in cells.iter().enumerate() {
+            let k = row * width + col;
+            let right = right_of(k, col, width);
+            for (j, t) in [k, right, k + width, right + width].into_iter().enumerate() {
+                (out.texels[j][i], at[j][i]) = (t as u32, t as u64);
+            }
+            (r[0][i], r[1][i]) = (r0.f64(), r1.f64());
+            (out.cell[0][i], out.cell[1][i]) = (col as f64, row as f64);
         }
-        let warp = {
-            #[inline(always)]
-            |[a, b, c, d, r0, r1]: [f64; 6]| warp_corners([a, b, c, d], [r0, r1])
-        };
-        simd::map_rows(out, rows, &warp, |_| true, false);
-        for (o, &(cell, _)) in out.iter_mut().zip(cells) {
-            o[2] *= self.scale[index(cell)];
+        let OnLines(lum) = &mut OnLines([[0.0; BLOCK]; 4]);
+        for (lum, at) in lum.iter_mut().zip(&*at) {
+            simd::gather(&self.lum, at, lum);
+        }
+        let OnLines(scale) = &mut OnLines([0.0; BLOCK]);
+        simd::gather(&self.scale, &at[0], scale);
+        for i in 0..BLOCK {
+            let corners = [lum[0][i], lum[1][i], lum[2][i], lum[3][i]];
+            let [x, y, bilerp] = warp_corners(corners, [r[0][i], r[1][i]]);
+            (out.place[0][i], out.place[1][i]) = (x, y);
+            out.place[2][i] = bilerp * scale[i];
         }
     }
 
@@ -194,6 +204,33 @@ impl LuminanceDensity {
             scale: &self.scale,
             lum_f32: &self.lum_f32,
             moments_f32: &self.moments_f32,
+        }
+    }
+}
+
+/// A group's points placed in their luminance cells
+/// ([`LuminanceDensity::place_columns`]), one column per quantity: lane `i`
+/// is the group's draw `i`.
+#[derive(Debug)]
+#[repr(align(64))]
+pub(super) struct PlacedCells {
+    /// Each cell's corner texels `[k, right, k + W, right + W]` (`k` its
+    /// top-left texel, `right` the texel right of it, wrapped): the texels
+    /// whose luminances are the corners `a, b, c, d`.
+    pub texels: [[u32; BLOCK]; 4],
+    /// Each cell's column and row.
+    pub cell: [[f64; BLOCK]; 2],
+    /// The point's fractions `x, y` in its cell and `p_q` there.
+    pub place: [[f64; BLOCK]; 3],
+}
+
+impl PlacedCells {
+    /// Columns of zeros.
+    pub(super) fn new() -> Self {
+        PlacedCells {
+            texels: [[0; BLOCK]; 4],
+            cell: [[0.0; BLOCK]; 2],
+            place: [[0.0; BLOCK]; 3],
         }
     }
 }

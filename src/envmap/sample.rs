@@ -218,13 +218,18 @@ impl EnvMap {
     #[inline(always)]
     fn table_to_uv<F: Real>(&self, q: [F; 2]) -> [F; 2] {
         match self.options.mapping {
-            Mapping::LatLong => {
-                let s = q[0] + F::c(0.5 / self.image.width() as f64);
-                [if s >= F::one() { s - F::one() } else { s }, q[1]]
-            }
+            Mapping::LatLong => self.lat_long_uv(q),
             Mapping::Angular => angular_uv(q[0], q[1]),
             Mapping::Cube => q,
         }
+    }
+
+    /// [`EnvMap::table_to_uv`] of a lat-long map: the table's columns
+    /// start half a texel right of `s = 0`, wrapped.
+    #[inline(always)]
+    pub(super) fn lat_long_uv<F: Real>(&self, q: [F; 2]) -> [F; 2] {
+        let s = q[0] + F::c(0.5 / self.image.width() as f64);
+        [if s >= F::one() { s - F::one() } else { s }, q[1]]
     }
 }
 

@@ -336,6 +336,23 @@ where
             }
         }
     }
+    map_columns(results, columns, kernel, valid)
+}
+
+/// `results[m][i] = kernel(x)[m]` with `x[k] = columns[k][i]`, for a block
+/// of columns, by a loop of constant length that vectorises; returns
+/// whether `valid` holds for every `x`.
+#[inline(always)]
+pub fn map_columns<F, T, const K: usize, const M: usize>(
+    results: &mut [[T; BLOCK]; M],
+    columns: &[[F; BLOCK]; K],
+    kernel: &impl Fn([F; K]) -> [T; M],
+    valid: &impl Fn(&[F; K]) -> bool,
+) -> bool
+where
+    F: Copy,
+    T: Copy,
+{
     let mut ok = true;
     for i in 0..BLOCK {
         let x = std::array::from_fn(|k| columns[k][i]);
