@@ -219,14 +219,14 @@ impl EnvMap {
 
     /// `out[i] = sample(us[i])` for a batch, in groups: the table points by
     /// the tables' batch samplers (whose cache misses overlap), then placed
-    /// on the map as [`EnvMap::sample`] places them and their texels
-    /// prefetched, the directions and densities of the group in one loop at
-    /// SIMD width, and last the radiance. Computed in `F` past the table
-    /// draw (whose searches run in `f64`; Mitsuba's bilinear density is
-    /// sampled in `f64` and rounded); in `f64`, the same bits as
-    /// [`EnvMap::sample`]. In `f32` a direction and its density are good to
-    /// a few ulps of `f32` (the density near a pole of a polar table to
-    /// about `10⁻⁷/sin θ`).
+    /// on the map as [`EnvMap::sample`] places them, the directions and
+    /// densities of the group at SIMD width, and last the radiance (for a
+    /// luminance density, two groups in flight and the second half in
+    /// columns). Computed in `F` past the table draw (whose searches run in
+    /// `f64`; Mitsuba's bilinear density is sampled in `f64` and rounded);
+    /// in `f64`, the same bits as [`EnvMap::sample`]. In `f32` a direction
+    /// and its density are good to a few ulps of `f32` (the density near a
+    /// pole of a polar table to about `10⁻⁷/sin θ`).
     ///
     /// # Panics
     /// If an array of `out` is shorter than `us`.
@@ -303,11 +303,11 @@ impl EnvMap {
     }
 
     /// [`EnvMap::sample_groups`] of a map drawn by the cells of `table`,
-    /// two groups in flight: a group's cells are drawn and the lines that
-    /// placing its points and reading their texels will read are
-    /// prefetched ([`Cells::prefetch`]), then the group before is placed
-    /// and finished ([`EnvMap::finish_cells`]), its lines by now in the
-    /// caches.
+    /// two groups in flight: a group's cells are drawn and, for a luminance
+    /// density, the lines that placing its points and reading their texels
+    /// will read are prefetched ([`EnvMap::prefetch_cell`]), then the group
+    /// before is placed and finished ([`EnvMap::finish_cells`]), its lines
+    /// by now in the caches.
     #[inline(always)]
     fn sample_cell_groups<F: Real, R>(
         &self,
@@ -404,6 +404,8 @@ impl EnvMap {
         mut emit: impl FnMut(usize, EnvSample<F>),
     ) {
         const B: usize = simd::BLOCK;
+        // (Only lat-long maps are sampled by their luminance.)
+        debug_assert_eq!(self.options.mapping, Mapping::LatLong);
         density.place_columns(cells, placed);
         let (w, h) = (self.image.width() as f64, (self.image.height() - 1) as f64);
         let zero = F::zero();
@@ -482,9 +484,8 @@ impl EnvMap {
     /// [`CellSampler::sample`] by `sampler` (built for this map) of each
     /// `(bits, r)` of `draws`, appended to `out`, group by group as
     /// [`EnvMap::sample_rows`] draws: the cells (their alias-table reads
-    /// overlap) and the density's table lines for them prefetched, the
-    /// points placed in them and their texels prefetched,
-    /// then [`EnvMap::finish_group`].
+    /// overlap) and the lines that placing points in them read prefetched,
+    /// then [`EnvMap::finish_cells`].
     #[inline(always)]
     pub(super) fn sample_cells<F: Real>(
         &self,
@@ -508,7 +509,7 @@ impl EnvMap {
 
     /// [`EnvMap::sample_cells`] of a map whose cells are `table`, group by
     /// group: the cells (their alias-table reads overlap) and the lines
-    /// that placing points in them reads prefetched, then
+    /// that placing points in them read prefetched, then
     /// [`EnvMap::finish_cells`].
     #[inline(always)]
     fn sample_cells_by<F: Real>(

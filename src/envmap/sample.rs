@@ -119,18 +119,6 @@ impl EnvMap {
         r: [F; 2],
     ) -> Placed<F> {
         let ([x, y], pdf_q) = density.place(cell, r.map(F::f64));
-        self.luminance_point(cell, [x, y, pdf_q])
-    }
-
-    /// The point at the fractions `[x, y]` of cell `cell` of the luminance
-    /// density, drawn there with density `pdf_q` per unit table area,
-    /// placed on the map ([`EnvMap::place_luminance`]'s second half).
-    #[inline(always)]
-    pub(super) fn luminance_point<F: Real>(
-        &self,
-        cell: (usize, usize),
-        [x, y, pdf_q]: [f64; 3],
-    ) -> Placed<F> {
         let (w, h) = (self.image.width() as f64, (self.image.height() - 1) as f64);
         let q = [(cell.1 as f64 + x) / w, (cell.0 as f64 + y) / h];
         Placed {
