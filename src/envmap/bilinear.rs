@@ -124,9 +124,9 @@ impl BilinearGrid {
 /// The point of the unit square with density `∝ bilerp(c, x, y)` (corners
 /// `[v00, v10, v01, v11]`, not all 0) at `r` in `[0, 1]²`: the marginal in
 /// y, then the conditional in x, each a linear density inverted in closed
-/// form.
+/// form, in `F`.
 #[inline(always)]
-pub(super) fn warp_bilinear(c: [f64; 4], r: [f64; 2]) -> [f64; 2] {
+pub(super) fn warp_bilinear<F: Real>(c: [F; 4], r: [F; 2]) -> [F; 2] {
     let y = sample_linear(r[1], c[0] + c[1], c[2] + c[3]);
     [
         sample_linear(r[0], lerp(y, c[0], c[2]), lerp(y, c[1], c[3])),
@@ -135,13 +135,13 @@ pub(super) fn warp_bilinear(c: [f64; 4], r: [f64; 2]) -> [f64; 2] {
 }
 
 #[inline(always)]
-fn lerp(t: f64, a: f64, b: f64) -> f64 {
-    (1.0 - t) * a + t * b
+fn lerp<F: Real>(t: F, a: F, b: F) -> F {
+    (F::one() - t) * a + t * b
 }
 
 /// `v00 (1−x)(1−y) + v10 x (1−y) + v01 (1−x) y + v11 x y`.
 #[inline(always)]
-pub(super) fn bilerp(c: [f64; 4], x: f64, y: f64) -> f64 {
+pub(super) fn bilerp<F: Real>(c: [F; 4], x: F, y: F) -> F {
     lerp(y, lerp(x, c[0], c[1]), lerp(x, c[2], c[3]))
 }
 
@@ -149,15 +149,16 @@ pub(super) fn bilerp(c: [f64; 4], x: f64, y: f64) -> f64 {
 /// `x = u(a + b)/(a + √((1 − u)a² + u b²))`, which is exact for `a = b` and
 /// stable for `a = 0` (0 at `u = 0`); `u` itself when `a = b = 0`.
 #[inline(always)]
-fn sample_linear(u: f64, a: f64, b: f64) -> f64 {
-    if a + b == 0.0 {
+fn sample_linear<F: Real>(u: F, a: F, b: F) -> F {
+    let zero = F::zero();
+    if a + b == zero {
         return u;
     }
     let denominator = a + lerp(u, a * a, b * b).sqrt();
-    if denominator > 0.0 {
-        (u * (a + b) / denominator).min(1.0)
+    if denominator > zero {
+        (u * (a + b) / denominator).min(F::one())
     } else {
-        0.0
+        zero
     }
 }
 

@@ -3,10 +3,10 @@
 //! bounce's together: [`CellSampler::sample_many`]).
 
 use super::distribution::Distribution;
+use super::polar::TableFloat;
 use super::{EnvMap, EnvSample};
 use crate::distr::AliasTable;
 use crate::error::Result;
-use crate::math::Real;
 use crate::simd;
 
 /// The density of [`EnvMap::sample`] (luminance or piecewise sampling),
@@ -59,7 +59,7 @@ impl CellSampler {
     /// density are good to a few `f32` ulps. (Given a map that has no
     /// cells, it draws by [`EnvMap::sample`] of `r`.)
     #[inline]
-    pub fn sample<F: Real>(&self, env: &EnvMap, bits: u64, r: [F; 2]) -> EnvSample<F> {
+    pub fn sample<F: TableFloat>(&self, env: &EnvMap, bits: u64, r: [F; 2]) -> EnvSample<F> {
         let cell = self.cell(bits);
         let placed = match &env.distribution {
             Distribution::Luminance(density) => env.place_luminance(density, cell, r),
@@ -82,7 +82,7 @@ impl CellSampler {
     /// `out` in order, the same samples: drawn together, in groups whose
     /// table reads overlap and whose directions and densities are computed
     /// at SIMD width (as [`EnvMap::sample_into`] draws).
-    pub fn sample_many<F: Real>(
+    pub fn sample_many<F: TableFloat>(
         &self,
         env: &EnvMap,
         draws: &[(u64, [F; 2])],

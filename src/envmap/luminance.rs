@@ -5,7 +5,7 @@
 //! [`Sampling::Luminance`]: super::Sampling::Luminance
 
 use super::bilinear::{bilerp, warp_bilinear};
-use super::image::{cell_texels, cell_u32, right_of};
+use super::image::{bilinear_weights, cell_texels, cell_u32, right_of};
 use crate::buffer::Buffer;
 use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;
@@ -56,7 +56,8 @@ pub(super) struct LuminanceDensity {
     scale: Buffer<f64>,
     /// Each texel's luminance times `WH'/Σw` (`L = Y·WH'/Σw`), rounded to
     /// `f32`, from which a query in `f32` computes `p_q` (see
-    /// [`density_f32`]): 4 bytes a texel, so that a 1024 × 512 map's
+    /// [`density_f32`]) and a draw in `f32` is placed in its cell
+    /// ([`Tables::place_f32`]): 4 bytes a texel, so that a 1024 × 512 map's
     /// (2 MiB) stays in a core's cache. A texel adds at least
     /// `Y(Δ − sin Δ)/Δ² ≥ 0.88·YΔ/6` to the weights of the two cells of
     /// its row it is a corner of (the least at a pole), so `L` is at most
@@ -132,58 +133,12 @@ impl LuminanceDensity {
         &self.cells
     }
 
-    /// Asks the CPU for the table lines that [`LuminanceDensity::place`]
-    /// reads for cell `(row, col)` ([`Tables::prefetch`]).
+    /// Asks the CPU for the table lines that [`LuminanceFloat::place`]
+    /// reads in `F` for cell `(row, col)`
+    /// ([`LuminanceFloat::prefetch_luminance`]).
     #[inline(always)]
-    pub(super) fn prefetch_cell(&self, (row, col): (usize, usize)) {
-        self.tables().prefetch(row * self.width + col);
-    }
-
-    /// The point of cell `(row, col)` that the fractions `r` in `[0, 1]²`
-    /// place, as the cell's fractions `(x, y)`, and `p_q` there.
-    #[inline]
-    pub(super) fn place(&self, (row, col): (usize, usize), r: [f64; 2]) -> ([f64; 2], f64) {
-        let k = row * self.width + col;
-        let [x, y, bilerp] = warp_corners(corners(&self.lum, self.width, k), r);
-        ([x, y], bilerp * self.scale[k])
-    }
-
-    /// [`LuminanceDensity::place`] of each `(cell, r)` of `cells` (at most
-    /// [`GROUP`]) into the columns of `out`: the cells' corners and scales
-    /// read by gathers, the warps in `f64` at SIMD width, the same bits as
-    /// one by one. Lanes past the group's draws are left holding values of
-    /// no draw.
-    #[inline(always)]
-    pub(super) fn place_columns<F: Real>(
-        &self,
-        cells: &[((usize, usize), [F; 2])],
-        out: &mut PlacedCells,
-    ) {
-        debug_assert!(cells.len() <= GROUP);
-        let width = self.width;
-        let OnLines(at) = &mut OnLines([[0u64; BLOCK]; 4]);
-        let OnLines(r) = &mut OnLines([[0.0; BLOCK]; 2]);
-        for (i, &((row, col), [r0, r1])) in cells.iter().enumerate() {
-            let k = row * width + col;
-            let right = right_of(k, col, width);
-            for (j, t) in [k, right, k + width, right + width].into_iter().enumerate() {
-                (out.texels[j][i], at[j][i]) = (t as u32, t as u64);
-            }
-            (r[0][i], r[1][i]) = (r0.f64(), r1.f64());
-            (out.cell[0][i], out.cell[1][i]) = (col as f64, row as f64);
-        }
-        let OnLines(lum) = &mut OnLines([[0.0; BLOCK]; 4]);
-        for (lum, at) in lum.iter_mut().zip(&*at) {
-            simd::gather(&self.lum, at, lum);
-        }
-        let OnLines(scale) = &mut OnLines([0.0; BLOCK]);
-        simd::gather(&self.scale, &at[0], scale);
-        for i in 0..BLOCK {
-            let corners = [lum[0][i], lum[1][i], lum[2][i], lum[3][i]];
-            let [x, y, bilerp] = warp_corners(corners, [r[0][i], r[1][i]]);
-            (out.place[0][i], out.place[1][i]) = (x, y);
-            out.place[2][i] = bilerp * scale[i];
-        }
+    pub(super) fn prefetch_cell<F: LuminanceFloat>(&self, (row, col): (usize, usize)) {
+        F::prefetch_luminance(self.tables(), row * self.width + col);
     }
 
     /// `p_q` at the fractions `(x, y)` of cell `(row, col)`.
@@ -209,28 +164,29 @@ impl LuminanceDensity {
 }
 
 /// A group's points placed in their luminance cells
-/// ([`LuminanceDensity::place_columns`]), one column per quantity: lane `i`
-/// is the group's draw `i`.
+/// ([`LuminanceFloat::place_columns`]), one column per quantity, in `F`:
+/// lane `i` is the group's draw `i`.
 #[derive(Debug)]
 #[repr(align(64))]
-pub(super) struct PlacedCells {
+pub struct PlacedCells<F> {
     /// Each cell's corner texels `[k, right, k + W, right + W]` (`k` its
     /// top-left texel, `right` the texel right of it, wrapped): the texels
     /// whose luminances are the corners `a, b, c, d`.
     pub texels: [[u32; BLOCK]; 4],
     /// Each cell's column and row.
-    pub cell: [[f64; BLOCK]; 2],
+    pub cell: [[F; BLOCK]; 2],
     /// The point's fractions `x, y` in its cell and `p_q` there.
-    pub place: [[f64; BLOCK]; 3],
+    pub place: [[F; BLOCK]; 3],
 }
 
-impl PlacedCells {
+impl<F: Real> PlacedCells<F> {
     /// Columns of zeros.
     pub(super) fn new() -> Self {
+        let zero = F::zero();
         PlacedCells {
             texels: [[0; BLOCK]; 4],
-            cell: [[0.0; BLOCK]; 2],
-            place: [[0.0; BLOCK]; 3],
+            cell: [[zero; BLOCK]; 2],
+            place: [[zero; BLOCK]; 3],
         }
     }
 }
@@ -272,9 +228,116 @@ pub struct Tables<'a> {
 }
 
 impl Tables<'_> {
+    /// The point of cell `(row, col)` that the fractions `r` in `[0, 1]²`
+    /// place, as the cell's fractions `(x, y)`, and `p_q` there, in `f64`
+    /// from the `f64` tables.
+    #[inline]
+    fn place(self, (row, col): (usize, usize), r: [f64; 2]) -> ([f64; 2], f64) {
+        let k = row * self.width + col;
+        let [x, y, bilerp] = warp_corners(corners(self.lum, self.width, k), r);
+        ([x, y], bilerp * self.scale[k])
+    }
+
+    /// [`Tables::place`] in `f32`, from the texels' `f32` table
+    /// (`L = Y·WH'/Σw`) and the row's moments: the point by the bilinear
+    /// warp of the cell's `L` ([`warp_corners_f32`]), `p_q` by
+    /// [`density_f32`] there, as `pdf` computes it in `f32`.
+    #[inline]
+    fn place_f32(self, (row, col): (usize, usize), r: [f32; 2]) -> ([f32; 2], f32) {
+        let k = row * self.width + col;
+        let c = corners(self.lum_f32, self.width, k);
+        let [x, y] = warp_corners_f32(c, r);
+        (
+            [x, y],
+            density_f32(c, self.moments_f32[row], bilinear_weights(x, y)),
+        )
+    }
+
+    /// The columns of `out` for `cells` (at most [`GROUP`]): each cell's
+    /// corner texels, row and column, and its fractions `r` as `F`. Lanes
+    /// past the group's draws keep what they held (texels of a cell of
+    /// the map).
+    #[inline(always)]
+    fn cell_columns<F: Real>(
+        self,
+        cells: &[((usize, usize), [F; 2])],
+        out: &mut PlacedCells<F>,
+        r: &mut [[F; BLOCK]; 2],
+    ) {
+        debug_assert!(cells.len() <= GROUP);
+        let width = self.width;
+        for (i, &((row, col), [r0, r1])) in cells.iter().enumerate() {
+            let k = row * width + col;
+            let right = right_of(k, col, width);
+            for (j, t) in [k, right, k + width, right + width].into_iter().enumerate() {
+                out.texels[j][i] = t as u32;
+            }
+            (r[0][i], r[1][i]) = (r0, r1);
+            (out.cell[0][i], out.cell[1][i]) = (F::c(col as f64), F::c(row as f64));
+        }
+    }
+
+    /// [`Tables::place`] of each `(cell, r)` of `cells` (at most
+    /// [`GROUP`]) into the columns of `out`: the cells' corners and scales
+    /// read by gathers, the warps in `f64` at SIMD width, the same bits as
+    /// one by one. Lanes past the group's draws are left holding values of
+    /// no draw.
+    #[inline(always)]
+    fn place_columns_f64(self, cells: &[((usize, usize), [f64; 2])], out: &mut PlacedCells<f64>) {
+        let OnLines(r) = &mut OnLines([[0.0; BLOCK]; 2]);
+        self.cell_columns(cells, out, r);
+        let OnLines(at) = &mut OnLines([[0u64; BLOCK]; 4]);
+        for (at, texels) in at.iter_mut().zip(&out.texels) {
+            *at = texels.map(u64::from);
+        }
+        let OnLines(lum) = &mut OnLines([[0.0; BLOCK]; 4]);
+        for (lum, at) in lum.iter_mut().zip(&*at) {
+            simd::gather(self.lum, at, lum);
+        }
+        let OnLines(scale) = &mut OnLines([0.0; BLOCK]);
+        simd::gather(self.scale, &at[0], scale);
+        for i in 0..BLOCK {
+            let corners = [lum[0][i], lum[1][i], lum[2][i], lum[3][i]];
+            let [x, y, bilerp] = warp_corners(corners, [r[0][i], r[1][i]]);
+            (out.place[0][i], out.place[1][i]) = (x, y);
+            out.place[2][i] = bilerp * scale[i];
+        }
+    }
+
+    /// [`Tables::place_f32`] of each `(cell, r)` of `cells` (at
+    /// most [`GROUP`]) into the columns of `out`: the cells' `L` and rows'
+    /// moments read by gathers, the warps and densities in `f32` at SIMD
+    /// width, the same bits as one by one. Lanes past the group's draws
+    /// are left holding values of no draw.
+    #[inline(always)]
+    fn place_columns_f32(self, cells: &[((usize, usize), [f32; 2])], out: &mut PlacedCells<f32>) {
+        let OnLines(r) = &mut OnLines([[0.0; BLOCK]; 2]);
+        self.cell_columns(cells, out, r);
+        let OnLines(corners) = &mut OnLines([[0.0; BLOCK]; 4]);
+        for (column, texels) in corners.iter_mut().zip(&out.texels) {
+            simd::gather_columns(
+                self.lum_f32.as_chunks().0,
+                texels,
+                std::array::from_mut(column),
+            );
+        }
+        let OnLines(rows) = &mut OnLines([0; BLOCK]);
+        for (row, &((j, _), _)) in rows.iter_mut().zip(cells) {
+            *row = j as u32;
+        }
+        let OnLines(moments) = &mut OnLines([[0.0; BLOCK]; 2]);
+        simd::gather_columns(self.moments_f32, rows, moments);
+        for i in 0..BLOCK {
+            let c = [corners[0][i], corners[1][i], corners[2][i], corners[3][i]];
+            let [x, y] = warp_corners_f32(c, [r[0][i], r[1][i]]);
+            let pdf_q = density_f32(c, [moments[0][i], moments[1][i]], bilinear_weights(x, y));
+            (out.place[0][i], out.place[1][i], out.place[2][i]) = (x, y, pdf_q);
+        }
+    }
+
     /// Asks the CPU for the lines that [`Tables::pdf_at`] (and
-    /// [`LuminanceDensity::place`]) read for cell `k` (its top-left texel):
-    /// its two rows' luminances and its scale.
+    /// [`Tables::place`]) read for cell `k` (its top-left texel): its two
+    /// rows' luminances and its scale.
     #[inline(always)]
     pub(super) fn prefetch(self, k: usize) {
         simd::prefetch(self.lum, k);
@@ -282,8 +345,8 @@ impl Tables<'_> {
         simd::prefetch(self.scale, k);
     }
 
-    /// Asks the CPU for the lines that [`Tables::pdf_at_f32`] reads for
-    /// cell `k`: its two rows' `L`.
+    /// Asks the CPU for the lines that [`Tables::pdf_at_f32`] (and
+    /// [`Tables::place_f32`]) read for cell `k`: its two rows' `L`.
     #[inline(always)]
     pub(super) fn prefetch_f32(self, k: usize) {
         simd::prefetch(self.lum_f32, k);
@@ -402,6 +465,20 @@ pub trait LuminanceFloat: Real {
         cells: &[u32; BLOCK],
         out: &mut [Self],
     );
+
+    /// The point that the fractions `r` place in cell `(row, col)` of
+    /// `tables`' density, as the cell's fractions `(x, y)`, and `p_q`
+    /// there: [`Tables::place`] in `f64`, [`Tables::place_f32`] in `f32`.
+    fn place(tables: Tables<'_>, cell: (usize, usize), r: [Self; 2]) -> ([Self; 2], Self);
+
+    /// [`LuminanceFloat::place`] of each `(cell, r)` of `cells` (at most
+    /// [`GROUP`]) into the columns of `out`, at SIMD width: the same bits
+    /// as one by one.
+    fn place_columns(
+        tables: Tables<'_>,
+        cells: &[((usize, usize), [Self; 2])],
+        out: &mut PlacedCells<Self>,
+    );
 }
 
 impl LuminanceFloat for f32 {
@@ -422,6 +499,18 @@ impl LuminanceFloat for f32 {
     ) {
         tables.block_pdfs_f32(q, cells, out);
     }
+    #[inline(always)]
+    fn place(tables: Tables<'_>, cell: (usize, usize), r: [f32; 2]) -> ([f32; 2], f32) {
+        tables.place_f32(cell, r)
+    }
+    #[inline(always)]
+    fn place_columns(
+        tables: Tables<'_>,
+        cells: &[((usize, usize), [f32; 2])],
+        out: &mut PlacedCells<f32>,
+    ) {
+        tables.place_columns_f32(cells, out);
+    }
 }
 
 impl LuminanceFloat for f64 {
@@ -441,6 +530,18 @@ impl LuminanceFloat for f64 {
         out: &mut [f64],
     ) {
         tables.block_pdfs(q, cells, out);
+    }
+    #[inline(always)]
+    fn place(tables: Tables<'_>, cell: (usize, usize), r: [f64; 2]) -> ([f64; 2], f64) {
+        tables.place(cell, r)
+    }
+    #[inline(always)]
+    fn place_columns(
+        tables: Tables<'_>,
+        cells: &[((usize, usize), [f64; 2])],
+        out: &mut PlacedCells<f64>,
+    ) {
+        tables.place_columns_f64(cells, out);
     }
 }
 
@@ -476,10 +577,27 @@ fn warp_corners(c: [f64; 4], r: [f64; 2]) -> [f64; 3] {
     [x, y, bilerp(c, x, y)]
 }
 
+/// The point of the unit square that `r` places with density `∝ bilerp(c,
+/// ·)` ([`warp_bilinear`]), in `f32`: the corners first divided by the
+/// largest (the warp is the same for any multiple of them), so that their
+/// squares neither overflow nor, beside a bright corner, vanish against
+/// it; a cell whose largest corner is subnormal is scaled by 2¹²⁶, which
+/// leaves its corners' squares normal.
+#[inline(always)]
+fn warp_corners_f32(c: [f32; 4], r: [f32; 2]) -> [f32; 2] {
+    let largest = c[0].max(c[1]).max(c[2]).max(c[3]);
+    let scale = if largest > 0.0 {
+        largest.recip().min(2f32.powi(126))
+    } else {
+        0.0
+    };
+    warp_bilinear(c.map(|v| v * scale), r)
+}
+
 /// The corners `[a, b, c, d]` of cell `k` (row-major, `width` a row):
 /// texels `col` and the next column (wrapped) on rows `row` and `row + 1`.
 #[inline(always)]
-fn corners(lum: &[f64], width: usize, k: usize) -> [f64; 4] {
+fn corners<T: Copy>(lum: &[T], width: usize, k: usize) -> [T; 4] {
     let next = right_of(k, k % width, width);
     [lum[k], lum[next], lum[k + width], lum[next + width]]
 }
@@ -518,103 +636,4 @@ fn angle_terms(x: f64) -> [f64; 3] {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `∫₀¹ (α + β t) sin(θ₀ + Δt) dt` by Simpson's rule.
-    fn simpson(alpha: f64, beta: f64, theta0: f64, delta: f64) -> f64 {
-        let n = 2000;
-        let f = |t: f64| (alpha + beta * t) * (theta0 + delta * t).sin();
-        let h = 1.0 / n as f64;
-        let inner: f64 = (1..n)
-            .map(|k| f(k as f64 * h) * if k % 2 == 1 { 4.0 } else { 2.0 })
-            .sum();
-        (f(0.0) + inner + f(1.0)) * h / 3.0
-    }
-
-    #[test]
-    fn angle_terms_agree_with_the_library() {
-        for x in [1e-6, 1e-3, 0.1, 0.2, 0.2499, SERIES_BELOW, 1.0] {
-            let (sin, cos) = f64::sin_cos(x);
-            let [s, v, g] = angle_terms(x);
-            assert!((s - sin).abs() <= 1e-15 * sin, "x={x}: {s} {sin}");
-            // The library's forms lose ~ε/x² of their digits, the series none.
-            assert!((v - (1.0 - cos)).abs() <= 1e-15 / (x * x) * v, "x={x}: {v}");
-            assert!(
-                (g - (sin - x * cos)).abs() <= 1e-15 / (x * x) * g,
-                "x={x}: {g}"
-            );
-            if x < SERIES_BELOW {
-                assert!(
-                    (v - 2.0 * (0.5 * x).sin().powi(2)).abs() <= 1e-15 * v,
-                    "x={x}: {v}"
-                );
-                // sin x − x cos x = Σ (−1)ⁿ⁺¹ 2n x²ⁿ⁺¹/(2n + 1)!, n ≥ 1.
-                let series: f64 = (1..8)
-                    .map(|n| {
-                        let sign = if n % 2 == 1 { 1.0 } else { -1.0 };
-                        let factorial: f64 = (1..=2 * n + 1).map(f64::from).product();
-                        sign * f64::from(2 * n) * x.powi(2 * n + 1) / factorial
-                    })
-                    .sum();
-                assert!((g - series).abs() <= 2e-15 * g, "x={x}: {g} {series}");
-            }
-        }
-    }
-
-    #[test]
-    fn cell_weights_are_the_luminance_over_the_cell() {
-        // Poles, equator, coarse and fine maps.
-        for height in [3, 4, 17, 1025, 16385] {
-            let delta = PI / (height - 1) as f64;
-            for row in [0, (height - 1) / 2, height - 2] {
-                let theta0 = row as f64 * delta;
-                let (sin, cos) = theta0.sin_cos();
-                let [i0, i1] = moments([sin.max(0.0), cos], delta);
-                for (alpha, beta) in [(1.0, 0.0), (0.0, 2.0), (3.5, -3.5)] {
-                    let truth = simpson(alpha, beta, theta0, delta);
-                    let ours = alpha * i0 + beta * i1;
-                    assert!((ours - truth).abs() < 1e-10 * truth, "H={height} row={row}");
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn cells_are_drawn_by_their_light_and_points_by_the_luminance() {
-        let (w, h) = (8, 5);
-        let mut lum: Vec<f64> = (0..w * h).map(|k| (k % 7) as f64).collect();
-        lum[2 * w + 3] = 40.0;
-        let d = LuminanceDensity::new(Buffer::from_slice(&lum, "lum").unwrap(), w, h)
-            .unwrap()
-            .unwrap();
-        // p_q integrates to 1 over the table (midpoint rule, exact for a
-        // bilinear function), and follows Y within each cell.
-        let n = 8;
-        let mut total = 0.0;
-        for k in 0..w * (h - 1) {
-            let cell = (k / w, k % w);
-            for a in 0..n {
-                for b in 0..n {
-                    let f = [(a as f64 + 0.5) / n as f64, (b as f64 + 0.5) / n as f64];
-                    total += d.table_pdf(cell, f);
-                }
-            }
-            let ratio = d.table_pdf(cell, [0.3, 0.6]) / bilerp(corners(&lum, w, k), 0.3, 0.6);
-            let other = d.table_pdf(cell, [0.9, 0.1]) / bilerp(corners(&lum, w, k), 0.9, 0.1);
-            assert!((ratio - other).abs() <= 1e-12 * ratio);
-            let (f, pdf) = d.place(cell, [0.25, 0.75]);
-            assert!((pdf - d.table_pdf(cell, f)).abs() <= 1e-15 * pdf);
-        }
-        let area = 1.0 / (w * (h - 1)) as f64;
-        assert!(
-            (total * area / (n * n) as f64 - 1.0).abs() < 1e-12,
-            "{total}"
-        );
-        assert!(
-            LuminanceDensity::new(Buffer::zeroed(w * h, "lum").unwrap(), w, h)
-                .unwrap()
-                .is_none()
-        );
-    }
-}
+mod tests;

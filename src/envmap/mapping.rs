@@ -122,12 +122,13 @@ impl Mapping {
         }
     }
 
-    /// The point of the domain that looks along `d` (a unit vector; other
-    /// lengths are accepted and normalised, the zero vector gives a valid
-    /// point), computed in `F`.
+    /// The point of the domain that looks along `d` (of any length, the
+    /// zero vector giving a valid point), computed in `F`. Every formula
+    /// is of ratios of `d`'s components (`atan2`, [`polar_angle`], a cube
+    /// face's `d_s/|d_major|`), so `d` is not normalised first: its length
+    /// only scales both sides of each ratio.
     #[inline(always)]
     pub fn from_dir<F: Real>(self, d: V3<F>) -> [F; 2] {
-        let d = normalized(d);
         let (zero, one) = (F::zero(), F::one());
         match self {
             Mapping::LatLong => {

@@ -109,22 +109,26 @@ impl EnvMap {
 
     /// The point that the fractions `r` place in cell `cell` of the
     /// luminance `density` (this map's), with its density per unit table
-    /// area. Placed in `f64` and rounded to `F`; the texels are the cell's
+    /// area, placed in `F` ([`LuminanceFloat::place`]: in `f32` from the
+    /// `f32` tables that `pdf` reads in `f32`); the texels are the cell's
     /// corners weighted by the point's fractions.
     #[inline(always)]
-    pub(super) fn place_luminance<F: Real>(
+    pub(super) fn place_luminance<F: LuminanceFloat>(
         &self,
         density: &LuminanceDensity,
         cell: (usize, usize),
         r: [F; 2],
     ) -> Placed<F> {
-        let ([x, y], pdf_q) = density.place(cell, r.map(F::f64));
+        let ([x, y], pdf_q) = F::place(density.tables(), cell, r);
         let (w, h) = (self.image.width() as f64, (self.image.height() - 1) as f64);
-        let q = [(cell.1 as f64 + x) / w, (cell.0 as f64 + y) / h];
+        let q = [
+            (F::c(cell.1 as f64) + x) / F::c(w),
+            (F::c(cell.0 as f64) + y) / F::c(h),
+        ];
         Placed {
-            point: self.table_to_uv(q.map(F::c)),
-            pdf_q: F::c(pdf_q),
-            corners: self.image.cell_corners(cell, [F::c(x), F::c(y)]),
+            point: self.table_to_uv(q),
+            pdf_q,
+            corners: self.image.cell_corners(cell, [x, y]),
         }
     }
 

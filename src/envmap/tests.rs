@@ -465,7 +465,7 @@ fn cell_sampler_draws_the_table_density() {
 /// group).
 #[test]
 fn cell_sampler_batches_are_its_single_draws() {
-    fn check<F: Real>(m: &EnvMap, cells: &CellSampler, draws: &[(u64, [F; 2])]) {
+    fn check<F: TableFloat>(m: &EnvMap, cells: &CellSampler, draws: &[(u64, [F; 2])]) {
         let mut many = Vec::new();
         cells.sample_many(m, draws, &mut many);
         assert_eq!(many.len(), draws.len());

@@ -9,10 +9,14 @@ use crate::envmap::distribution::Distribution;
 use crate::envmap::image::{Corners, bilinear_weights};
 use crate::envmap::luminance::{LuminanceDensity, PlacedCells};
 use crate::envmap::mapping::Mapping;
+use crate::envmap::polar::TableFloat;
 use crate::envmap::sample::Placed;
 use crate::envmap::{EnvMap, EnvSample};
 use crate::math::Real;
 use crate::simd;
+
+#[cfg(doc)]
+use crate::envmap::luminance::LuminanceFloat;
 
 impl EnvMap {
     /// `out[i] = sample(us[i])` for a batch, in groups: the table points by
@@ -24,11 +28,13 @@ impl EnvMap {
     /// `f64`; Mitsuba's bilinear density is sampled in `f64` and rounded);
     /// in `f64`, the same bits as [`EnvMap::sample`]. In `f32` a direction
     /// and its density are good to a few ulps of `f32` (the density near a
-    /// pole of a polar table to about `10⁻⁷/sin θ`).
+    /// pole of a polar table to about `10⁻⁷/sin θ`); a luminance density's
+    /// points are placed in their cells in `f32`, from the `f32` table that
+    /// [`EnvMap::pdf`] reads in `f32` (`LuminanceFloat::place`).
     ///
     /// # Panics
     /// If an array of `out` is shorter than `us`.
-    pub fn sample_into<F: Real>(&self, us: &[[F; 2]], out: EnvSamples<'_, F>) {
+    pub fn sample_into<F: TableFloat>(&self, us: &[[F; 2]], out: EnvSamples<'_, F>) {
         self.sample_rows(us, |&u| u, out);
     }
 
@@ -39,7 +45,7 @@ impl EnvMap {
     ///
     /// # Panics
     /// If an array of `out` is shorter than `rows`.
-    pub fn sample_rows<F: Real, R>(
+    pub fn sample_rows<F: TableFloat, R>(
         &self,
         rows: &[R],
         prepare: impl FnMut(&R) -> [F; 2],
@@ -56,7 +62,7 @@ impl EnvMap {
     /// group at SIMD width. Maps drawn by cells run in
     /// [`EnvMap::sample_cell_groups`].
     #[inline(always)]
-    fn sample_groups<F: Real, R>(
+    fn sample_groups<F: TableFloat, R>(
         &self,
         rows: &[R],
         mut prepare: impl FnMut(&R) -> [F; 2],
@@ -107,7 +113,7 @@ impl EnvMap {
     /// before is placed and finished ([`EnvMap::finish_cells`]), its lines
     /// by now in the caches.
     #[inline(always)]
-    fn sample_cell_groups<F: Real, R>(
+    fn sample_cell_groups<F: TableFloat, R>(
         &self,
         table: Cells<'_>,
         rows: &[R],
@@ -128,7 +134,7 @@ impl EnvMap {
             let drawn = &mut cells[g % 2][..rows.len()];
             table.draw(us, drawn);
             for &(cell, _) in drawn.iter() {
-                self.prefetch_cell(table, cell);
+                self.prefetch_cell::<F>(table, cell);
             }
             if let Some((p, n)) = previous.replace((g, rows.len())) {
                 self.finish_cells(table, &cells[p % 2][..n], &mut staged, |k, s| {
@@ -147,9 +153,9 @@ impl EnvMap {
     /// `table` reads: a luminance density's table lines and the cell's
     /// texels (its corners); a piecewise table's cells read none.
     #[inline(always)]
-    fn prefetch_cell(&self, table: Cells<'_>, cell: (usize, usize)) {
+    fn prefetch_cell<F: TableFloat>(&self, table: Cells<'_>, cell: (usize, usize)) {
         if let Cells::Luminance(density) = table {
-            density.prefetch_cell(cell);
+            density.prefetch_cell::<F>(cell);
             self.image
                 .prefetch_cell(cell.0 * self.image.width() + cell.1);
         }
@@ -161,7 +167,7 @@ impl EnvMap {
     /// table, each point placed in its cell and its texels prefetched, then
     /// [`EnvMap::finish_group`].
     #[inline(always)]
-    fn finish_cells<F: Real>(
+    fn finish_cells<F: TableFloat>(
         &self,
         table: Cells<'_>,
         cells: &[((usize, usize), [F; 2])],
@@ -188,33 +194,34 @@ impl EnvMap {
 
     /// The second half of the draws of `cells` (at most [`GROUP`]) from a
     /// luminance `density` (this map's), in columns: the points placed in
-    /// their cells ([`LuminanceDensity::place_columns`]); their directions,
+    /// their cells ([`LuminanceFloat::place_columns`]); their directions,
     /// densities and texel weights at SIMD width; their texels read by
     /// gathers and blended ([`Image::blend_texels`](crate::envmap::image::Image::blend_texels)).
     /// Each sample is handed to `emit` with its index in the group: the
     /// same bits as [`EnvMap::place_luminance`] then [`EnvMap::sample_at`].
     #[inline(always)]
-    fn finish_luminance<F: Real>(
+    fn finish_luminance<F: TableFloat>(
         &self,
         density: &LuminanceDensity,
         cells: &[((usize, usize), [F; 2])],
-        placed: &mut PlacedCells,
+        placed: &mut PlacedCells<F>,
         mut emit: impl FnMut(usize, EnvSample<F>),
     ) {
         const B: usize = simd::BLOCK;
         // (Only lat-long maps are sampled by their luminance.)
         debug_assert_eq!(self.options.mapping, Mapping::LatLong);
-        density.place_columns(cells, placed);
-        let (w, h) = (self.image.width() as f64, (self.image.height() - 1) as f64);
+        F::place_columns(density.tables(), cells, placed);
+        let w = F::c(self.image.width() as f64);
+        let h = F::c((self.image.height() - 1) as f64);
         let zero = F::zero();
         let simd::OnLines(points) = &mut simd::OnLines([[zero; B]; 3]);
         let simd::OnLines(weights) = &mut simd::OnLines([[zero; B]; 4]);
         for i in 0..B {
             let [x, y, pdf_q] = std::array::from_fn(|m| placed.place[m][i]);
             let q = [(placed.cell[0][i] + x) / w, (placed.cell[1][i] + y) / h];
-            let [s, t] = self.lat_long_uv(q.map(F::c));
-            (points[0][i], points[1][i], points[2][i]) = (s, t, F::c(pdf_q));
-            for (column, wt) in weights.iter_mut().zip(bilinear_weights(F::c(x), F::c(y))) {
+            let [s, t] = self.lat_long_uv(q);
+            (points[0][i], points[1][i], points[2][i]) = (s, t, pdf_q);
+            for (column, wt) in weights.iter_mut().zip(bilinear_weights(x, y)) {
                 column[i] = wt;
             }
         }
@@ -285,7 +292,7 @@ impl EnvMap {
     /// overlap) and the lines that placing points in them read prefetched,
     /// then [`EnvMap::finish_cells`].
     #[inline(always)]
-    pub(in crate::envmap) fn sample_cells<F: Real>(
+    pub(in crate::envmap) fn sample_cells<F: TableFloat>(
         &self,
         sampler: &CellSampler,
         draws: &[(u64, [F; 2])],
@@ -310,7 +317,7 @@ impl EnvMap {
     /// that placing points in them read prefetched, then
     /// [`EnvMap::finish_cells`].
     #[inline(always)]
-    fn sample_cells_by<F: Real>(
+    fn sample_cells_by<F: TableFloat>(
         &self,
         sampler: &CellSampler,
         draws: &[(u64, [F; 2])],
@@ -322,7 +329,7 @@ impl EnvMap {
         for draws in draws.chunks(GROUP) {
             for (cell, &(bits, r)) in cells.iter_mut().zip(draws) {
                 *cell = (sampler.cell(bits), r);
-                self.prefetch_cell(table, cell.0);
+                self.prefetch_cell::<F>(table, cell.0);
             }
             self.finish_cells(table, &cells[..draws.len()], &mut staged, |_, s| {
                 out.push(s)
@@ -338,7 +345,7 @@ struct Staged<F> {
     points: simd::OnLines<[[F; 3]; GROUP]>,
     frames: simd::OnLines<[[F; 5]; GROUP]>,
     corners: [Corners<F>; GROUP],
-    placed: PlacedCells,
+    placed: PlacedCells<F>,
 }
 
 impl<F: Real> Staged<F> {

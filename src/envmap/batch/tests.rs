@@ -8,7 +8,7 @@ use crate::math::Real;
 use crate::warp;
 
 /// `m.sample_into(us)` as samples (radiance 0: a batch writes none).
-fn batch<F: Real>(m: &EnvMap, us: &[[F; 2]]) -> Vec<EnvSample<F>> {
+fn batch<F: TableFloat>(m: &EnvMap, us: &[[F; 2]]) -> Vec<EnvSample<F>> {
     let n = us.len();
     let (mut direction, mut pdf, mut weight) = (
         vec![[F::zero(); 3]; n],
