@@ -55,7 +55,8 @@ impl CellSampler {
     /// wants. The cell comes from the 64 random bits `bits`, the point
     /// within it from the fractions `r` in `[0, 1)²` (along the table's x
     /// and y); from there it is the path of [`EnvMap::sample`]. Computed in
-    /// `F`: in `f32` the point stays in its cell, and the direction and
+    /// `F`: in `f32` the point stays in its cell, placed from the `f32`
+    /// tables as [`EnvMap::sample_into`] places it, and the direction and
     /// density are good to a few `f32` ulps. (Given a map that has no
     /// cells, it draws by [`EnvMap::sample`] of `r`.)
     #[inline]

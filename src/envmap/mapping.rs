@@ -126,7 +126,9 @@ impl Mapping {
     /// zero vector giving a valid point), computed in `F`. Every formula
     /// is of ratios of `d`'s components (`atan2`, [`polar_angle`], a cube
     /// face's `d_s/|d_major|`), so `d` is not normalised first: its length
-    /// only scales both sides of each ratio.
+    /// only scales both sides of each ratio, as long as the squares in
+    /// [`polar_angle`] stay normal floats (in `f32`, lengths from about
+    /// 10⁻¹⁹ to 10¹⁹).
     #[inline(always)]
     pub fn from_dir<F: Real>(self, d: V3<F>) -> [F; 2] {
         let (zero, one) = (F::zero(), F::one());

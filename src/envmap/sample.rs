@@ -110,7 +110,7 @@ impl EnvMap {
     /// The point that the fractions `r` place in cell `cell` of the
     /// luminance `density` (this map's), with its density per unit table
     /// area, placed in `F` ([`LuminanceFloat::place`]: in `f32` from the
-    /// `f32` tables that `pdf` reads in `f32`); the texels are the cell's
+    /// `f32` tables that [`EnvMap::pdf_into`] reads in `f32`); the texels are the cell's
     /// corners weighted by the point's fractions.
     #[inline(always)]
     pub(super) fn place_luminance<F: LuminanceFloat>(

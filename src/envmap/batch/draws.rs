@@ -30,7 +30,9 @@ impl EnvMap {
     /// and its density are good to a few ulps of `f32` (the density near a
     /// pole of a polar table to about `10⁻⁷/sin θ`); a luminance density's
     /// points are placed in their cells in `f32`, from the `f32` table that
-    /// [`EnvMap::pdf`] reads in `f32` (`LuminanceFloat::place`).
+    /// [`EnvMap::pdf_into`] reads in `f32` (`LuminanceFloat::place`): a
+    /// texel whose `f32` luminance rounds to 0 beside the map's brightest
+    /// has density 0 there, as `pdf_into` gives it in `f32`.
     ///
     /// # Panics
     /// If an array of `out` is shorter than `us`.

@@ -334,7 +334,9 @@ impl PyEnvMap {
     ///
     /// Parameters
     /// ----------
-    /// d : array_like, shape (N, 3) or (3,), directions (normalised here)
+    /// d : array_like, shape (N, 3) or (3,), directions of any length (only
+    ///     the direction counts; float32 lengths below about 1e-19 lose
+    ///     precision in their squares)
     /// out : ndarray, optional, keyword only
     ///     Array to write into (the result's shape and dtype, C-ordered), as
     ///     numpy's ufuncs take; saves allocating a fresh result per call.
@@ -355,7 +357,9 @@ impl PyEnvMap {
     ///
     /// Parameters
     /// ----------
-    /// d : array_like, shape (N, 3) or (3,), directions (normalised here)
+    /// d : array_like, shape (N, 3) or (3,), directions of any length (only
+    ///     the direction counts; float32 lengths below about 1e-19 lose
+    ///     precision in their squares)
     /// out : ndarray, optional, keyword only
     ///     Array to write into, shape (N,), of d's dtype (as for ``eval``).
     ///
