@@ -539,18 +539,21 @@ pub fn sin_cos_turn<F: Real>(t: F) -> (F, F) {
 
 /// `atan2(y, x)` in `(−π, π]` (the library's signs and values at ±0 and
 /// on the axes), branch-free and without library calls, so that loops over
-/// it vectorise: `t = min(|x|, |y|)/max(|x|, |y|)` in `[0, 1]`, reduced to
-/// `|r| ≤ tan(π/8)` by `atan t = π/4 + atan((t − 1)/(t + 1))`, then
-/// [`Real::atan_reduced`] and the octant's reflections. Within 3 ulp of the
-/// library's in `f64` and 4 in `f32`. Inputs are finite.
+/// it vectorise: with `lo = min(|x|, |y|)`, `hi = max(|x|, |y|)`,
+/// `r = lo/hi` in `[0, tan(π/8)]`, or, where `lo > (√2 − 1)·hi`,
+/// `r = (lo − hi)/(lo + hi)` (`atan(lo/hi) = π/4 + atan r`): one division
+/// of the chosen numerator and denominator, which holds subnormal inputs
+/// too. Then [`Real::atan_reduced`] and the octant's reflections. Within 3
+/// ulp of the library's in `f64` and 4 in `f32`. Inputs are finite.
 #[inline(always)]
 pub fn atan2<F: Real>(y: F, x: F) -> F {
     let (ax, ay) = (x.abs(), y.abs());
     let (lo, hi) = (ax.min(ay), ax.max(ay));
-    let t = lo / hi.max(F::min_positive_value());
-    let big = t > F::c(std::f64::consts::SQRT_2 - 1.0);
-    // (t − 1)/(t + 1) from lo and hi directly: one rounding fewer.
-    let r = if big { (lo - hi) / (lo + hi) } else { t };
+    let big = lo > F::c(std::f64::consts::SQRT_2 - 1.0) * hi;
+    // (lo − hi)/(lo + hi) from lo and hi directly: one rounding fewer than
+    // from lo/hi. (0/1 at the origin.)
+    let (num, den) = if big { (lo - hi, lo + hi) } else { (lo, hi) };
+    let r = num / if hi > F::zero() { den } else { F::one() };
     let a = F::atan_reduced(r);
     let a = if big { a + F::FRAC_PI_4() } else { a };
     let a = if ay > ax { F::FRAC_PI_2() - a } else { a };

@@ -13,7 +13,7 @@
 
 use crate::math::{Real, atan2, sin_cos_turn};
 use crate::warp::V3;
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_1_PI, PI};
 
 /// How an image covers the sphere of directions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -138,11 +138,11 @@ impl Mapping {
                 let s = if s < zero { s + one } else { s };
                 // -0.0 and s + 1 rounding up to 1 both mean the start of the turn.
                 let s = if s >= one { zero } else { s.abs() };
-                [s, polar_angle(d[1], d[0], d[2]) / F::PI()]
+                [s, polar_angle(d[1], d[0], d[2]) * F::c(FRAC_1_PI)]
             }
             Mapping::Angular => {
                 let rho = (d[0] * d[0] + d[1] * d[1]).sqrt();
-                let r = polar_angle(d[2], d[0], d[1]) / F::PI();
+                let r = polar_angle(d[2], d[0], d[1]) * F::c(FRAC_1_PI);
                 let (a, b) = if rho > zero {
                     (d[0] * r / rho, d[1] * r / rho)
                 } else {

@@ -109,6 +109,23 @@ fn atan2_matches_the_library() {
     }
     assert_eq!(atan2(1.0, 0.0), std::f64::consts::FRAC_PI_2);
     assert_eq!(atan2(0.0, -1.0), std::f64::consts::PI);
+    // Subnormal inputs, whose ratio is an ordinary number.
+    for (y, x) in [
+        (1e-40f32, 1e-40f32),
+        (-3e-41, 2e-41),
+        (1e-45, -1e-40),
+        (4e-39, 1e-38),
+    ] {
+        let (ours, lib) = (atan2(y, x), y.atan2(x));
+        assert!(
+            (ours - lib).abs() <= 4.0 * f32::EPSILON * lib.abs(),
+            "{y}, {x}: {ours} {lib}"
+        );
+    }
+    for (y, x) in [(1e-310f64, 1e-310f64), (-3e-320, 2e-320), (5e-324, -1e-310)] {
+        let (ours, lib) = (atan2(y, x), y.atan2(x));
+        assert!(ulps(ours, lib) <= 3, "{y}, {x}: {ours} {lib}");
+    }
 }
 
 #[test]
