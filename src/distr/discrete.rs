@@ -231,7 +231,8 @@ impl Discrete1D {
     }
 
     /// The index as [`Discrete1D::sample`], and `u` rescaled within that
-    /// entry's share to `[0, 1)`: `(u·Σw − C_{i−1}) / w_i`, a fresh uniform
+    /// entry's share to `[0, 1)`: `(u·Σw − C_{i−1}) / (C_i − C_{i−1})` (the
+    /// step of the running sums: `w_i` up to their round-off), a fresh uniform
     /// number for a second decision.
     #[inline]
     pub fn sample_reuse<F: Real>(&self, u: F) -> (usize, F) {
@@ -582,6 +583,32 @@ mod tests {
         assert_eq!(d.sample(-0.0f64), 5);
         assert_eq!(d.sample(-0.0f32), d.sample(0.0f32));
         assert_eq!(d.sample_reuse(-0.0f64), d.sample_reuse(0.0f64));
+    }
+
+    #[test]
+    fn weights_too_small_to_move_the_sums_leave_rescaled_numbers_in_the_unit_interval() {
+        // The rescaled u divides by the step of the running sums, which is 0
+        // at an entry too light to move them: the search must never return
+        // one. Short (unguided) and long (guided) tables, single draws and
+        // batches, u on a grid and at every running sum's own u.
+        for n in [5, 300] {
+            let weights: Vec<f64> = (0..n)
+                .map(|i| if i % 2 == 1 { 1e-30 } else { 1.0 + i as f64 })
+                .collect();
+            let d = Discrete1D::new(&weights).unwrap();
+            let mut us: Vec<f64> = (0..=4000).map(|k| k as f64 / 4000.0).collect();
+            us.extend((0..n).map(|i| d.cdf(i)));
+            let mut batch = vec![(0, 0.0); us.len()];
+            d.sample_reuse_into(&us, &mut batch);
+            for (&u, &got) in us.iter().zip(&batch) {
+                let (i, r) = d.sample_reuse(u);
+                assert_eq!((i, r), got, "n = {n}, u = {u}");
+                assert!(weights[i] >= 1.0, "n = {n}, u = {u}: entry {i}");
+                assert!((0.0..1.0).contains(&r), "n = {n}, u = {u}: {r}");
+                let r32 = d.sample_reuse(u as f32).1;
+                assert!((0.0..1.0).contains(&r32), "n = {n}, u = {u}: {r32}");
+            }
+        }
     }
 
     #[test]

@@ -374,10 +374,18 @@ impl<'a> Search<'a> {
     }
 
     /// The leftover of `u` past the running sum before index `i`, rescaled
-    /// to `[0, 1)` by its weight.
+    /// to `[0, 1)` by the step of the running sums there:
+    /// `(u·Σw − C_{i−1}) / (C_i − C_{i−1})`. The step is `w_i` up to the
+    /// sums' round-off, and read from the running sums the search has just
+    /// read, not from the table of weights (one table fewer in the caches
+    /// of a batch); it is positive for every index the search returns (a
+    /// weight too small to move the sum is never returned: the entry
+    /// before it reaches `u·Σw` first), and a leftover within the step
+    /// stays below 1.
     #[inline(always)]
     pub(crate) fn rescale<F: Real>(&self, u: F, i: usize) -> F {
-        let rescaled = (u.f64() * self.sum - self.sum_before(i)) / self.weights[self.start + i];
+        let before = self.sum_before(i);
+        let rescaled = (u.f64() * self.sum - before) / (self.running(i) - before);
         // Clamped in `F`: `1 − 2⁻⁵³` would round to `1.0` in `f32`.
         F::c(rescaled.max(0.0)).min(F::ONE_MINUS_EPSILON)
     }
@@ -516,8 +524,8 @@ impl Lanes {
     }
 
     /// `rescaled[k] = table.rescale(u_k, index[k])` for each draw (as
-    /// [`Lanes::set`] gave it, `index` its answer), the running sum before
-    /// each index and its weight read by gathers and the divisions at SIMD
+    /// [`Lanes::set`] gave it, `index` its answer), the running sums before
+    /// and at each index read by gathers and the divisions at SIMD
     /// width; draws without a table ([`Lanes::empty`]) keep their
     /// `rescaled[k]`. `store` as for [`Lanes::search`].
     #[inline(always)]
@@ -534,12 +542,12 @@ impl Lanes {
             read[k] = at[k].saturating_sub(1);
         }
         let simd::OnLines(got) = &mut simd::OnLines([0.0; GROUP]);
-        let simd::OnLines(weight) = &mut simd::OnLines([0.0; GROUP]);
+        let simd::OnLines(running) = &mut simd::OnLines([0.0; GROUP]);
         simd::gather(store.cdf, read, got);
-        simd::gather(store.weights, at, weight);
+        simd::gather(store.cdf, at, running);
         for k in 0..GROUP {
             let before = if index[k] == 0 { 0.0 } else { got[k] };
-            let r = F::c(((self.value[k] - before) / weight[k]).max(0.0));
+            let r = F::c(((self.value[k] - before) / (running[k] - before)).max(0.0));
             if self.end[k] > 0 {
                 rescaled[k] = r.min(F::ONE_MINUS_EPSILON);
             }

@@ -190,7 +190,8 @@ pub struct PyDiscrete1D(distr::Discrete1D);
 
 index_table_methods!(PyDiscrete1D, distr::Discrete1D, "Discrete1D", {
     /// Indices as ``sample``, and u rescaled within the chosen entry's share
-    /// to [0, 1): (u * sum - C[i-1]) / w[i], a fresh uniform number.
+    /// to [0, 1): (u * sum - C[i-1]) / (C[i] - C[i-1]) (the step of the
+    /// running sums: w[i] up to their round-off), a fresh uniform number.
     ///
     /// Parameters
     /// ----------
