@@ -146,11 +146,11 @@ impl GuideCell {
 /// Writes into `guide` (the cells from `start` on) the index of each of the
 /// running sums `cdf` (those of entries `first..`) into its cell, the last
 /// entries first, so that each cell keeps the smallest index that hits it;
-/// the cells are found [`SCATTER`] entries at a time, at SIMD width.
-/// Entries whose cell lies before `start` write nothing. As the sums never
-/// decrease, the guide can be filled block by block, the blocks taken last
-/// first: a block of entries whose first entry's cell is past the block
-/// before's last keeps to its own cells.
+/// the cells are found [`SCATTER`] entries at a time, at SIMD width, and
+/// written by [`store_guide`]. Entries whose cell lies before `start` write
+/// nothing. As the sums never decrease, the guide can be filled block by
+/// block, the blocks taken last first: a block of entries whose first
+/// entry's cell is past the block before's last keeps to its own cells.
 #[inline(always)]
 pub(crate) fn scatter_guide(
     cdf: &[f64],
@@ -164,11 +164,20 @@ pub(crate) fn scatter_guide(
         for (to, &c) in cells.iter_mut().zip(chunk) {
             *to = cell.of(c);
         }
-        let first = first + k * SCATTER;
-        for (i, &to) in cells[..chunk.len()].iter().enumerate().rev() {
-            if let Some(g) = guide.get_mut((to as usize).wrapping_sub(start)) {
-                *g = (first + i) as u32;
-            }
+        store_guide(&cells[..chunk.len()], first + k * SCATTER, guide, start);
+    }
+}
+
+/// `guide[cells[i] − start] = first + i` for each `i`, the last first
+/// (cells outside the guide skipped). Never inlined, so that it is compiled
+/// outside the vector dispatch, one store per entry: inlined at AVX-512,
+/// LLVM made the loop a scatter instruction, 15 % of a `Discrete1D` build
+/// of 10^6 weights on a Zen 4, where scatters are slow.
+#[inline(never)]
+fn store_guide(cells: &[u32], first: usize, guide: &mut [u32], start: usize) {
+    for (i, &to) in cells.iter().enumerate().rev() {
+        if let Some(g) = guide.get_mut((to as usize).wrapping_sub(start)) {
+            *g = (first + i) as u32;
         }
     }
 }
