@@ -1,9 +1,6 @@
 //! [`Discrete1D`]: a discrete distribution sampled by inverting its CDF.
 
-use super::search::{
-    CHAINS, GuideCell, Lanes, Search, close_guide, guide_len, positive_range, scatter_guide,
-    search_group, sum_blocks_into,
-};
+use super::search::{Lanes, Search, close_guide, guide_len, positive_range, search_group};
 use super::{GROUP, Weights, check_len, find_invalid};
 use crate::buffer::Buffer;
 use crate::error::{Error, Result};
@@ -11,18 +8,9 @@ use crate::math::Real;
 use crate::parallel;
 use crate::simd;
 use rayon::prelude::*;
+use sums::{SUM_BLOCK, SUM_GROUP, block_totals, sum_blocks_and_fill_guide};
 
-/// Entries per block of the running sums of a long table: each block is
-/// summed from 0 and then offset by the blocks before it, in parallel. Fixed,
-/// so that the sums do not depend on the thread count (a table of at most
-/// one block is summed strictly in order, as Mitsuba does). Not a power of
-/// two: the blocks of a group are read and written side by side, and
-/// streams a power of two apart fall into the same cache sets.
-const SUM_BLOCK: usize = 8000;
-
-/// Entries per task of the running sums: [`CHAINS`] blocks, summed side by
-/// side ([`sum_blocks_into`]).
-const SUM_GROUP: usize = CHAINS * SUM_BLOCK;
+mod sums;
 
 /// A discrete distribution over the indices `0..n`, with probabilities
 /// proportional to non-negative weights `w`.
@@ -53,47 +41,6 @@ pub struct Discrete1D {
     /// `guide[k]`: the first index whose running sum reaches `k/G · Σw`,
     /// clamped to `[first, last]`, for `k = 0..=G` (empty for short tables).
     guide: Buffer<u32>,
-}
-
-/// Adds to each block of the running sums `cdf` its entry of `offsets`
-/// (the total of the blocks before it), and fills the guide of the sums
-/// (total `sum`) but for [`close_guide`]: each entry's index written into
-/// its cell ([`scatter_guide`]), the cells no entry hits `u32::MAX`. In
-/// parallel by groups of blocks: the sums never decrease, so the entries
-/// of a group hit the cells after its offset's (the group before's last
-/// sum) up to its own last sum's, which no other group writes.
-fn offset_blocks_and_fill_guide(cdf: &mut [f64], offsets: &[f64], sum: f64, guide: &mut [u32]) {
-    let cell = GuideCell::new(guide.len(), sum);
-    let (mut rest, mut start) = (guide, 0);
-    let mut groups = Vec::with_capacity(offsets.len().div_ceil(CHAINS));
-    for (g, group) in offsets.chunks(CHAINS).enumerate() {
-        let end = offsets.get((g + 1) * CHAINS).copied().unwrap_or(sum);
-        let next = cell.map_or(0, |cell| cell.of(end) as usize + 1);
-        let (own, later) = std::mem::take(&mut rest).split_at_mut(next - start);
-        groups.push((group, start, own));
-        (rest, start) = (later, next);
-    }
-    rest.fill(u32::MAX);
-    (cdf.par_chunks_mut(SUM_GROUP), groups)
-        .into_par_iter()
-        .enumerate()
-        .for_each(|(g, (cdf, (offsets, start, own)))| {
-            own.fill(u32::MAX);
-            // The blocks last first, as the guide is filled.
-            let blocks = (cdf.chunks_mut(SUM_BLOCK).zip(offsets).enumerate()).rev();
-            simd::dispatch(
-                #[inline(always)]
-                |_| {
-                    for (b, (cdf, &offset)) in blocks {
-                        cdf.iter_mut().for_each(|c| *c += offset);
-                        if let Some(cell) = cell {
-                            let first = g * SUM_GROUP + b * SUM_BLOCK;
-                            scatter_guide(cdf, first, cell, own, start);
-                        }
-                    }
-                },
-            )
-        });
 }
 
 impl Discrete1D {
@@ -129,19 +76,11 @@ impl Discrete1D {
     /// meaningless). Tables longer than [`SUM_GROUP`] are summed in
     /// parallel (on the current rayon pool).
     fn build(weights: &[f64]) -> Result<(Option<Self>, bool)> {
-        // The copy of the weights and each block's running sums from 0, in
-        // parallel (a group of blocks per task); then to each block the sum
-        // of the blocks before it, with the guide.
-        let mut copy = Buffer::for_overwrite(weights.len(), "the table's weights")?;
-        let mut cdf = Buffer::for_overwrite(weights.len(), "the table's running sums")?;
-        let (totals, valid): (Vec<_>, Vec<bool>) = (
-            cdf.par_chunks_mut(SUM_GROUP),
-            copy.par_chunks_mut(SUM_GROUP),
-            weights.par_chunks(SUM_GROUP),
-        )
-            .into_par_iter()
-            .map(|(cdf, copy, weights)| sum_blocks_into(weights, cdf, copy, SUM_BLOCK))
-            .unzip();
+        // Each block's total (in parallel, a group of blocks per task); the
+        // offsets of the blocks; then, in one pass, the copy of the weights,
+        // the running sums and the guide.
+        let (totals, valid): (Vec<_>, Vec<bool>) =
+            weights.par_chunks(SUM_GROUP).map(block_totals).unzip();
         let valid = valid.into_iter().all(|v| v);
         let blocks = weights.len().div_ceil(SUM_BLOCK);
         let mut offsets = Vec::with_capacity(blocks);
@@ -156,8 +95,10 @@ impl Discrete1D {
         if !(valid && acc > 0.0 && acc.is_finite()) {
             return Ok((None, valid));
         }
+        let mut copy = Buffer::for_overwrite(weights.len(), "the table's weights")?;
+        let mut cdf = Buffer::for_overwrite(weights.len(), "the table's running sums")?;
         let mut guide = Buffer::for_overwrite(guide_len(weights.len()), "the table's guide")?;
-        offset_blocks_and_fill_guide(&mut cdf, &offsets, acc, &mut guide);
+        sum_blocks_and_fill_guide(weights, (&mut copy, &mut cdf), &offsets, acc, &mut guide);
         close_guide(&mut guide, (first, last));
         let table = Discrete1D {
             weights: Weights::new(copy, acc),

@@ -27,51 +27,6 @@ pub(crate) fn sum_into(weights: &[f64], cdf: &mut [f64], copy: &mut [f64]) -> (f
     (acc, valid)
 }
 
-/// Blocks whose running sums [`sum_blocks_into`] computes side by side.
-pub(crate) const CHAINS: usize = 8;
-
-/// The running sums from 0 of each block of `block` entries of `weights`
-/// into `cdf`, and the weights into `copy` (all three of one length, at
-/// most [`CHAINS`] blocks): each block's total, and whether every weight is
-/// finite and `>= 0`. Each block is summed in order, as [`sum_into`] sums
-/// it, but a group of [`CHAINS`] whole blocks side by side: one block's sums
-/// are a chain of additions, each waiting on the one before, and the
-/// chains of several overlap.
-pub(crate) fn sum_blocks_into(
-    weights: &[f64],
-    cdf: &mut [f64],
-    copy: &mut [f64],
-    block: usize,
-) -> ([f64; CHAINS], bool) {
-    let mut totals = [0.0; CHAINS];
-    let whole = weights.len() == CHAINS * block;
-    if !(whole && cdf.len() == weights.len() && copy.len() == weights.len()) {
-        let mut valid = true;
-        let blocks = (cdf.chunks_mut(block)).zip(weights.chunks(block).zip(copy.chunks_mut(block)));
-        for (t, (cdf, (weights, copy))) in totals.iter_mut().zip(blocks) {
-            let (total, ok) = sum_into(weights, cdf, copy);
-            (*t, valid) = (total, valid & ok);
-        }
-        return (totals, valid);
-    }
-    simd::stream_copy(copy, weights);
-    simd::store_fence();
-    // The loop of `sum_into`, over the blocks at once.
-    let w: [&[f64]; CHAINS] = std::array::from_fn(|j| &weights[j * block..][..block]);
-    let mut parts = cdf.chunks_exact_mut(block);
-    let c: [&mut [f64]; CHAINS] = std::array::from_fn(|_| parts.next().unwrap_or_default());
-    let mut valid = [true; CHAINS];
-    for i in 0..block {
-        for j in 0..CHAINS {
-            let x = w[j][i];
-            totals[j] += x;
-            c[j][i] = totals[j];
-            valid[j] &= is_weight(x);
-        }
-    }
-    (totals, valid.iter().all(|&v| v))
-}
-
 /// The first and last entries of positive weight (`None` if there is none).
 pub(crate) fn positive_range(weights: &[f64]) -> Option<(usize, usize)> {
     let positive = |w: &f64| *w > 0.0;
@@ -183,7 +138,7 @@ fn store_guide(cells: &[u32], first: usize, guide: &mut [u32], start: usize) {
 }
 
 /// Entries whose guide cells [`scatter_guide`] finds together.
-const SCATTER: usize = 64;
+pub(crate) const SCATTER: usize = 64;
 
 /// The guide after [`scatter_guide`]: each cell that no entry hit takes
 /// the answer of the next cell up (the last cells `last`), and every answer
