@@ -359,13 +359,15 @@ pub fn add_escaped(scene: &Scene, settings: &Settings, escaped: &mut Escaped, l:
 /// The first hit of the camera ray `ray` (whose first hit is `hit`) that
 /// is not on an area light: the ray passes through them (re-spawned past
 /// each, as Mitsuba's `hide_emitters` does), and `ray` is updated to the
-/// last spawn.
+/// last spawn. Only a light's surface point is computed (for the spawn):
+/// whether a hit is on one is known from its primitive
+/// ([`Scene::hits_emitter`]).
 pub fn skip_emitters(scene: &Scene, ray: &mut Ray, mut hit: Option<Hit>, time: f32) -> Option<Hit> {
     while let Some(h) = hit {
-        let (shape, sp) = scene.surface(ray, &h, time);
-        if !scene.is_emitter(shape) {
+        if !scene.hits_emitter(&h) {
             break;
         }
+        let (_, sp) = scene.surface(ray, &h, time);
         ray.o = offset(sp.p, sp.ng, ray.d);
         hit = scene.intersect(ray, time);
     }
