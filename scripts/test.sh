@@ -28,12 +28,25 @@ if ! { dpkg -s libllvm19 && dpkg -s libembree3-3; } >/dev/null 2>&1 \
   $SUDO apt-get install -y -qq libllvm19 $EMBREE >/dev/null
 fi
 
-stage "pip, maturin"
-python -m pip install --quiet --upgrade pip "maturin>=1.7,<2"
-
-# What the suite needs from the package index (the package's dependencies
-# and its test, mitsuba, plot and distributed extras, read from
-# pyproject.toml) downloads while the wheel compiles.
+# Rust format, lint, unit tests and docs run in the background from here
+# on, beside the wheel's build, the install, the stub check and pytest:
+# the compilers' one-threaded phases, the downloads and pytest's
+# one-threaded Python fill each other's idle core. They build in a target
+# directory of their own, so that neither build waits on the other's lock.
+# Their log is printed after pytest. (After the libraries above: the Rust
+# tests check that Embree loads under CI.)
+rust_checks() {
+  export CARGO_TARGET_DIR="$ROOT/target/checks"
+  rustup component add rustfmt clippy >/dev/null 2>&1 || true
+  stage "cargo fmt, cargo clippy"
+  cargo fmt --check
+  cargo clippy --all-targets --all-features --quiet -- -D warnings
+  stage "cargo test"
+  cargo test --lib --quiet
+  stage "cargo doc"
+  RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
+  stage "Rust checks done"
+}
 LOGS=$(mktemp -d)
 # On an early exit, the background jobs (and their children) are stopped.
 stop_jobs() {
@@ -44,6 +57,16 @@ stop_jobs() {
   done
 }
 trap 'stop_jobs; rm -rf "$LOGS"' EXIT
+stage "Rust checks (in the background)"
+rust_checks >"$LOGS/rust.log" 2>&1 &
+RUST=$!
+
+stage "pip, maturin"
+python -m pip install --quiet --upgrade pip "maturin>=1.7,<2"
+
+# What the suite needs from the package index (the package's dependencies
+# and its test, mitsuba, plot and distributed extras, read from
+# pyproject.toml) downloads while the wheel compiles.
 python - >"$LOGS/requirements.txt" <<'PY'
 try:
     import tomllib
@@ -93,25 +116,6 @@ stage "smoke tests (in the background)"
 smoke_tests >"$LOGS/smoke.log" 2>&1 &
 SMOKE=$!
 
-# Rust format, lint, unit tests and docs run in the background, beside the
-# install, the stub check and pytest: the compiler's one-threaded phases and
-# pytest's one-threaded Python fill each other's idle core. Their log is
-# printed after pytest.
-rust_checks() {
-  rustup component add rustfmt clippy >/dev/null 2>&1 || true
-  stage "cargo fmt, cargo clippy"
-  cargo fmt --check
-  cargo clippy --all-targets --all-features --quiet -- -D warnings
-  stage "cargo test"
-  cargo test --lib --quiet
-  stage "cargo doc"
-  RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
-  stage "Rust checks done"
-}
-stage "Rust checks (in the background)"
-rust_checks >"$LOGS/rust.log" 2>&1 &
-RUST=$!
-
 # The same wheel, with what the suite needs, into this Python, in place of
 # any earlier install (pip keeps one of the same version otherwise; the
 # distribution was called "mcsample" before: that name on the package
@@ -132,9 +136,12 @@ stage "pytest"
 # executes every notebook top to bottom and fails on any error. Two worker
 # processes (pytest-xdist): half the suite's time is one-threaded Python
 # (statistics, notebooks, setup), which the other worker's renders overlap.
-# (--dist loadgroup: the tests of a Dask cluster share one worker.)
+# (--dist loadgroup: the tests of a Dask cluster share one worker.) The
+# notebooks, the longest items (up to 1.5 minutes each), are collected
+# first, so that the workers hand out the short tests last and finish
+# together.
 (cd tests && python -m pytest -q -p no:cacheprovider -n 2 --dist loadgroup --durations=20 \
-  --nbmake . ../notebooks "$@") || failed="$failed pytest"
+  --nbmake ../notebooks . "$@") || failed="$failed pytest"
 
 stage "Rust checks' results"
 wait "$RUST" || failed="$failed rust-checks"
