@@ -3,10 +3,10 @@
 # (libLLVM for Mitsuba's llvm variant, Python packages), builds this
 # package's abi3 wheel and smoke-tests it in fresh virtual environments
 # without Rust, installs it, and runs the whole suite: pytest (two worker
-# processes), and beside it Rust format / lint / unit tests / docs and the
-# stub check. Prints when each stage starts; exits non-zero if any part
-# failed. Arguments go to pytest (`-n 0` runs it in one process, as
-# `--pdb` needs).
+# processes), and beside it, at low priority, Rust format / lint / unit
+# tests / docs and the stub check. Prints when each stage starts; exits
+# non-zero if any part failed. Arguments go to pytest (`-n 0` runs it in
+# one process, as `--pdb` needs).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -29,9 +29,10 @@ if ! { dpkg -s libllvm19 && dpkg -s libembree3-3; } >/dev/null 2>&1 \
 fi
 
 # Rust format, lint, unit tests and docs run in the background from here
-# on, beside the wheel's build, the install, the stub check and pytest:
-# the compilers' one-threaded phases, the downloads and pytest's
-# one-threaded Python fill each other's idle core. They build in a target
+# on, at the lowest CPU priority (`background`): beside the wheel's build,
+# the install and pytest, which wait on each other, they take only the
+# cycles those leave idle (the compiler's one-threaded phases, the
+# downloads, pytest's one-threaded Python). They build in a target
 # directory of their own, so that neither build waits on the other's lock.
 # Their log is printed after pytest. (After the libraries above: the Rust
 # tests check that Embree loads under CI.)
@@ -57,8 +58,10 @@ stop_jobs() {
   done
 }
 trap 'stop_jobs; rm -rf "$LOGS"' EXIT
+# Runs its arguments at the lowest CPU priority (nice 19).
+background() { renice -n 19 -p "$BASHPID" >/dev/null; "$@"; }
 stage "Rust checks (in the background)"
-rust_checks >"$LOGS/rust.log" 2>&1 &
+background rust_checks >"$LOGS/rust.log" 2>&1 &
 RUST=$!
 
 stage "pip, maturin"
@@ -113,7 +116,7 @@ smoke_tests() {
   done
 }
 stage "smoke tests (in the background)"
-smoke_tests >"$LOGS/smoke.log" 2>&1 &
+background smoke_tests >"$LOGS/smoke.log" 2>&1 &
 SMOKE=$!
 
 # The same wheel, with what the suite needs, into this Python, in place of
@@ -125,11 +128,13 @@ stage "test dependencies"
 python -m pip uninstall --quiet -y mcsample mcsample-toolkit 2>/dev/null || true
 python -m pip install --quiet "$WHEEL[test,mitsuba,plot,distributed]"
 
-failed=""
-stage "stub check"
-python -m mypy.stubtest mcsample._core --allowlist scripts/stubtest-allowlist.txt \
-  || failed="$failed stubtest"
+# The stub check, in the background as the Rust checks are.
+stage "stub check (in the background)"
+background python -m mypy.stubtest mcsample._core --allowlist scripts/stubtest-allowlist.txt \
+  >"$LOGS/stubtest.log" 2>&1 &
+STUBTEST=$!
 
+failed=""
 stage "pytest"
 # Run pytest from outside the source tree so it imports the installed
 # package, not python/mcsample without its compiled core. --nbmake also
@@ -143,6 +148,9 @@ stage "pytest"
 (cd tests && python -m pytest -q -p no:cacheprovider -n 2 --dist loadgroup --durations=20 \
   --nbmake ../notebooks . "$@") || failed="$failed pytest"
 
+stage "stub check's results"
+wait "$STUBTEST" || failed="$failed stubtest"
+cat "$LOGS/stubtest.log"
 stage "Rust checks' results"
 wait "$RUST" || failed="$failed rust-checks"
 cat "$LOGS/rust.log"
