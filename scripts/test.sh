@@ -33,19 +33,26 @@ fi
 # the install and pytest, which wait on each other, they take only the
 # cycles those leave idle (the compiler's one-threaded phases, the
 # downloads, pytest's one-threaded Python). They build in a target
-# directory of their own, so that neither build waits on the other's lock.
-# Their log is printed after pytest. (After the libraries above: the Rust
-# tests check that Embree loads under CI.)
+# directory of their own (clippy and the docs), so that neither build
+# waits on the other's lock, or in the wheel's (the unit tests: built with
+# the release profile, they reuse most of the dependencies the wheel's
+# build compiled, and mcsample's own code keeps its debug assertions and
+# overflow checks, as `cargo test` has them). Their log is printed after
+# pytest. (After the libraries above: the Rust tests check that Embree
+# loads under CI.)
 rust_checks() {
-  export CARGO_TARGET_DIR="$ROOT/target/checks"
   rustup component add rustfmt clippy >/dev/null 2>&1 || true
   stage "cargo fmt, cargo clippy"
   cargo fmt --check
-  cargo clippy --all-targets --all-features --quiet -- -D warnings
-  stage "cargo test"
-  cargo test --lib --quiet
+  CARGO_TARGET_DIR="$ROOT/target/checks" cargo clippy --all-targets --all-features --quiet \
+    -- -D warnings
+  stage "cargo test (after the wheel's build)"
+  until [ -e "$LOGS/wheel-built" ]; do sleep 2; done
+  cargo test --release --lib --quiet \
+    --config 'profile.release.package.mcsample.debug-assertions=true' \
+    --config 'profile.release.package.mcsample.overflow-checks=true'
   stage "cargo doc"
-  RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
+  CARGO_TARGET_DIR="$ROOT/target/checks" RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet
   stage "Rust checks done"
 }
 LOGS=$(mktemp -d)
@@ -92,6 +99,7 @@ stage "wheel"
 rm -rf target/wheels
 maturin build --release --quiet
 WHEEL=$(ls "$PWD"/target/wheels/mcsample_toolkit-*-cp39-abi3-*.whl)
+touch "$LOGS/wheel-built"
 ls -l "$WHEEL"
 
 # Installed into fresh virtual environments with no Rust toolchain on PATH
