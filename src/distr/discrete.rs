@@ -138,8 +138,9 @@ impl Discrete1D {
                 self.searched_in_groups(
                     us,
                     out,
+                    false,
                     #[inline(always)]
-                    |_, _, index, out| {
+                    |_, index, out| {
                         for (o, &i) in out.iter_mut().zip(index) {
                             *o = I::from(i as u32);
                         }
@@ -150,13 +151,15 @@ impl Discrete1D {
     }
 
     /// The groups of [`Discrete1D::sample_into`], each group's indices
-    /// handed to `finish(table, lanes, index, out)` to write its outputs.
+    /// handed to `finish(lanes, index, out)` to write its outputs (with
+    /// `rescale`, `lanes` ready for [`Lanes::rescale`]).
     #[inline(always)]
     fn searched_in_groups<F: Real, O>(
         &self,
         us: &[F],
         out: &mut [O],
-        finish: impl Fn(&Search<'_>, &Lanes, &[u64; GROUP], &mut [O]),
+        rescale: bool,
+        finish: impl Fn(&Lanes, &[u64; GROUP], &mut [O]),
     ) {
         let search = self.search();
         let mut lanes = Lanes::new();
@@ -166,8 +169,8 @@ impl Discrete1D {
                 #[inline(always)]
                 |k: usize| Some((search, us[k].f64()))
             };
-            search_group(us.len(), &search, draw, &mut lanes, &mut index);
-            finish(&search, &lanes, &index, out);
+            search_group(us.len(), &search, draw, (&mut lanes, rescale), &mut index);
+            finish(&lanes, &index, out);
         }
     }
 
@@ -197,10 +200,11 @@ impl Discrete1D {
         self.searched_in_groups(
             us,
             out,
+            true,
             #[inline(always)]
-            |search, lanes, index, out| {
+            |lanes, index, out| {
                 let mut rescaled = [F::zero(); GROUP];
-                lanes.rescale(search, index, &mut rescaled);
+                lanes.rescale(&mut rescaled);
                 for (o, (&i, &r)) in out.iter_mut().zip(index.iter().zip(&rescaled)) {
                     *o = (i as usize, r);
                 }

@@ -279,21 +279,21 @@ impl Discrete2D {
                 #[inline(always)]
                 |k: usize| Some((marginal, us[k][1].f64()))
             };
-            search_group(n, &marginal, row_draw, &mut lanes, &mut rows);
+            search_group(n, &marginal, row_draw, (&mut lanes, rescale), &mut rows);
             for ((r, c), u) in u_row.iter_mut().zip(u_col.iter_mut()).zip(us) {
                 (*c, *r) = (u[0], u[1]);
             }
             if rescale {
-                lanes.rescale(&marginal, &rows, &mut u_row);
+                lanes.rescale(&mut u_row);
             }
             // Each row's search is found by arithmetic on its index.
             let col_draw = {
                 #[inline(always)]
                 |k: usize| Some((tables.search(rows[k] as usize)?, us[k][0].f64()))
             };
-            search_group(n, &store, col_draw, &mut lanes, &mut cols);
+            search_group(n, &store, col_draw, (&mut lanes, rescale), &mut cols);
             if rescale {
-                lanes.rescale(&store, &cols, &mut u_col);
+                lanes.rescale(&mut u_col);
             }
             for (k, o) in out.iter_mut().enumerate() {
                 *o = ((rows[k] as usize, cols[k] as usize), [u_col[k], u_row[k]]);
@@ -362,6 +362,38 @@ mod tests {
         d.sample_into(&us, &mut cells);
         for (&u, &c) in us.iter().zip(&cells) {
             assert_eq!(c, (0, linear(&w[..cols], u[0])), "u = {u:?}");
+        }
+    }
+
+    #[test]
+    fn a_rows_first_entry_is_rescaled_from_zero_not_the_row_before() {
+        // Each row's first entry holds most of its weight, and each row
+        // outweighs the one before: the running sum before a row's first
+        // entry is 0, not the last sum of the row before (read past the
+        // row's start, it lies below the value and would settle the draw
+        // with a wrong rescaled u).
+        let cols = 80;
+        let w: Vec<f64> = (0..4 * cols)
+            .map(|i| match i % cols {
+                0 => 50.0 * 10f64.powi((i / cols) as i32),
+                _ => 1.0,
+            })
+            .collect();
+        let d = Discrete2D::new(&w, 4, cols).unwrap();
+        let us: Vec<[f64; 2]> = (0..=2000)
+            .map(|k| {
+                [
+                    k as f64 / 2000.0,
+                    (k as f64 * 0.618_033_988_749_895).fract(),
+                ]
+            })
+            .collect();
+        let mut out = vec![((0, 0), [0.0; 2]); us.len()];
+        d.sample_reuse_into(&us, &mut out);
+        for (&u, &(cell, r)) in us.iter().zip(&out) {
+            let (single_cell, single) = d.sample_reuse(u);
+            assert_eq!(cell, single_cell, "u = {u:?}");
+            assert_eq!(r.map(f64::to_bits), single.map(f64::to_bits), "u = {u:?}");
         }
     }
 

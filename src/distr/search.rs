@@ -36,12 +36,25 @@ pub(crate) fn positive_range(weights: &[f64]) -> Option<(usize, usize)> {
     ))
 }
 
-/// The length of the guide table of a table of `n` entries: one cell per 4
-/// entries (a short search, a small table), plus the end; 0 (no guide) for
-/// tables shorter than [`GUIDE_MIN_LEN`].
+/// The length of the guide table of a table of `n` entries: one cell per 2
+/// entries up to [`DENSE_GUIDE_MAX`] entries, one per 4 above, plus the
+/// end; 0 (no guide) for tables shorter than [`GUIDE_MIN_LEN`]. With a
+/// cell per 2 entries, [`Lanes::search`]'s window settles all but a few
+/// in a hundred draws even of an environment map's peaked rows, for a
+/// `u32` per two `f64` sums; a long table's guide is kept half as large,
+/// as its reads miss the caches.
 pub(crate) fn guide_len(n: usize) -> usize {
-    if n < GUIDE_MIN_LEN { 0 } else { n / 4 + 1 }
+    match n {
+        _ if n < GUIDE_MIN_LEN => 0,
+        _ if n <= DENSE_GUIDE_MAX => n / 2 + 1,
+        _ => n / 4 + 1,
+    }
 }
+
+/// The longest table with a guide cell per 2 entries (see [`guide_len`]):
+/// 64K running sums, half a MiB. (At 10^6 entries, one cell per 2 made
+/// `Discrete1D.sample` 13 % slower than one per 4.)
+const DENSE_GUIDE_MAX: usize = 1 << 16;
 
 /// Fills the guide table of the running sums `cdf` (total `sum`, entries of
 /// positive weight from `first` to `last`): `guide[k]` is the first `i`
@@ -66,7 +79,7 @@ pub(crate) fn fill_guide(cdf: &[f64], sum: f64, range: (usize, usize), guide: &m
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct GuideCell {
     scale: f64,
-    /// `G` (below 2³¹: a table has fewer than 2³² entries, and a quarter as
+    /// `G` (below 2³¹: a table has fewer than 2³² entries, and half as
     /// many cells).
     cells: f64,
 }
@@ -114,7 +127,10 @@ pub(crate) fn scatter_guide(
     guide: &mut [u32],
     start: usize,
 ) {
-    let mut cells = [0; SCATTER];
+    // On a line boundary: a 64-byte store of the cells split across two
+    // lines stalled the build of 10^6 weights (1.3× its time) in a build
+    // whose stack happened to fall so.
+    let simd::OnLines(cells) = &mut simd::OnLines([0; SCATTER]);
     for (k, chunk) in cdf.chunks(SCATTER).enumerate().rev() {
         for (to, &c) in cells.iter_mut().zip(chunk) {
             *to = cell.of(c);
@@ -282,7 +298,7 @@ impl<'a> Search<'a> {
 
     /// The running sum `C_i` of entry `i` of the table (`i < len`).
     #[inline(always)]
-    fn running(&self, i: usize) -> f64 {
+    pub(crate) fn running(&self, i: usize) -> f64 {
         self.cdf[self.start + i]
     }
 
@@ -396,9 +412,14 @@ pub(crate) struct Lanes {
     first: [u64; GROUP],
     /// One past its last entry.
     end: [u64; GROUP],
+    /// After a search: the running sum before each draw's index `i`,
+    /// `C_{i−1}` (0 for `i = 0`), and the one at it, `C_i`, for
+    /// [`Lanes::rescale`].
+    before: [f64; GROUP],
+    at: [f64; GROUP],
 }
 
-const _: () = assert!(GROUP == simd::BLOCK && SCAN == 8);
+const _: () = assert!(GROUP == simd::BLOCK);
 
 /// Whether running sum `c` lies below `value` (1 or 0), by their bits: for
 /// `c` finite and `>= 0` as `c < value` for `value >= 0` (`-0.0` as
@@ -418,6 +439,8 @@ impl Lanes {
             start: [0; GROUP],
             first: [0; GROUP],
             end: [0; GROUP],
+            before: [0.0; GROUP],
+            at: [0.0; GROUP],
         }
     }
 
@@ -439,85 +462,99 @@ impl Lanes {
     }
 
     /// The index each draw's [`Search::index`] finds by its guide cell's
-    /// window, into `index` (the table's own, from 0): the cell's first
-    /// entry `lo`, the running sum before it, then the count of the
-    /// [`SCAN`] sums from `lo` below `u·Σw` by a binary search of 4
-    /// steps, a gather each (the window is sorted; its reads past the
-    /// table's end read its last sum, `Σw`, as the sums past its last
-    /// entry of positive weight are). Returns the draws (bit `k` for draw
-    /// `k`) for which the window does not settle the answer (the cell
-    /// missed by round-off, the answer past the window, no table, a
-    /// negative `u`): for those, `index` holds no answer, and
-    /// [`Search::index`] finds it.
+    /// window, into `index` (the table's own, from 0), and the running sums
+    /// [`Lanes::rescale`] takes: the cell's first entry `lo` (a gather),
+    /// then a branch-free binary search of [`STEPS`] steps, a gather each,
+    /// of the window `w_j = C_{lo−1+j}`, `j < 2^STEPS − 1`, for the count
+    /// `c` of its sums below `u·Σw`. `w_0` checks the guide cell (round-off
+    /// can start it one entry late); at the table's first entry of
+    /// positive weight it counts as below and reads 0, the sum before that
+    /// entry. For `1 ≤ c ≤ 2^STEPS − 2` the answer is `lo − 1 + c`, and the
+    /// search has read both sums around it: the last sum it found below
+    /// is `w_{c−1}`, the last not below `w_c`. The window is sorted; its
+    /// reads past the table's end read its last sum, `Σw`, as the sums past
+    /// its last entry of positive weight are. Returns the draws (bit `k`
+    /// for draw `k`) for which the window does not settle the answer (the
+    /// cell missed by round-off, the answer past the window, no table, a
+    /// negative or NaN `u·Σw`): for those, `index` and the sums hold no
+    /// answer, and [`search_group`] finds them by [`Search::index`].
     /// `store` is any table of the store (its slices are the store's).
     #[inline(always)]
-    pub(crate) fn search(&self, store: &Search<'_>, index: &mut [u64; GROUP]) -> u64 {
+    pub(crate) fn search(
+        &mut self,
+        store: &Search<'_>,
+        rescale: bool,
+        index: &mut [u64; GROUP],
+    ) -> u64 {
         let simd::OnLines(lo) = &mut simd::OnLines([0u32; GROUP]);
         simd::gather(store.guide, &self.cell, lo);
         let simd::OnLines(at) = &mut simd::OnLines([0u64; GROUP]);
-        let simd::OnLines(read) = &mut simd::OnLines([0u64; GROUP]);
         for k in 0..GROUP {
             at[k] = self.start[k] + u64::from(lo[k]);
-            read[k] = at[k].saturating_sub(1);
         }
+        let simd::OnLines(read) = &mut simd::OnLines([0u64; GROUP]);
         let simd::OnLines(got) = &mut simd::OnLines([0.0; GROUP]);
-        simd::gather(store.cdf, read, got);
-        let simd::OnLines(ok) = &mut simd::OnLines([0u64; GROUP]);
-        for k in 0..GROUP {
-            let lo_ok = u64::from(at[k] == self.first[k]) | below(got[k], self.value[k]);
-            let signed = self.value[k].is_sign_negative();
-            ok[k] = lo_ok & u64::from(at[k] < self.end[k] && !signed);
-        }
+        // The sums as bits, so that each step's choice is a mask.
+        let simd::OnLines(before) = &mut simd::OnLines([0u64; GROUP]);
+        let simd::OnLines(after) = &mut simd::OnLines([0u64; GROUP]);
         index.fill(0);
-        for half in [4, 2, 1, 0] {
-            for (k, &pos) in index.iter().enumerate() {
+        for step in (0..STEPS).rev() {
+            let half = 1 << step;
+            // Window entry `j = c + half − 1` is running sum `at + j − 1`.
+            for (k, &c) in index.iter().enumerate() {
                 let last = self.end[k].saturating_sub(1);
-                read[k] = (at[k] + pos + half.max(1) - 1).min(last);
+                read[k] = (at[k] + c + half - 1).saturating_sub(1).min(last);
             }
             simd::gather(store.cdf, read, got);
-            for (pos, (&c, &value)) in index.iter_mut().zip(got.iter().zip(&self.value)) {
-                *pos += half.max(1) * below(c, value);
+            for (k, c) in index.iter_mut().enumerate() {
+                // Only the last step can read `w_0`.
+                let forced = u64::from(step == 0 && *c == 0 && at[k] == self.first[k]);
+                let sum = got[k].to_bits() & forced.wrapping_sub(1);
+                let is_below = forced | below(f64::from_bits(sum), self.value[k]);
+                let mask = is_below.wrapping_neg();
+                *c += half & mask;
+                if rescale {
+                    before[k] = (sum & mask) | (before[k] & !mask);
+                    after[k] = (sum & !mask) | (after[k] & mask);
+                }
+            }
+        }
+        if rescale {
+            for k in 0..GROUP {
+                self.before[k] = f64::from_bits(before[k]);
+                self.at[k] = f64::from_bits(after[k]);
             }
         }
         let mut redo = 0;
         for (k, i) in index.iter_mut().enumerate() {
-            redo |= u64::from(ok[k] == 0 || *i >= SCAN as u64) << k;
-            *i += u64::from(lo[k]);
+            let settled = (1..(1 << STEPS) - 1).contains(i);
+            let ok = settled && at[k] < self.end[k] && !self.value[k].is_sign_negative();
+            redo |= u64::from(!ok) << k;
+            *i = (*i + u64::from(lo[k])).saturating_sub(1);
         }
         redo
     }
 
-    /// `rescaled[k] = table.rescale(u_k, index[k])` for each draw (as
-    /// [`Lanes::set`] gave it, `index` its answer), the running sums before
-    /// and at each index read by gathers and the divisions at SIMD
-    /// width; draws without a table ([`Lanes::empty`]) keep their
-    /// `rescaled[k]`. `store` as for [`Lanes::search`].
+    /// `rescaled[k] = table.rescale(u_k, i_k)` for each draw (as
+    /// [`Lanes::set`] gave it, `i_k` its answer) from the running sums its
+    /// search read, the divisions at SIMD width; draws without a table
+    /// ([`Lanes::empty`]) keep their `rescaled[k]`.
     #[inline(always)]
-    pub(crate) fn rescale<F: Real>(
-        &self,
-        store: &Search<'_>,
-        index: &[u64; GROUP],
-        rescaled: &mut [F; GROUP],
-    ) {
-        let simd::OnLines(at) = &mut simd::OnLines([0u64; GROUP]);
-        let simd::OnLines(read) = &mut simd::OnLines([0u64; GROUP]);
-        for k in 0..GROUP {
-            at[k] = self.start[k] + index[k];
-            read[k] = at[k].saturating_sub(1);
-        }
-        let simd::OnLines(got) = &mut simd::OnLines([0.0; GROUP]);
-        let simd::OnLines(running) = &mut simd::OnLines([0.0; GROUP]);
-        simd::gather(store.cdf, read, got);
-        simd::gather(store.cdf, at, running);
-        for k in 0..GROUP {
-            let before = if index[k] == 0 { 0.0 } else { got[k] };
-            let r = F::c(((self.value[k] - before) / (running[k] - before)).max(0.0));
+    pub(crate) fn rescale<F: Real>(&self, rescaled: &mut [F; GROUP]) {
+        for (k, rescaled) in rescaled.iter_mut().enumerate() {
+            let before = self.before[k];
+            let r = F::c(((self.value[k] - before) / (self.at[k] - before)).max(0.0));
             if self.end[k] > 0 {
-                rescaled[k] = r.min(F::ONE_MINUS_EPSILON);
+                *rescaled = r.min(F::ONE_MINUS_EPSILON);
             }
         }
     }
 }
+
+/// The binary search steps of [`Lanes::search`]: its window holds
+/// `2^STEPS − 1` running sums, and settles answers up to `2^STEPS − 3`
+/// entries past the guide cell's first.
+const STEPS: u32 = 3;
 
 /// For each of the first `n` draws of a group, `index[k]` = the index
 /// [`Search::index`] finds for `u` in `table` where `draw(k)` is `Some((table,
@@ -530,7 +567,7 @@ pub(crate) fn search_group<'a>(
     n: usize,
     store: &Search<'a>,
     draw: impl Fn(usize) -> Option<(Search<'a>, f64)>,
-    lanes: &mut Lanes,
+    (lanes, rescale): (&mut Lanes, bool),
     index: &mut [u64; GROUP],
 ) {
     for k in 0..n {
@@ -540,7 +577,7 @@ pub(crate) fn search_group<'a>(
         }
     }
     let all = if store.guided() {
-        lanes.search(store, index)
+        lanes.search(store, rescale, index)
     } else {
         u64::MAX
     };
@@ -548,6 +585,15 @@ pub(crate) fn search_group<'a>(
     while redo != 0 {
         let k = redo.trailing_zeros() as usize;
         redo &= redo - 1;
-        index[k] = draw(k).map_or(0, |(table, u)| table.index(u, table.guide_cell(u)) as u64);
+        index[k] = match draw(k) {
+            Some((table, u)) => {
+                let i = table.index(u, table.guide_cell(u));
+                if rescale {
+                    (lanes.before[k], lanes.at[k]) = (table.sum_before(i), table.running(i));
+                }
+                i as u64
+            }
+            None => 0,
+        };
     }
 }

@@ -10,6 +10,7 @@ use super::pickle::reduce;
 use super::records::record;
 use crate::distr::{self, GROUP};
 use crate::python::{Obj, Out};
+use crate::simd;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -63,6 +64,39 @@ pub(super) fn in_groups<U: Copy, R: Copy + Default>(
         for (k, &r) in drawn.iter().enumerate() {
             write(g * DRAWS_PER_CALL + k, r);
         }
+    }
+}
+
+/// [`in_groups`] into one array of rows: each call's results made rows by
+/// `row` in a buffer on the stack and copied into `out` (as long as
+/// `inputs`), with `stream` (for outputs of [`simd::STREAM_MIN_BYTES`] or
+/// more) by non-temporal stores ([`simd::stream_copy_rows`]), which skip
+/// reading each line of the output before writing it.
+pub(super) fn in_groups_into<U: Copy, R: Copy + Default, T: Copy + Default, const M: usize>(
+    (inputs, out): (&[U], &mut [[T; M]]),
+    draw: impl Fn(&[U], &mut [R]),
+    row: impl Fn(R) -> [T; M],
+    stream: bool,
+) {
+    let mut buffer = [R::default(); DRAWS_PER_CALL];
+    let simd::OnLines(rows) = &mut simd::OnLines([[T::default(); M]; DRAWS_PER_CALL]);
+    for (group, out) in inputs
+        .chunks(DRAWS_PER_CALL)
+        .zip(out.chunks_mut(DRAWS_PER_CALL))
+    {
+        let (drawn, rows) = (&mut buffer[..group.len()], &mut rows[..group.len()]);
+        draw(group, drawn);
+        for (to, &r) in rows.iter_mut().zip(drawn.iter()) {
+            *to = row(r);
+        }
+        if stream {
+            simd::stream_copy_rows(out, rows);
+        } else {
+            out.copy_from_slice(rows);
+        }
+    }
+    if stream {
+        simd::store_fence();
     }
 }
 
@@ -298,9 +332,10 @@ impl PyDiscrete2D {
     fn sample<'py>(&self, py: Python<'py>, u: &Obj<'py>, out: Out<'_, 'py>) -> PyResult<Obj<'py>> {
         with_precision!(u, F => {
             let u = Points::<F, 2>::extract(u, "u")?;
+            let stream = u.n.saturating_mul(size_of::<[i64; 2]>()) >= simd::STREAM_MIN_BYTES;
             map_chunks(py, &u, Check::Unit, out, |u, cells: &mut [[i64; 2]]| {
                 let draw = |u: &[[F; 2]], out: &mut [_]| self.table.sample_into(u, out);
-                in_groups(u, draw, |k, (r, c)| cells[k] = [r as i64, c as i64]);
+                in_groups_into((u, cells), draw, |(r, c)| [r as i64, c as i64], stream);
             })
         })
     }

@@ -13,8 +13,11 @@
 mod gather;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
+mod stream;
 
 pub use gather::{Gathered, gather, gather_columns};
+pub(crate) use stream::stream_copy;
+pub use stream::{store_fence, stream_copy_rows};
 
 /// Name of the environment variable that caps the instruction set batch
 /// loops use: `avx512`, `avx2` or `baseline` (for tests and debugging;
@@ -437,103 +440,6 @@ fn interleave<T: Copy, const M: usize>(columns: &[[T; BLOCK]; M], rows: &mut [[T
         for m in 0..M {
             flat[i * M + m] = columns[m][i];
         }
-    }
-}
-
-/// Copies `src` into `dst` (same length) with non-temporal stores of the
-/// widest kind the CPU has ([`level`]), when `dst` is whole cache lines (as
-/// [`map_rows`] arranges, and as the blocks of a page-aligned
-/// [`crate::buffer::Buffer`] are); otherwise with plain stores. For copies
-/// that are not read again soon: such stores skip reading each line before
-/// writing it. Follow the copies by [`store_fence`]. The width is read at
-/// run time on purpose: given as the dispatch's constant, LLVM merged the
-/// copy into the block's transpose, which cost the AVX2 warps of three
-/// components instructions per row.
-#[inline(always)]
-pub(crate) fn stream_copy<T: Copy>(dst: &mut [T], src: &[T]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        let len = size_of_val(dst);
-        if len == size_of_val(src)
-            && len.is_multiple_of(LINE)
-            && dst.as_ptr().align_offset(LINE) == 0
-        {
-            let (d, s) = (dst.as_mut_ptr().cast::<u8>(), src.as_ptr().cast::<u8>());
-            #[allow(unsafe_code)]
-            // SAFETY: `d` and `s` point to `len` valid bytes of two distinct
-            // slices (one borrowed mutably), `d` aligned to a line and `len`
-            // a multiple of it; `T: Copy` has no drop glue, and the bytes
-            // copied are those of valid `T` values. `level` reports only
-            // instruction sets the CPU has.
-            unsafe {
-                match level() {
-                    Level::Avx512 => stream_lines_avx512(d, s, len),
-                    Level::Avx2 => stream_lines_avx(d, s, len),
-                    Level::Baseline => stream_lines_sse2(d, s, len),
-                }
-            }
-            return;
-        }
-    }
-    dst.copy_from_slice(src);
-}
-
-/// Defines a function that copies `len` bytes (whole lines) from `s` to the
-/// line-aligned `d` with non-temporal stores of one vector type. Marked
-/// `#[inline(never)]`: with `#[inline]`, LLVM folded the block's transpose
-/// into the copy and assembled each vector from single floats, which ran
-/// the streamed warps several times slower.
-macro_rules! stream_lines {
-    ($name:ident, $feature:literal, $vector:ident, $load:ident, $store:ident) => {
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = $feature)]
-        #[allow(unsafe_code)]
-        #[inline(never)]
-        unsafe fn $name(d: *mut u8, s: *const u8, len: usize) {
-            use std::arch::x86_64::{$load, $store, $vector};
-            const STEP: usize = size_of::<$vector>();
-            for offset in (0..len).step_by(STEP) {
-                // SAFETY: the caller's bounds and alignment: `offset + STEP`
-                // is within `len`, and `d + offset` is aligned to `STEP`.
-                unsafe {
-                    let v = $load(s.add(offset).cast::<$vector>());
-                    $store(d.add(offset).cast::<$vector>(), v);
-                }
-            }
-        }
-    };
-}
-stream_lines!(
-    stream_lines_avx512,
-    "avx512f",
-    __m512i,
-    _mm512_loadu_si512,
-    _mm512_stream_si512
-);
-stream_lines!(
-    stream_lines_avx,
-    "avx",
-    __m256i,
-    _mm256_loadu_si256,
-    _mm256_stream_si256
-);
-stream_lines!(
-    stream_lines_sse2,
-    "sse2",
-    __m128i,
-    _mm_loadu_si128,
-    _mm_stream_si128
-);
-
-/// Orders non-temporal stores (those of [`stream_copy`]) before whatever
-/// follows (another thread reading the output after the batch joins).
-#[inline(always)]
-pub(crate) fn store_fence() {
-    #[cfg(target_arch = "x86_64")]
-    #[allow(unsafe_code)]
-    // SAFETY: SSE is part of every x86-64 CPU.
-    unsafe {
-        std::arch::x86_64::_mm_sfence();
     }
 }
 

@@ -139,20 +139,25 @@ fn side_by_side_searches_agree_where_windows_fail() {
 }
 
 /// Draws of `search` (over `d`'s weights) side by side: those the
-/// windows settle have the answer of a linear scan; returns how many
-/// were left to the single search.
-fn lanes_redone(d: &Discrete1D, search: &Search<'_>) -> usize {
+/// windows settle have the answer of a linear scan, and the rescaled `u`
+/// of the single draw (from the running sums the search read); returns
+/// how many were left to the single search.
+fn lanes_redone(d: &Discrete1D, search: &Search<'_>, us: &[f64]) -> usize {
     let mut lanes = Lanes::new();
     let mut redone = 0;
-    for us in window_us(d).chunks(GROUP) {
+    for us in us.chunks(GROUP) {
         for (k, &u) in us.iter().enumerate() {
             lanes.set(k, search, u);
         }
         let mut index = [0; GROUP];
-        let redo = lanes.search(search, &mut index);
+        let redo = lanes.search(search, true, &mut index);
+        let mut rescaled = [0.0f64; GROUP];
+        lanes.rescale(&mut rescaled);
         for (k, &u) in us.iter().enumerate() {
             if redo & (1 << k) == 0 {
                 assert_eq!(index[k] as usize, linear(d, u), "u = {u}");
+                let single = search.rescale(u, index[k] as usize);
+                assert_eq!(rescaled[k].to_bits(), single.to_bits(), "u = {u}");
             } else {
                 redone += 1;
             }
@@ -166,17 +171,49 @@ fn lanes_leave_to_the_single_search_the_draws_their_window_misses() {
     let mut redone = 0;
     for weights in window_tables() {
         let d = Discrete1D::new(&weights).unwrap();
-        redone += lanes_redone(&d, &d.search());
-        // Every guide cell one entry late, as round-off could make
-        // one (see the test below): the sum before it gives it away.
-        let late: Vec<u32> = (d.guide.iter())
-            .map(|&g| (g + 1).min(d.last as u32))
-            .collect();
-        let search = Search::new((d.weights(), &d.cdf, &late), (d.sum(), d.first, d.last));
-        redone += lanes_redone(&d, &search);
+        redone += lanes_redone_with_late_cells(&d, &window_us(&d));
     }
     // The cluster's draws and the late cells'.
     assert!(redone > 1000, "{redone}");
+}
+
+/// [`lanes_redone`] of `d`'s own guide and of one whose every cell
+/// starts one entry late, as round-off could make one (see the test
+/// below): the sum before it gives it away.
+fn lanes_redone_with_late_cells(d: &Discrete1D, us: &[f64]) -> usize {
+    let late: Vec<u32> = (d.guide.iter())
+        .map(|&g| (g + 1).min(d.last as u32))
+        .collect();
+    let search = Search::new((d.weights(), &d.cdf, &late), (d.sum(), d.first, d.last));
+    lanes_redone(d, &d.search(), us) + lanes_redone(d, &search, us)
+}
+
+#[test]
+fn long_tables_with_a_sparser_guide_are_searched_side_by_side() {
+    // Past 2^16 entries a guide cell spans 4 entries, not 2: a cluster
+    // of tiny weights, a ramp, and `u` on a grid and on every 97th
+    // running sum and its neighbours.
+    let n = (1 << 16) + 1000;
+    let weights: Vec<f64> = (0..n)
+        .map(|i| match i {
+            30_000..30_400 => 1e-9,
+            _ => 1.0 + (i % 7) as f64,
+        })
+        .collect();
+    let d = Discrete1D::new(&weights).unwrap();
+    assert_eq!(d.guide.len(), n / 4 + 1);
+    let mut us: Vec<f64> = (0..=3000).map(|k| k as f64 / 3000.0).collect();
+    for &c in d.cdf.iter().step_by(97) {
+        let u = c / d.sum();
+        us.extend([u, u.next_down().max(0.0), u.next_up().min(1.0)]);
+    }
+    let redone = lanes_redone_with_late_cells(&d, &us);
+    assert!(redone > 100, "{redone}");
+    let mut out = vec![0u64; us.len()];
+    d.sample_into(&us, &mut out);
+    for (&u, &i) in us.iter().zip(&out) {
+        assert_eq!(i as usize, d.sample(u), "u = {u}");
+    }
 }
 
 /// Weights of long tables (one part group; groups of blocks whole or
