@@ -313,14 +313,7 @@ impl Tables<'_> {
     fn place_columns_f32(self, cells: &[((usize, usize), [f32; 2])], out: &mut PlacedCells<f32>) {
         let OnLines(r) = &mut OnLines([[0.0; BLOCK]; 2]);
         self.cell_columns(cells, out, r);
-        let OnLines(corners) = &mut OnLines([[0.0; BLOCK]; 4]);
-        for (column, texels) in corners.iter_mut().zip(&out.texels) {
-            simd::gather_columns(
-                self.lum_f32.as_chunks().0,
-                texels,
-                std::array::from_mut(column),
-            );
-        }
+        let OnLines(corners) = &gather_corners(self.lum_f32, &out.texels);
         let OnLines(rows) = &mut OnLines([0; BLOCK]);
         for (row, &((j, _), _)) in rows.iter_mut().zip(cells) {
             *row = j as u32;
@@ -407,14 +400,7 @@ impl Tables<'_> {
             }
             rows[i] = row;
         }
-        let OnLines(corners) = &mut OnLines([[0.0; BLOCK]; 4]);
-        for (column, texels) in corners.iter_mut().zip(texels.iter()) {
-            simd::gather_columns(
-                self.lum_f32.as_chunks().0,
-                texels,
-                std::array::from_mut(column),
-            );
-        }
+        let OnLines(corners) = &gather_corners(self.lum_f32, texels);
         let OnLines(moments) = &mut OnLines([[0.0; BLOCK]; 2]);
         simd::gather_columns(self.moments_f32, rows, moments);
         let OnLines(pdf) = &mut OnLines([0.0; BLOCK]);
@@ -592,6 +578,33 @@ fn warp_corners_f32(c: [f32; 4], r: [f32; 2]) -> [f32; 2] {
         0.0
     };
     warp_bilinear(c.map(|v| v * scale), r)
+}
+
+/// The `L` of the corners `texels[j][i]` (`[a, b, c, d]` of [`cell_texels`]
+/// for each of a block's cells `i`), one column per corner: each row's two
+/// by one run of two from its left corner ([`simd::gather_runs`]: half the
+/// loads of a gather per corner), and those of the cells whose right
+/// corners wrap to the row's first column (not right after their left
+/// ones) read again one by one. A texel past `lum` reads as the last, as
+/// [`simd::gather_columns`] reads it (callers pass none).
+#[inline(always)]
+fn gather_corners(lum: &[f32], texels: &[[u32; BLOCK]; 4]) -> OnLines<[[f32; BLOCK]; 4]> {
+    let mut corners = OnLines([[0.0; BLOCK]; 4]);
+    let (rows, _) = corners.0.as_chunks_mut::<2>();
+    for (row, left) in rows.iter_mut().zip([&texels[0], &texels[2]]) {
+        simd::gather_runs(lum, left, row);
+    }
+    let wraps = |i: usize| texels[1][i] != texels[0][i].wrapping_add(1);
+    // A fold without branches, which vectorises; wrapped cells are rare.
+    if (0..BLOCK).fold(false, |any, i| any | wraps(i)) {
+        let last = lum.len().saturating_sub(1);
+        for i in (0..BLOCK).filter(|&i| wraps(i)) {
+            for (column, t) in corners.0.iter_mut().zip(texels) {
+                column[i] = lum.get((t[i] as usize).min(last)).copied().unwrap_or(0.0);
+            }
+        }
+    }
+    corners
 }
 
 /// The corners `[a, b, c, d]` of cell `k` (row-major, `width` a row):

@@ -15,7 +15,7 @@ mod gather;
 mod lanes;
 mod stream;
 
-pub use gather::{Gathered, gather, gather_columns};
+pub use gather::{Gathered, gather, gather_columns, gather_runs};
 pub(crate) use stream::stream_copy;
 pub use stream::{store_fence, stream_copy_rows};
 
