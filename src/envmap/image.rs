@@ -326,19 +326,19 @@ impl Image {
 
     /// The texels `texels[j][i]` blended by `weights[j][i]` over the four
     /// corners `j` of each of a block's places `i`, one column per RGB
-    /// channel: read by gathers and blended at SIMD width, in the same
-    /// order as [`Image::blend`] (the same bits).
+    /// channel: read by [`gather_corner_rows`] and blended at SIMD width,
+    /// in the same order as [`Image::blend`] (the same bits).
     #[inline(always)]
     pub(crate) fn blend_texels<F: Real>(
         &self,
         texels: &[[u32; simd::BLOCK]; 4],
         weights: [&[F; simd::BLOCK]; 4],
     ) -> simd::OnLines<[[F; simd::BLOCK]; 3]> {
+        let simd::OnLines(rows) = &gather_corner_rows::<3, 6>(self.texels.as_flattened(), texels);
         let mut blended = simd::OnLines([[F::zero(); simd::BLOCK]; 3]);
-        for (texels, w) in texels.iter().zip(weights) {
-            let simd::OnLines(t) = &mut simd::OnLines([[0.0; simd::BLOCK]; 3]);
-            simd::gather_columns(&self.texels, texels, t);
-            for (rgb, t) in blended.0.iter_mut().zip(t.iter()) {
+        for (j, w) in weights.into_iter().enumerate() {
+            let corner = &rows[j / 2][3 * (j % 2)..];
+            for (rgb, t) in blended.0.iter_mut().zip(corner) {
                 for i in 0..simd::BLOCK {
                     rgb[i] = rgb[i] + w[i] * F::c(f64::from(t[i]));
                 }
@@ -402,6 +402,48 @@ pub(super) fn cell_u32<F: Real>(x0: F, y0: F, width: u32, rows: u32) -> [u32; 2]
 pub(super) fn cell_texels(k: u32, col: u32, width: u32) -> [u32; 4] {
     let right = right_of(k, col, width);
     [k, right, k + width, right + width]
+}
+
+/// The `C` values of each corner of a block's cells, from a table of `C`
+/// values a texel (`flat`, row-major) and the corners' texels
+/// `texels[j][i]` (`[a, b, c, d]` of [`cell_texels`] for each cell `i`):
+/// `rows[0]` holds `a`'s values then `b`'s, `rows[1]` `c`'s then `d`'s,
+/// one column each. Each row's two corners are one run of `R = 2C` values
+/// from its left one ([`simd::gather_runs`]: a 64-bit gather reads two
+/// values, half the loads of a gather each), and the cells whose right
+/// corners wrap to the row's first column (not right after their left
+/// ones) are read again one by one. A texel past the table reads as the
+/// last, as [`simd::gather_columns`] reads it (callers pass none).
+#[inline(always)]
+pub(super) fn gather_corner_rows<const C: usize, const R: usize>(
+    flat: &[f32],
+    texels: &[[u32; simd::BLOCK]; 4],
+) -> simd::OnLines<[[[f32; simd::BLOCK]; R]; 2]> {
+    const { assert!(R == 2 * C) };
+    let mut rows = simd::OnLines([[[0.0; simd::BLOCK]; R]; 2]);
+    let simd::OnLines(starts) = &mut simd::OnLines([0u32; simd::BLOCK]);
+    for (row, left) in rows.0.iter_mut().zip([&texels[0], &texels[2]]) {
+        for (s, &t) in starts.iter_mut().zip(left) {
+            // Within `u32`: at most `C` values a texel of at most
+            // `MAX_TEXELS` (padded: three times as many) texels.
+            *s = C as u32 * t;
+        }
+        simd::gather_runs(flat, starts, row);
+    }
+    let wraps = |i: usize| texels[1][i] != texels[0][i].wrapping_add(1);
+    // A fold without branches, which vectorises; wrapped cells are rare.
+    if (0..simd::BLOCK).fold(false, |any, i| any | wraps(i)) {
+        let last = (flat.len() / C).saturating_sub(1);
+        for i in (0..simd::BLOCK).filter(|&i| wraps(i)) {
+            for (j, t) in texels.iter().enumerate() {
+                let first = C * (t[i] as usize).min(last);
+                for c in 0..C {
+                    rows.0[j / 2][C * (j % 2) + c][i] = flat.get(first + c).copied().unwrap_or(0.0);
+                }
+            }
+        }
+    }
+    rows
 }
 
 /// The texel right of texel `k` of column `col` on a lat-long map `width`

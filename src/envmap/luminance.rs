@@ -5,7 +5,7 @@
 //! [`Sampling::Luminance`]: super::Sampling::Luminance
 
 use super::bilinear::{bilerp, warp_bilinear};
-use super::image::{bilinear_weights, cell_texels, cell_u32, right_of};
+use super::image::{bilinear_weights, cell_texels, cell_u32, gather_corner_rows, right_of};
 use crate::buffer::Buffer;
 use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;
@@ -313,7 +313,8 @@ impl Tables<'_> {
     fn place_columns_f32(self, cells: &[((usize, usize), [f32; 2])], out: &mut PlacedCells<f32>) {
         let OnLines(r) = &mut OnLines([[0.0; BLOCK]; 2]);
         self.cell_columns(cells, out, r);
-        let OnLines(corners) = &gather_corners(self.lum_f32, &out.texels);
+        let OnLines([[l00, l10], [l01, l11]]) =
+            &gather_corner_rows::<1, 2>(self.lum_f32, &out.texels);
         let OnLines(rows) = &mut OnLines([0; BLOCK]);
         for (row, &((j, _), _)) in rows.iter_mut().zip(cells) {
             *row = j as u32;
@@ -321,7 +322,7 @@ impl Tables<'_> {
         let OnLines(moments) = &mut OnLines([[0.0; BLOCK]; 2]);
         simd::gather_columns(self.moments_f32, rows, moments);
         for i in 0..BLOCK {
-            let c = [corners[0][i], corners[1][i], corners[2][i], corners[3][i]];
+            let c = [l00[i], l10[i], l01[i], l11[i]];
             let [x, y] = warp_corners_f32(c, [r[0][i], r[1][i]]);
             let pdf_q = density_f32(c, [moments[0][i], moments[1][i]], bilinear_weights(x, y));
             (out.place[0][i], out.place[1][i], out.place[2][i]) = (x, y, pdf_q);
@@ -400,13 +401,13 @@ impl Tables<'_> {
             }
             rows[i] = row;
         }
-        let OnLines(corners) = &gather_corners(self.lum_f32, texels);
+        let OnLines([[l00, l10], [l01, l11]]) = &gather_corner_rows::<1, 2>(self.lum_f32, texels);
         let OnLines(moments) = &mut OnLines([[0.0; BLOCK]; 2]);
         simd::gather_columns(self.moments_f32, rows, moments);
         let OnLines(pdf) = &mut OnLines([0.0; BLOCK]);
         for (i, p) in pdf.iter_mut().enumerate() {
             let wt = [q[2][i], q[3][i], q[4][i], q[5][i]];
-            let c = [corners[0][i], corners[1][i], corners[2][i], corners[3][i]];
+            let c = [l00[i], l10[i], l01[i], l11[i]];
             *p = density_f32(c, [moments[0][i], moments[1][i]], wt) * q[6][i];
         }
         out.copy_from_slice(&pdf[..out.len()]);
@@ -578,33 +579,6 @@ fn warp_corners_f32(c: [f32; 4], r: [f32; 2]) -> [f32; 2] {
         0.0
     };
     warp_bilinear(c.map(|v| v * scale), r)
-}
-
-/// The `L` of the corners `texels[j][i]` (`[a, b, c, d]` of [`cell_texels`]
-/// for each of a block's cells `i`), one column per corner: each row's two
-/// by one run of two from its left corner ([`simd::gather_runs`]: half the
-/// loads of a gather per corner), and those of the cells whose right
-/// corners wrap to the row's first column (not right after their left
-/// ones) read again one by one. A texel past `lum` reads as the last, as
-/// [`simd::gather_columns`] reads it (callers pass none).
-#[inline(always)]
-fn gather_corners(lum: &[f32], texels: &[[u32; BLOCK]; 4]) -> OnLines<[[f32; BLOCK]; 4]> {
-    let mut corners = OnLines([[0.0; BLOCK]; 4]);
-    let (rows, _) = corners.0.as_chunks_mut::<2>();
-    for (row, left) in rows.iter_mut().zip([&texels[0], &texels[2]]) {
-        simd::gather_runs(lum, left, row);
-    }
-    let wraps = |i: usize| texels[1][i] != texels[0][i].wrapping_add(1);
-    // A fold without branches, which vectorises; wrapped cells are rare.
-    if (0..BLOCK).fold(false, |any, i| any | wraps(i)) {
-        let last = lum.len().saturating_sub(1);
-        for i in (0..BLOCK).filter(|&i| wraps(i)) {
-            for (column, t) in corners.0.iter_mut().zip(texels) {
-                column[i] = lum.get((t[i] as usize).min(last)).copied().unwrap_or(0.0);
-            }
-        }
-    }
-    corners
 }
 
 /// The corners `[a, b, c, d]` of cell `k` (row-major, `width` a row):
