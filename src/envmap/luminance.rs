@@ -5,7 +5,8 @@
 //! [`Sampling::Luminance`]: super::Sampling::Luminance
 
 use super::bilinear::{bilerp, warp_bilinear};
-use super::image::{bilinear_weights, cell_texels, cell_u32, gather_corner_rows, right_of};
+use super::cell::{cell_texels, cell_u32, gather_corner_rows, right_of};
+use super::image::bilinear_weights;
 use crate::buffer::Buffer;
 use crate::distr::{Discrete2D, GROUP};
 use crate::error::Result;

@@ -54,6 +54,7 @@
 
 mod batch;
 mod bilinear;
+mod cell;
 mod cell_sampler;
 mod convert;
 mod distribution;
