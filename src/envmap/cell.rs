@@ -4,6 +4,7 @@
 
 use std::ops::{Add, Sub};
 
+use super::MAX_TEXELS;
 use crate::math::Real;
 use crate::simd::{self, BLOCK};
 
@@ -41,13 +42,13 @@ pub(super) fn gather_corner_rows<const C: usize, const R: usize>(
     flat: &[f32],
     texels: &[[u32; BLOCK]; 4],
 ) -> simd::OnLines<[[[f32; BLOCK]; R]; 2]> {
-    const { assert!(R == 2 * C) };
+    const { assert!(R == 2 * C && 3 * C * MAX_TEXELS <= u32::MAX as usize) };
     let mut rows = simd::OnLines([[[0.0; BLOCK]; R]; 2]);
     let simd::OnLines(starts) = &mut simd::OnLines([0u32; BLOCK]);
     for (row, left) in rows.0.iter_mut().zip([&texels[0], &texels[2]]) {
         for (s, &t) in starts.iter_mut().zip(left) {
-            // Within `u32`: at most `C` values a texel of at most
-            // `MAX_TEXELS` (padded: three times as many) texels.
+            // Within `u32` (asserted above): `C` values a texel of at most
+            // `MAX_TEXELS` texels, three times as many padded.
             *s = C as u32 * t;
         }
         simd::gather_runs(flat, starts, row);
