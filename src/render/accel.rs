@@ -362,9 +362,10 @@ impl Accel {
             }
         }
         let hits = &mut out[first..];
-        match self.bvh {
-            None => self.leaf.intersect_many(rays, hits),
-            Some(_) => {
+        match (self.bvh.as_ref(), self.embree.as_ref()) {
+            (None, None) => self.leaf.intersect_fresh(rays, hits),
+            (None, Some(_)) => self.leaf.intersect_many(rays, hits),
+            (Some(_), _) => {
                 for (ray, hit) in rays.iter().zip(hits) {
                     *hit = self.nearer_other(ray, *hit);
                 }
@@ -495,8 +496,7 @@ impl Subset {
     /// The nearest hit of each ray of `rays` on these primitives (primitive
     /// numbers as in the whole scene), into `hits` (of the same length).
     pub fn intersect_many(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-        hits.fill(None);
-        self.0.intersect_many(rays, hits);
+        self.0.intersect_fresh(rays, hits);
     }
 }
 

@@ -112,15 +112,35 @@ impl Leaf {
             rays,
             hits,
             #[inline(always)]
-            |rays, hits| self.intersect_block(rays, hits),
+            |rays, hits| self.intersect_block::<false>(rays, hits),
         );
     }
 
-    /// [`Leaf::intersect_many`] of at most [`BLOCK`] rays.
+    /// [`Leaf::intersect`] of each ray of `rays`, into `hits` (whatever
+    /// they held): [`Leaf::intersect_many`] with no hits so far, without
+    /// reading them.
+    pub(super) fn intersect_fresh(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+        if self.triangles.is_empty() && self.spheres.is_empty() && self.disks.is_empty() {
+            hits.fill(None);
+        }
+        self.by_blocks(
+            rays,
+            hits,
+            #[inline(always)]
+            |rays, hits| self.intersect_block::<true>(rays, hits),
+        );
+    }
+
+    /// [`Leaf::intersect_many`] of at most [`BLOCK`] rays; with `FRESH`,
+    /// [`Leaf::intersect_fresh`]'s.
     #[inline(always)]
-    fn intersect_block(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
+    fn intersect_block<const FRESH: bool>(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         let block = Block::new(rays);
-        let mut best = Best::new(rays, hits);
+        let mut best = if FRESH {
+            Best::fresh(rays)
+        } else {
+            Best::new(rays, hits)
+        };
         for &([p0, e1, e2], id) in &self.triangles {
             for i in 0..BLOCK {
                 let scaled = moller_trumbore(block.o(i), block.d(i), p0, e1, e2);
@@ -283,6 +303,20 @@ impl Best {
             best.t[i] = hit.map_or(ray.tmax, |h| h.t);
             best.primitive[i] = hit.map_or(NONE, |h| h.primitive);
             [best.bary[0][i], best.bary[1][i]] = hit.map_or([0.0; 2], |h| h.bary);
+        }
+        best
+    }
+
+    /// No hits yet on `rays`: their `tmax`.
+    #[inline(always)]
+    fn fresh(rays: &[Ray]) -> Self {
+        let mut best = Best {
+            t: [0.0; BLOCK],
+            primitive: [NONE; BLOCK],
+            bary: [[0.0; BLOCK]; 2],
+        };
+        for (t, ray) in best.t.iter_mut().zip(rays) {
+            *t = ray.tmax;
         }
         best
     }

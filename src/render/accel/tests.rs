@@ -275,6 +275,10 @@ fn leaf_batches_are_single_rays_bit_for_bit() {
                 assert_eq!(bits(hits), bits(&accel.leaf.intersect(&shrunk).or(*theirs)));
                 replaced += usize::from(theirs.is_some() && hits.unwrap().primitive != 99);
             }
+            // Without hits so far, over whatever the slots held.
+            let mut fresh = theirs.clone();
+            accel.leaf.intersect_fresh(rays, &mut fresh);
+            assert!(fresh.iter().map(bits).eq(one.iter().map(bits)));
             let mut blocked: Vec<bool> = (0..n).map(|i| i % 5 == 0).collect();
             accel.leaf.occluded_many(rays, &mut blocked);
             for (i, (ray, b)) in rays.iter().zip(&blocked).enumerate() {
