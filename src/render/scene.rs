@@ -19,7 +19,7 @@ use crate::math::luminance;
 use crate::phong::Phong;
 
 mod lights;
-use lights::{AreaLight, EnvLight, Light};
+use lights::{AreaLight, EnvLight, Light, LightChoice};
 pub use lights::{ChosenLight, Emission, EnvDensity, InvertedSamples, LightSample};
 
 /// A surface's BSDF: the Phong BRDF (a diffuse material is Phong with
@@ -81,7 +81,7 @@ pub struct Scene {
     environment: Option<Environment>,
     env_light: Option<u32>,
     lights: Vec<Light>,
-    light_choice: Option<Discrete1D>,
+    light_choice: Option<LightChoice>,
     camera: Camera,
     width: usize,
     height: usize,
@@ -205,9 +205,7 @@ impl Scene {
                 powers.push(power);
             }
         }
-        let light_choice = (!powers.is_empty())
-            .then(|| Discrete1D::new(&powers))
-            .transpose()?;
+        let light_choice = LightChoice::new(&powers)?;
         let emitting = lights.iter().filter_map(|light| match light {
             Light::Area(a) => Some(a.first..a.first + a.count),
             Light::Environment(_) => None,

@@ -19,6 +19,44 @@ pub(super) enum Light {
     Environment(EnvLight),
 }
 
+/// How emitter sampling chooses a light: in proportion to the lights'
+/// powers `Φ_i`, with probability `P(i) = Φ_i / ΣΦ`.
+#[derive(Clone, Debug)]
+pub(super) struct LightChoice {
+    table: Discrete1D,
+    /// `P(i)` rounded to `f32`, as every density that includes the choice
+    /// uses it.
+    pmfs: Vec<f32>,
+}
+
+impl LightChoice {
+    /// The choice among lights of `powers` (`None` without a light).
+    ///
+    /// # Errors
+    /// As [`Discrete1D::new`].
+    pub(super) fn new(powers: &[f64]) -> crate::error::Result<Option<Self>> {
+        if powers.is_empty() {
+            return Ok(None);
+        }
+        let table = Discrete1D::new(powers)?;
+        let pmfs = (0..powers.len()).map(|i| table.pmf(i) as f32).collect();
+        Ok(Some(LightChoice { table, pmfs }))
+    }
+
+    /// The light `u` chooses ([`Discrete1D::sample`]) and its `P(i)`.
+    #[inline]
+    fn sample(&self, u: f32) -> (usize, f32) {
+        let i = self.table.sample(u);
+        (i, self.pmf(i))
+    }
+
+    /// `P(i)` (0 outside the lights).
+    #[inline]
+    fn pmf(&self, i: usize) -> f32 {
+        self.pmfs.get(i).copied().unwrap_or(0.0)
+    }
+}
+
 /// The density emitter sampling draws the environment by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EnvDensity {
@@ -176,7 +214,7 @@ pub enum Emission {
 impl Scene {
     fn choice_pmf(&self, light: Option<u32>) -> f32 {
         match (light, &self.light_choice) {
-            (Some(l), Some(choice)) => choice.pmf(l as usize) as f32,
+            (Some(l), Some(choice)) => choice.pmf(l as usize),
             _ => 0.0,
         }
     }
@@ -311,9 +349,7 @@ impl Scene {
     /// sampling ([`Environment::sample`] by inversion) (`u[1..3]`). `None`
     /// when the scene has no light or the sample carries no radiance.
     pub fn sample_emission(&self, u: [f32; 3]) -> Option<Emission> {
-        let choice = self.light_choice.as_ref()?;
-        let index = choice.sample(u[0]);
-        let pmf = choice.pmf(index) as f32;
+        let (index, pmf) = self.light_choice.as_ref()?.sample(u[0]);
         match &self.lights[index] {
             Light::Environment(_) => {
                 let (d, pdf, radiance) = self.environment.as_ref()?.sample([u[1], u[2]], None);
@@ -473,11 +509,10 @@ impl Scene {
     /// none.
     #[inline]
     pub fn choose_light(&self, u: f32, density: EnvDensity) -> Option<ChosenLight<'_>> {
-        let choice = self.light_choice.as_ref()?;
-        let index = choice.sample(u);
+        let (index, pmf) = self.light_choice.as_ref()?.sample(u);
         Some(ChosenLight {
             light: &self.lights[index],
-            pmf: choice.pmf(index) as f32,
+            pmf,
             density,
         })
     }
