@@ -12,8 +12,10 @@
 //!   component `c` of row `s`.
 
 use std::arch::x86_64::{
-    __m512i, _mm512_loadu_si512, _mm512_permutex2var_epi32, _mm512_setzero_si512,
-    _mm512_storeu_si512, _mm512_stream_si512,
+    __m512i, _mm512_loadu_si512, _mm512_mask_storeu_epi32, _mm512_maskz_loadu_epi32,
+    _mm512_permutex2var_epi32, _mm512_setzero_si512, _mm512_shuffle_i32x4, _mm512_storeu_si512,
+    _mm512_stream_si512, _mm512_unpackhi_epi32, _mm512_unpackhi_epi64, _mm512_unpacklo_epi32,
+    _mm512_unpacklo_epi64,
 };
 
 /// Lanes of a 512-bit vector of four-byte values.
@@ -156,6 +158,141 @@ pub(super) fn columns_to_rows<T: Copy, const M: usize, const B: usize>(
     }
 }
 
+/// Whether [`columns_to_rows_transposed`] handles blocks of `b` rows of
+/// `m` components of type `T`.
+pub(super) const fn transposes<T>(m: usize, b: usize) -> bool {
+    size_of::<T>() == 4 && m >= 2 && m <= LANES && b.is_multiple_of(LANES)
+}
+
+/// `rows[i][m] = columns[m][i]` for a block of `B` rows of `M` four-byte
+/// components, `M` up to 16 (see [`transposes`]; does nothing for other
+/// shapes): each group of 16 rows as a 16 × 16 transpose in registers
+/// ([`transpose16`], the columns past `M` zeros), each row then written by
+/// one store of its `M` lanes. The compiler's own form of this loop
+/// scatters, one element at a time on AMD's cores.
+#[target_feature(enable = "avx512f")]
+#[inline]
+pub(super) fn columns_to_rows_transposed<T: Copy, const M: usize, const B: usize>(
+    columns: &[[T; B]; M],
+    rows: &mut [[T; M]; B],
+) {
+    if !transposes::<T>(M, B) {
+        return;
+    }
+    let dst = rows.as_mut_ptr().cast::<i32>();
+    let mask = ((1_u32 << M) - 1) as u16;
+    for g in 0..B / LANES {
+        let mut lines = [_mm512_setzero_si512(); LANES];
+        for (line, column) in lines.iter_mut().zip(columns) {
+            // SAFETY: lanes 16·g to 16·g + 15 of a column of B values.
+            #[allow(unsafe_code)]
+            unsafe {
+                *line = _mm512_loadu_si512(column.as_ptr().add(LANES * g).cast());
+            }
+        }
+        transpose16(&mut lines);
+        for (s, line) in lines.iter().enumerate() {
+            // SAFETY: row 16·g + s of B rows of M four-byte values: its M
+            // lanes (the mask) lie inside `rows`; the bits are values of
+            // type T, moved whole.
+            #[allow(unsafe_code)]
+            unsafe {
+                _mm512_mask_storeu_epi32(dst.add(M * (LANES * g + s)), mask, *line);
+            }
+        }
+    }
+}
+
+/// Whether [`rows_to_columns_transposed`] handles blocks of `b` rows of
+/// `k` components of type `T`.
+pub(super) const fn transposes_rows<T>(k: usize, b: usize) -> bool {
+    size_of::<T>() == 4 && k >= 2 && b.is_multiple_of(LANES)
+}
+
+/// `columns[k][i] = rows[i][k]` for a block of `B` rows of `K` four-byte
+/// components (see [`transposes_rows`]; does nothing for other shapes):
+/// each group of 16 rows read 16 components at a time (the row's first `K`
+/// by one load when `K < 16`; else components `k0 .. k0 + 16`, the last
+/// such window ending at the row's end) and transposed in registers
+/// ([`transpose16`]). The compiler's own form of this loop gathers each
+/// column.
+#[target_feature(enable = "avx512f")]
+#[inline]
+pub(super) fn rows_to_columns_transposed<F: Copy, const K: usize, const B: usize>(
+    rows: &[[F; K]; B],
+    columns: &mut [[F; B]; K],
+) {
+    if !transposes_rows::<F>(K, B) {
+        return;
+    }
+    let src = rows.as_ptr().cast::<i32>();
+    let mask = if K < LANES {
+        ((1_u32 << K) - 1) as u16
+    } else {
+        u16::MAX
+    };
+    for g in 0..B / LANES {
+        let mut k0 = 0;
+        while k0 < K {
+            // The window's first component: k0, or K − 16 for the last
+            // window of a row longer than 16.
+            let start = if K < LANES { 0 } else { k0.min(K - LANES) };
+            let mut lines = [_mm512_setzero_si512(); LANES];
+            for (s, line) in lines.iter_mut().enumerate() {
+                // SAFETY: components `start ..` of row 16·g + s, of which
+                // the mask keeps min(K, 16), all inside the row (`start +
+                // 16 <= K` when K >= 16); `loadu` needs no alignment.
+                #[allow(unsafe_code)]
+                unsafe {
+                    *line = _mm512_maskz_loadu_epi32(mask, src.add(K * (LANES * g + s) + start));
+                }
+            }
+            transpose16(&mut lines);
+            let end = (start + LANES).min(K);
+            for (k, line) in (k0..end).zip(&lines[k0 - start..]) {
+                // SAFETY: lanes 16·g to 16·g + 15 of a column of B values;
+                // the bits are values of type F, moved whole.
+                #[allow(unsafe_code)]
+                unsafe {
+                    _mm512_storeu_si512(columns[k].as_mut_ptr().add(LANES * g).cast(), *line);
+                }
+            }
+            k0 = end;
+        }
+    }
+}
+
+/// Transposes 16 vectors of 16 lanes in place (`v[j]` lane `i` becomes
+/// `v[i]` lane `j`): pairs of lanes, of pairs, of 128-bit quarters, then of
+/// halves are exchanged, 64 shuffles in all.
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn transpose16(v: &mut [__m512i; LANES]) {
+    let mut t = [_mm512_setzero_si512(); LANES];
+    for i in 0..LANES / 2 {
+        t[2 * i] = _mm512_unpacklo_epi32(v[2 * i], v[2 * i + 1]);
+        t[2 * i + 1] = _mm512_unpackhi_epi32(v[2 * i], v[2 * i + 1]);
+    }
+    for q in 0..LANES / 4 {
+        let b = 4 * q;
+        v[b] = _mm512_unpacklo_epi64(t[b], t[b + 2]);
+        v[b + 1] = _mm512_unpackhi_epi64(t[b], t[b + 2]);
+        v[b + 2] = _mm512_unpacklo_epi64(t[b + 1], t[b + 3]);
+        v[b + 3] = _mm512_unpackhi_epi64(t[b + 1], t[b + 3]);
+    }
+    for h in 0..2 {
+        let b = 8 * h;
+        for k in 0..4 {
+            t[b + k] = _mm512_shuffle_i32x4::<0x88>(v[b + k], v[b + 4 + k]);
+            t[b + 4 + k] = _mm512_shuffle_i32x4::<0xdd>(v[b + k], v[b + 4 + k]);
+        }
+    }
+    for k in 0..8 {
+        v[k] = _mm512_shuffle_i32x4::<0x88>(t[k], t[8 + k]);
+        v[8 + k] = _mm512_shuffle_i32x4::<0xdd>(t[k], t[8 + k]);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -207,5 +344,68 @@ mod tests {
                 assert_eq!(pick_scalar(&columns, v, true), rows[v], "m {m}, line {v}");
             }
         }
+    }
+    /// Columns of 2 to 16 components become their rows by transposes, in
+    /// blocks of one and of four groups of 16 rows (where the CPU has
+    /// AVX-512).
+    #[test]
+    fn transposes_write_every_row_whole() {
+        if !std::arch::is_x86_feature_detected!("avx512f") {
+            return;
+        }
+        fn check<const M: usize, const B: usize>() {
+            // Column c, row s holds 1000·s + c.
+            let columns: [[u32; B]; M] =
+                std::array::from_fn(|c| std::array::from_fn(|s| 1000 * s as u32 + c as u32));
+            let mut rows = [[u32::MAX; M]; B];
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX-512 F (checked above).
+            unsafe {
+                columns_to_rows_transposed(&columns, &mut rows);
+            }
+            for (s, row) in rows.iter().enumerate() {
+                let want: [u32; M] = std::array::from_fn(|c| 1000 * s as u32 + c as u32);
+                assert_eq!(*row, want, "M {M}, B {B}, row {s}");
+            }
+        }
+        check::<2, 16>();
+        check::<4, 64>();
+        check::<11, 64>();
+        check::<11, 16>();
+        check::<15, 32>();
+        check::<16, 64>();
+    }
+
+    /// Rows of 2 to 40 components become their columns by transposes, in
+    /// blocks of one and of four groups of 16 rows (where the CPU has
+    /// AVX-512).
+    #[test]
+    fn transposes_read_every_column_whole() {
+        if !std::arch::is_x86_feature_detected!("avx512f") {
+            return;
+        }
+        fn check<const K: usize, const B: usize>() {
+            // Row s, component c holds 1000·s + c.
+            let rows: [[u32; K]; B] =
+                std::array::from_fn(|s| std::array::from_fn(|c| 1000 * s as u32 + c as u32));
+            let mut columns = [[u32::MAX; B]; K];
+            #[allow(unsafe_code)]
+            // SAFETY: the CPU has AVX-512 F (checked above).
+            unsafe {
+                rows_to_columns_transposed(&rows, &mut columns);
+            }
+            for (c, column) in columns.iter().enumerate() {
+                let want: [u32; B] = std::array::from_fn(|s| 1000 * s as u32 + c as u32);
+                assert_eq!(*column, want, "K {K}, B {B}, column {c}");
+            }
+        }
+        check::<2, 16>();
+        check::<5, 64>();
+        check::<15, 16>();
+        check::<16, 64>();
+        check::<17, 16>();
+        check::<18, 64>();
+        check::<32, 32>();
+        check::<40, 64>();
     }
 }

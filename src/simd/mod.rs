@@ -285,10 +285,10 @@ where
     if !permute_columns_to_rows(results, out, level, stream) {
         if stream {
             let OnLines(rows) = &mut OnLines([[T::default(); M]; BLOCK]);
-            interleave(results, rows);
+            interleave(results, rows, level);
             stream_copy(out, rows);
         } else {
-            interleave(results, out);
+            interleave(results, out, level);
         }
     }
     ok
@@ -351,7 +351,9 @@ where
     T: Copy,
 {
     let OnLines(columns) = &mut OnLines([[F::default(); BLOCK]; K]);
-    if !permute_rows_to_columns(inputs, columns, level) {
+    if !permute_rows_to_columns(inputs, columns, level)
+        && !transpose_rows_to_columns(inputs, columns, level)
+    {
         for i in 0..BLOCK {
             for k in 0..K {
                 columns[k][i] = inputs[i][k];
@@ -417,6 +419,27 @@ fn permute_rows_to_columns<F: Copy, const K: usize>(
     false
 }
 
+/// [`lanes::rows_to_columns_transposed`] where the CPU and the shape
+/// allow; returns whether it ran.
+#[inline(always)]
+fn transpose_rows_to_columns<F: Copy, const K: usize>(
+    rows: &[[F; K]; BLOCK],
+    columns: &mut [[F; BLOCK]; K],
+    level: Level,
+) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if level == Level::Avx512 && lanes::transposes_rows::<F>(K, BLOCK) {
+        #[allow(unsafe_code)]
+        // SAFETY: `level` reports AVX-512 only when the CPU has AVX-512 F.
+        unsafe {
+            lanes::rows_to_columns_transposed(rows, columns);
+        }
+        return true;
+    }
+    let _ = (rows, columns, level);
+    false
+}
+
 /// [`lanes::columns_to_rows`] where the CPU and the shape allow; returns
 /// whether it ran.
 #[inline(always)]
@@ -431,10 +454,26 @@ fn permute_columns_to_rows<T: Copy, const M: usize>(
     false
 }
 
-/// `rows[i][m] = columns[m][i]`, as one flat loop of constant length,
-/// which vectorises where a loop over rows does not.
+/// `rows[i][m] = columns[m][i]`: on AVX-512 by transposes in registers
+/// ([`lanes::columns_to_rows_transposed`], up to 16 components), else as
+/// one flat loop of constant length, which vectorises where a loop over
+/// rows does not.
 #[inline(always)]
-fn interleave<T: Copy, const M: usize>(columns: &[[T; BLOCK]; M], rows: &mut [[T; M]; BLOCK]) {
+fn interleave<T: Copy, const M: usize>(
+    columns: &[[T; BLOCK]; M],
+    rows: &mut [[T; M]; BLOCK],
+    level: Level,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if level == Level::Avx512 && lanes::transposes::<T>(M, BLOCK) {
+        #[allow(unsafe_code)]
+        // SAFETY: `level` reports AVX-512 only when the CPU has AVX-512 F.
+        unsafe {
+            lanes::columns_to_rows_transposed(columns, rows);
+        }
+        return;
+    }
+    let _ = level;
     let flat = rows.as_flattened_mut();
     for i in 0..BLOCK {
         for m in 0..M {
