@@ -10,6 +10,13 @@
 //! - rows to columns (`m` components): `e = m·j + v`;
 //! - columns to rows: `e = 16·c + s`, for output element `16·v + j` =
 //!   component `c` of row `s`.
+//!
+//! Rows of other lengths go through a 16 × 16 transpose in registers
+//! ([`transpose16`]): rows of up to 16 components written back from
+//! their columns ([`columns_to_rows_transposed`]), rows of any length
+//! read into columns 16 components at a time
+//! ([`rows_to_columns_transposed`]). Left to the compiler, these loops
+//! scattered and gathered one element at a time.
 
 use std::arch::x86_64::{
     __m512i, _mm512_loadu_si512, _mm512_mask_storeu_epi32, _mm512_maskz_loadu_epi32,

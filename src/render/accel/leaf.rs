@@ -122,6 +122,7 @@ impl Leaf {
     pub(super) fn intersect_fresh(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
         if self.triangles.is_empty() && self.spheres.is_empty() && self.disks.is_empty() {
             hits.fill(None);
+            return;
         }
         self.by_blocks(
             rays,
