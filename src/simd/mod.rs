@@ -389,13 +389,14 @@ where
     ok
 }
 
-/// Runs the permute `$call` of [`lanes`] and returns `true` from the
-/// enclosing function when `$level` is AVX-512 and [`lanes::handles`]
-/// `$n` components of `$T`; does nothing otherwise (and on other CPUs).
-macro_rules! permute_on_avx512 {
-    ($level:expr, $T:ty, $n:expr, $call:expr) => {
+/// Runs the transpose `$call` of [`lanes`] and returns `true` from the
+/// enclosing function when `$level` is AVX-512 and `$shape` (which of
+/// [`lanes`]' shapes it handles) holds; does nothing otherwise (and on
+/// other CPUs).
+macro_rules! on_avx512 {
+    ($level:expr, $shape:expr, $call:expr) => {
         #[cfg(target_arch = "x86_64")]
-        if $level == Level::Avx512 && lanes::handles::<$T>($n, BLOCK) {
+        if $level == Level::Avx512 && $shape {
             #[allow(unsafe_code)]
             // SAFETY: `level` reports AVX-512 only when the CPU has AVX-512 F.
             unsafe {
@@ -414,7 +415,11 @@ fn permute_rows_to_columns<F: Copy, const K: usize>(
     columns: &mut [[F; BLOCK]; K],
     level: Level,
 ) -> bool {
-    permute_on_avx512!(level, F, K, lanes::rows_to_columns(rows, columns));
+    on_avx512!(
+        level,
+        lanes::handles::<F>(K, BLOCK),
+        lanes::rows_to_columns(rows, columns)
+    );
     let _ = (rows, columns, level);
     false
 }
@@ -427,15 +432,11 @@ fn transpose_rows_to_columns<F: Copy, const K: usize>(
     columns: &mut [[F; BLOCK]; K],
     level: Level,
 ) -> bool {
-    #[cfg(target_arch = "x86_64")]
-    if level == Level::Avx512 && lanes::transposes_rows::<F>(K, BLOCK) {
-        #[allow(unsafe_code)]
-        // SAFETY: `level` reports AVX-512 only when the CPU has AVX-512 F.
-        unsafe {
-            lanes::rows_to_columns_transposed(rows, columns);
-        }
-        return true;
-    }
+    on_avx512!(
+        level,
+        lanes::transposes_rows::<F>(K, BLOCK),
+        lanes::rows_to_columns_transposed(rows, columns)
+    );
     let _ = (rows, columns, level);
     false
 }
@@ -449,31 +450,45 @@ fn permute_columns_to_rows<T: Copy, const M: usize>(
     level: Level,
     stream: bool,
 ) -> bool {
-    permute_on_avx512!(level, T, M, lanes::columns_to_rows(columns, rows, stream));
+    on_avx512!(
+        level,
+        lanes::handles::<T>(M, BLOCK),
+        lanes::columns_to_rows(columns, rows, stream)
+    );
     let _ = (columns, rows, level, stream);
     false
 }
 
+/// [`lanes::columns_to_rows_transposed`] where the CPU and the shape
+/// allow; returns whether it ran.
+#[inline(always)]
+fn transpose_columns_to_rows<T: Copy, const M: usize>(
+    columns: &[[T; BLOCK]; M],
+    rows: &mut [[T; M]; BLOCK],
+    level: Level,
+) -> bool {
+    on_avx512!(
+        level,
+        lanes::transposes::<T>(M, BLOCK),
+        lanes::columns_to_rows_transposed(columns, rows)
+    );
+    let _ = (columns, rows, level);
+    false
+}
+
 /// `rows[i][m] = columns[m][i]`: on AVX-512 by transposes in registers
-/// ([`lanes::columns_to_rows_transposed`], up to 16 components), else as
-/// one flat loop of constant length, which vectorises where a loop over
-/// rows does not.
+/// ([`transpose_columns_to_rows`], up to 16 components), else as one flat
+/// loop of constant length, which vectorises where a loop over rows does
+/// not.
 #[inline(always)]
 fn interleave<T: Copy, const M: usize>(
     columns: &[[T; BLOCK]; M],
     rows: &mut [[T; M]; BLOCK],
     level: Level,
 ) {
-    #[cfg(target_arch = "x86_64")]
-    if level == Level::Avx512 && lanes::transposes::<T>(M, BLOCK) {
-        #[allow(unsafe_code)]
-        // SAFETY: `level` reports AVX-512 only when the CPU has AVX-512 F.
-        unsafe {
-            lanes::columns_to_rows_transposed(columns, rows);
-        }
+    if transpose_columns_to_rows(columns, rows, level) {
         return;
     }
-    let _ = level;
     let flat = rows.as_flattened_mut();
     for i in 0..BLOCK {
         for m in 0..M {
