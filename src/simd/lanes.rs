@@ -16,13 +16,18 @@
 //! their columns ([`columns_to_rows_transposed`]), rows of any length
 //! read into columns 16 components at a time
 //! ([`rows_to_columns_transposed`]). Left to the compiler, these loops
-//! scattered and gathered one element at a time.
+//! scattered and gathered one element at a time. Pairs of three-vectors
+//! (a ray's origin and direction) go to six columns by 4 × 4 transposes
+//! within each 128-bit quarter ([`vector_pairs_to_columns`]).
 
+use glam::Vec3A;
 use std::arch::x86_64::{
-    __m512i, _mm512_loadu_si512, _mm512_mask_storeu_epi32, _mm512_maskz_loadu_epi32,
-    _mm512_permutex2var_epi32, _mm512_setzero_si512, _mm512_shuffle_i32x4, _mm512_storeu_si512,
-    _mm512_stream_si512, _mm512_unpackhi_epi32, _mm512_unpackhi_epi64, _mm512_unpacklo_epi32,
-    _mm512_unpacklo_epi64,
+    __m128, __m512, __m512i, _mm512_castpd_ps, _mm512_castps_pd, _mm512_insertf32x4,
+    _mm512_loadu_si512, _mm512_mask_storeu_epi32, _mm512_maskz_loadu_epi32,
+    _mm512_permutex2var_epi32, _mm512_setzero_ps, _mm512_setzero_si512, _mm512_shuffle_i32x4,
+    _mm512_storeu_ps, _mm512_storeu_si512, _mm512_stream_si512, _mm512_unpackhi_epi32,
+    _mm512_unpackhi_epi64, _mm512_unpackhi_pd, _mm512_unpackhi_ps, _mm512_unpacklo_epi32,
+    _mm512_unpacklo_epi64, _mm512_unpacklo_pd, _mm512_unpacklo_ps,
 };
 
 /// Lanes of a 512-bit vector of four-byte values.
@@ -269,6 +274,85 @@ pub(super) fn rows_to_columns_transposed<F: Copy, const K: usize, const B: usize
     }
 }
 
+/// `columns[k][i]` = component `k` of `pair(items[i])[0]` for `k < 3`, and
+/// component `k − 3` of `pair(items[i])[1]` for `k >= 3`; zeros for `i` at
+/// or past `items.len()`. Each group of 16 items as four vectors of four
+/// items' three-vectors (item `4q + j` in quarter `q` of vector `j`), then
+/// a 4 × 4 transpose within each quarter: 24 inserts and 14 shuffles per
+/// 16 items. The compiler's own form of this loop gathers each column (six
+/// gathers per 16 items), and copies a block's last items one value at a
+/// time.
+#[target_feature(enable = "avx512f")]
+#[inline]
+pub(super) fn vector_pairs_to_columns<T, const B: usize>(
+    items: &[T],
+    pair: impl Fn(&T) -> [Vec3A; 2],
+    columns: &mut [[f32; B]; 6],
+) {
+    if !B.is_multiple_of(LANES) {
+        return;
+    }
+    for g in 0..B / LANES {
+        let mut first = [_mm512_setzero_ps(); 4];
+        let mut second = [_mm512_setzero_ps(); 4];
+        for (j, (a, b)) in first.iter_mut().zip(&mut second).enumerate() {
+            for q in 0..4 {
+                let Some(item) = items.get(LANES * g + 4 * q + j) else {
+                    break;
+                };
+                let [x, y] = pair(item).map(__m128::from);
+                *a = insert_quarter(*a, q, x);
+                *b = insert_quarter(*b, q, y);
+            }
+        }
+        for (vectors, at) in [(first, 0), (second, 3)] {
+            for (k, column) in transpose_quarters(vectors).iter().enumerate() {
+                // SAFETY: lanes 16·g to 16·g + 15 of a column of B values.
+                #[allow(unsafe_code)]
+                unsafe {
+                    _mm512_storeu_ps(columns[at + k].as_mut_ptr().add(LANES * g), *column);
+                }
+            }
+        }
+    }
+}
+
+/// `v` with its quarter `q` (lanes `4q .. 4q + 4`) set to `x`.
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn insert_quarter(v: __m512, q: usize, x: __m128) -> __m512 {
+    match q {
+        0 => _mm512_insertf32x4::<0>(v, x),
+        1 => _mm512_insertf32x4::<1>(v, x),
+        2 => _mm512_insertf32x4::<2>(v, x),
+        _ => _mm512_insertf32x4::<3>(v, x),
+    }
+}
+
+/// The first three rows of the 4 × 4 transposes of `v` within each
+/// quarter: lane `4q + j` of row `k` is lane `4q + k` of `v[j]`.
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn transpose_quarters(v: [__m512; 4]) -> [__m512; 3] {
+    let lo01 = _mm512_unpacklo_ps(v[0], v[1]);
+    let hi01 = _mm512_unpackhi_ps(v[0], v[1]);
+    let lo23 = _mm512_unpacklo_ps(v[2], v[3]);
+    let hi23 = _mm512_unpackhi_ps(v[2], v[3]);
+    let pairs = |a: __m512, b: __m512, high: bool| {
+        let (a, b) = (_mm512_castps_pd(a), _mm512_castps_pd(b));
+        _mm512_castpd_ps(if high {
+            _mm512_unpackhi_pd(a, b)
+        } else {
+            _mm512_unpacklo_pd(a, b)
+        })
+    };
+    [
+        pairs(lo01, lo23, false),
+        pairs(lo01, lo23, true),
+        pairs(hi01, hi23, false),
+    ]
+}
+
 /// Transposes 16 vectors of 16 lanes in place (`v[j]` lane `i` becomes
 /// `v[i]` lane `j`): pairs of lanes, of pairs, of 128-bit quarters, then of
 /// halves are exchanged, 64 shuffles in all.
@@ -414,5 +498,40 @@ mod tests {
         check::<18, 64>();
         check::<32, 32>();
         check::<40, 64>();
+    }
+
+    /// Every item's two vectors land in their six columns, and the rows
+    /// past the items are zeros, for blocks of one and four groups of 16
+    /// and every count of items up to the block (where the CPU has
+    /// AVX-512).
+    #[test]
+    fn vector_pairs_fill_every_column() {
+        if !std::arch::is_x86_feature_detected!("avx512f") {
+            return;
+        }
+        fn check<const B: usize>() {
+            // Item i holds 100·i + 1, 2, 3 and 100·i + 4, 5, 6.
+            let items: Vec<[Vec3A; 2]> = (0..B)
+                .map(|i| {
+                    let v = |c: usize| (100 * i + c) as f32;
+                    [Vec3A::new(v(1), v(2), v(3)), Vec3A::new(v(4), v(5), v(6))]
+                })
+                .collect();
+            for n in 0..=B {
+                let mut columns = [[f32::NAN; B]; 6];
+                #[allow(unsafe_code)]
+                // SAFETY: the CPU has AVX-512 F (checked above).
+                unsafe {
+                    vector_pairs_to_columns(&items[..n], |&p| p, &mut columns);
+                }
+                for (k, column) in columns.iter().enumerate() {
+                    let want: [f32; B] =
+                        std::array::from_fn(|i| if i < n { (100 * i + k + 1) as f32 } else { 0.0 });
+                    assert_eq!(*column, want, "B {B}, {n} items, column {k}");
+                }
+            }
+        }
+        check::<16>();
+        check::<64>();
     }
 }

@@ -476,6 +476,27 @@ fn transpose_columns_to_rows<T: Copy, const M: usize>(
     false
 }
 
+/// `columns[k][i]`: component `k` of `pair(items[i])[0]` for `k < 3`, of
+/// `pair(items[i])[1]` for `k >= 3` (zeros past the items), for at most `B`
+/// items (a multiple of 16), on AVX-512 by transposes in registers
+/// ([`lanes::vector_pairs_to_columns`]); returns whether it ran (not at
+/// other levels, where the caller's own loop is as good).
+#[inline(always)]
+pub fn vector_pairs_to_columns<T, const B: usize>(
+    items: &[T],
+    pair: impl Fn(&T) -> [glam::Vec3A; 2],
+    columns: &mut [[f32; B]; 6],
+    level: Level,
+) -> bool {
+    on_avx512!(
+        level,
+        B.is_multiple_of(16),
+        lanes::vector_pairs_to_columns(items, pair, columns)
+    );
+    let _ = (items, pair, columns, level);
+    false
+}
+
 /// `rows[i][m] = columns[m][i]`: on AVX-512 by transposes in registers
 /// ([`transpose_columns_to_rows`], up to 16 components), else as one flat
 /// loop of constant length, which vectorises where a loop over rows does

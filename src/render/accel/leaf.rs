@@ -9,7 +9,7 @@
 use super::{Hit, Primitive};
 use crate::render::mesh::Mesh;
 use crate::render::shape::{Candidate, Disk, Ray, Sphere, Triangle, Triangles4, moller_trumbore};
-use crate::simd::{self, OnLines};
+use crate::simd::{self, Level, OnLines};
 
 /// Rays per block of the batch tests (the loops over a block's rays
 /// vectorise; 64 keeps a block's columns within the L1 cache).
@@ -112,7 +112,7 @@ impl Leaf {
             rays,
             hits,
             #[inline(always)]
-            |rays, hits| self.intersect_block::<false>(rays, hits),
+            |rays, hits, level| self.intersect_block::<false>(rays, hits, level),
         );
     }
 
@@ -128,15 +128,20 @@ impl Leaf {
             rays,
             hits,
             #[inline(always)]
-            |rays, hits| self.intersect_block::<true>(rays, hits),
+            |rays, hits, level| self.intersect_block::<true>(rays, hits, level),
         );
     }
 
     /// [`Leaf::intersect_many`] of at most [`BLOCK`] rays; with `FRESH`,
     /// [`Leaf::intersect_fresh`]'s.
     #[inline(always)]
-    fn intersect_block<const FRESH: bool>(&self, rays: &[Ray], hits: &mut [Option<Hit>]) {
-        let block = Block::new(rays);
+    fn intersect_block<const FRESH: bool>(
+        &self,
+        rays: &[Ray],
+        hits: &mut [Option<Hit>],
+        level: Level,
+    ) {
+        let block = Block::new(rays, level);
         let mut best = if FRESH {
             Best::fresh(rays)
         } else {
@@ -177,24 +182,25 @@ impl Leaf {
             rays,
             blocked,
             #[inline(always)]
-            |rays, blocked| self.occluded_block(rays, blocked),
+            |rays, blocked, level| self.occluded_block(rays, blocked, level),
         );
     }
 
     /// `test` of each block of at most [`BLOCK`] rays of `rays` and their
     /// rows of `out`, compiled for the widest vector unit
-    /// ([`simd::dispatch`]); nothing at all for an empty leaf.
+    /// ([`simd::dispatch`], whose level `test` is given); nothing at all for
+    /// an empty leaf.
     #[inline(always)]
-    fn by_blocks<T>(&self, rays: &[Ray], out: &mut [T], test: impl Fn(&[Ray], &mut [T])) {
+    fn by_blocks<T>(&self, rays: &[Ray], out: &mut [T], test: impl Fn(&[Ray], &mut [T], Level)) {
         debug_assert_eq!(rays.len(), out.len());
         if self.triangles.is_empty() && self.spheres.is_empty() && self.disks.is_empty() {
             return;
         }
         simd::dispatch(
             #[inline(always)]
-            |_| {
+            |level| {
                 for (rays, out) in rays.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
-                    test(rays, out);
+                    test(rays, out, level);
                 }
             },
         );
@@ -202,8 +208,8 @@ impl Leaf {
 
     /// [`Leaf::occluded_many`] of at most [`BLOCK`] rays.
     #[inline(always)]
-    fn occluded_block(&self, rays: &[Ray], blocked: &mut [bool]) {
-        let block = Block::new(rays);
+    fn occluded_block(&self, rays: &[Ray], blocked: &mut [bool], level: Level) {
+        let block = Block::new(rays, level);
         let OnLines(tmax) = &mut OnLines([0.0; BLOCK]);
         let OnLines(any) = &mut OnLines([false; BLOCK]);
         for (i, (ray, &b)) in rays.iter().zip(&*blocked).enumerate() {
@@ -227,28 +233,34 @@ impl Leaf {
     }
 }
 
-/// A block's ray origins and directions, one array per component (the
-/// rows past the block's rays are zero), on cache-line boundaries.
+/// A block's ray origins and directions, one array per component (`x, y,
+/// z` of the origins, then of the directions; the rows past the block's
+/// rays are zero), on cache-line boundaries.
 #[repr(align(64))]
 struct Block {
-    o: [[f32; BLOCK]; 3],
-    d: [[f32; BLOCK]; 3],
+    od: [[f32; BLOCK]; 6],
     /// How many rows hold rays (the rest are zeros).
     rows: usize,
 }
 
 impl Block {
+    /// The block of `rays` (at most [`BLOCK`]), in code compiled for
+    /// `level`: on AVX-512 by transposes in registers
+    /// ([`simd::vector_pairs_to_columns`]).
     #[inline(always)]
-    fn new(rays: &[Ray]) -> Self {
+    fn new(rays: &[Ray], level: Level) -> Self {
         let mut block = Block {
-            o: [[0.0; BLOCK]; 3],
-            d: [[0.0; BLOCK]; 3],
+            od: [[0.0; BLOCK]; 6],
             rows: rays.len().min(BLOCK),
         };
-        for (i, ray) in rays.iter().enumerate().take(BLOCK) {
+        let rays = &rays[..block.rows];
+        if simd::vector_pairs_to_columns(rays, |r| [r.o, r.d], &mut block.od, level) {
+            return block;
+        }
+        for (i, ray) in rays.iter().enumerate() {
             for k in 0..3 {
-                block.o[k][i] = ray.o[k];
-                block.d[k][i] = ray.d[k];
+                block.od[k][i] = ray.o[k];
+                block.od[3 + k][i] = ray.d[k];
             }
         }
         block
@@ -271,12 +283,12 @@ impl Block {
 
     #[inline(always)]
     fn o(&self, i: usize) -> [f32; 3] {
-        [self.o[0][i], self.o[1][i], self.o[2][i]]
+        [self.od[0][i], self.od[1][i], self.od[2][i]]
     }
 
     #[inline(always)]
     fn d(&self, i: usize) -> [f32; 3] {
-        [self.d[0][i], self.d[1][i], self.d[2][i]]
+        [self.od[3][i], self.od[4][i], self.od[5][i]]
     }
 }
 
