@@ -162,6 +162,35 @@ fn sample_seed(key: u64, pixel: u64, index: u64) -> (u64, u64) {
     (mix(key, index), pixel)
 }
 
+/// [`sample_seed`] of `count` samples in a row whose pixels have `spp`
+/// samples each, from sample `start.1` of pixel `start.0` on (pixel `p`'s
+/// `(pixel, key)` in `keys[p]`; sample `k`'s index `first + k`), appended
+/// to `out`: one pixel's run at a time, each at SIMD width (three 64-bit
+/// products per sample).
+fn sample_seeds(
+    keys: &[(u64, u64)],
+    (mut p, mut k): (usize, usize),
+    (count, spp): (usize, usize),
+    first: u64,
+    out: &mut Vec<(u64, u64)>,
+) {
+    crate::simd::dispatch(
+        #[inline(always)]
+        |_| {
+            let mut left = count;
+            while left > 0 {
+                let run = (spp - k).min(left);
+                let Some(&(pixel, key)) = keys.get(p) else {
+                    return;
+                };
+                let from = first + k as u64;
+                out.extend((from..from + run as u64).map(|i| sample_seed(key, pixel, i)));
+                (p, k, left) = (p + 1, 0, left - run);
+            }
+        },
+    );
+}
+
 /// State shared with whoever watches a render from another thread.
 #[derive(Debug, Default)]
 pub struct Progress {
@@ -285,10 +314,8 @@ impl Batch {
                 // seeds it; the paths go on from where these draws leave
                 // it.
                 self.starts.clear();
-                self.starts.extend(batch.map(|(p, k)| {
-                    let (pixel, key) = keys[p];
-                    sample_seed(key, pixel, index(k))
-                }));
+                let count = (first + BATCH).min(n) - first;
+                sample_seeds(&keys, start, (count, spp), index(0), &mut self.starts);
                 self.drawn.draw_fresh(&self.starts, &camera)?;
                 self.resume.extend_from_slice(&self.drawn.generators);
             } else {

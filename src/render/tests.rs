@@ -946,3 +946,28 @@ fn a_row_s_samples_counted_along_are_its_quotients_and_remainders() {
         }
     }
 }
+
+/// The seeds of a batch's samples, pixel run by pixel run, are those of
+/// each sample alone: batches that start inside a pixel, end inside
+/// another, or hold one sample per pixel.
+#[test]
+fn sample_seeds_are_each_samples_seed() {
+    let keys: Vec<(u64, u64)> = (0..6).map(|p| (100 + p, super::mix(7, p))).collect();
+    for (start, count, spp) in [
+        ((0, 0), 24, 4),
+        ((1, 3), 9, 5),
+        ((2, 0), 3, 1),
+        ((0, 7), 1, 8),
+    ] {
+        let mut seeds = Vec::new();
+        super::sample_seeds(&keys, start, (count, spp), 40, &mut seeds);
+        let mut want = Vec::new();
+        let mut at = start;
+        for _ in 0..count {
+            let (pixel, key) = keys[at.0];
+            want.push(super::sample_seed(key, pixel, 40 + at.1 as u64));
+            at = super::next_sample(at, spp);
+        }
+        assert_eq!(seeds, want, "start {start:?}, {count} samples, spp {spp}");
+    }
+}
