@@ -482,7 +482,7 @@ fn transpose_columns_to_rows<T: Copy, const M: usize>(
 /// ([`lanes::vector_pairs_to_columns`]); returns whether it ran (not at
 /// other levels, where the caller's own loop is as good).
 #[inline(always)]
-pub fn vector_pairs_to_columns<T, const B: usize>(
+pub(crate) fn vector_pairs_to_columns<T, const B: usize>(
     items: &[T],
     pair: impl Fn(&T) -> [glam::Vec3A; 2],
     columns: &mut [[f32; B]; 6],
