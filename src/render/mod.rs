@@ -163,15 +163,15 @@ fn sample_seed(key: u64, pixel: u64, index: u64) -> (u64, u64) {
 }
 
 /// [`sample_seed`] of `count` samples in a row whose pixels have `spp`
-/// samples each, from sample `start.1` of pixel `start.0` on (pixel `p`'s
-/// `(pixel, key)` in `keys[p]`; sample `k`'s index `first + k`), appended
-/// to `out`: one pixel's run at a time, each at SIMD width (three 64-bit
-/// products per sample).
+/// samples each, from sample `start.1 < spp` of pixel `start.0` on (pixel
+/// `p`'s `(pixel, key)` in `keys[p]`; sample `k`'s index `first_index +
+/// k`), appended to `out`: one pixel's run at a time, each at SIMD width
+/// (three 64-bit products per sample).
 fn sample_seeds(
     keys: &[(u64, u64)],
     (mut p, mut k): (usize, usize),
     (count, spp): (usize, usize),
-    first: u64,
+    first_index: u64,
     out: &mut Vec<(u64, u64)>,
 ) {
     crate::simd::dispatch(
@@ -181,9 +181,10 @@ fn sample_seeds(
             while left > 0 {
                 let run = (spp - k).min(left);
                 let Some(&(pixel, key)) = keys.get(p) else {
+                    debug_assert!(false, "samples past the row's pixels");
                     return;
                 };
-                let from = first + k as u64;
+                let from = first_index + k as u64;
                 out.extend((from..from + run as u64).map(|i| sample_seed(key, pixel, i)));
                 (p, k, left) = (p + 1, 0, left - run);
             }
@@ -303,8 +304,9 @@ impl Batch {
         // first) and the number in it of the batch's first sample.
         for first in (0..n).step_by(BATCH) {
             let start = (first / spp, first % spp);
+            let count = (first + BATCH).min(n) - first;
             let mut at = start;
-            let batch = (0..(first + BATCH).min(n) - first).map(|_| {
+            let batch = (0..count).map(|_| {
                 let sample = at;
                 at = next_sample(at, spp);
                 sample
@@ -314,7 +316,6 @@ impl Batch {
                 // seeds it; the paths go on from where these draws leave
                 // it.
                 self.starts.clear();
-                let count = (first + BATCH).min(n) - first;
                 sample_seeds(&keys, start, (count, spp), index(0), &mut self.starts);
                 self.drawn.draw_fresh(&self.starts, &camera)?;
                 self.resume.extend_from_slice(&self.drawn.generators);

@@ -274,12 +274,18 @@ pub(super) fn rows_to_columns_transposed<F: Copy, const K: usize, const B: usize
     }
 }
 
+/// Whether [`vector_pairs_to_columns`] handles blocks of `b` items.
+pub(super) const fn transposes_pairs(b: usize) -> bool {
+    b.is_multiple_of(LANES)
+}
+
 /// `columns[k][i]` = component `k` of `pair(items[i])[0]` for `k < 3`, and
 /// component `k − 3` of `pair(items[i])[1]` for `k >= 3`; zeros for `i` at
 /// or past `items.len()`. Each group of 16 items as four vectors of four
 /// items' three-vectors (item `4q + j` in quarter `q` of vector `j`), then
-/// a 4 × 4 transpose within each quarter: 24 inserts and 14 shuffles per
-/// 16 items. The compiler's own form of this loop gathers each column (six
+/// a 4 × 4 transpose within each quarter: 32 inserts (8 of them into
+/// zeroed vectors) and 14 shuffles per 16 items. Does nothing unless
+/// [`transposes_pairs`] holds for `B`. The compiler's own form of this loop gathers each column (six
 /// gathers per 16 items), and copies a block's last items one value at a
 /// time.
 #[target_feature(enable = "avx512f")]
@@ -289,7 +295,7 @@ pub(super) fn vector_pairs_to_columns<T, const B: usize>(
     pair: impl Fn(&T) -> [Vec3A; 2],
     columns: &mut [[f32; B]; 6],
 ) {
-    if !B.is_multiple_of(LANES) {
+    if !transposes_pairs(B) {
         return;
     }
     for g in 0..B / LANES {

@@ -490,7 +490,7 @@ pub(crate) fn vector_pairs_to_columns<T, const B: usize>(
 ) -> bool {
     on_avx512!(
         level,
-        B.is_multiple_of(16),
+        lanes::transposes_pairs(B),
         lanes::vector_pairs_to_columns(items, pair, columns)
     );
     let _ = (items, pair, columns, level);
