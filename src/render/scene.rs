@@ -281,11 +281,25 @@ impl Scene {
         if hit.primitive as usize >= self.accel.primitives().len() {
             return self.moving_surface(ray, hit, tau);
         }
+        self.still_surface(ray, hit)
+    }
+
+    /// [`Scene::surface`] of a hit on a shape that stays (any hit, in a
+    /// scene without moving shapes: [`Scene::has_movers`]).
+    #[inline(always)]
+    pub fn still_surface(&self, ray: &Ray, hit: &Hit) -> (u32, SurfacePoint) {
         let primitive = &self.accel.primitives()[hit.primitive as usize];
         (
             self.accel.shape_of(hit.primitive),
             primitive.point(ray.o + ray.d * hit.t, hit.bary, self.accel.meshes()),
         )
+    }
+
+    /// Whether some shape moves during the shutter (its hits then need
+    /// [`Scene::surface`]'s time).
+    #[inline]
+    pub fn has_movers(&self) -> bool {
+        !self.movers.is_empty()
     }
 
     /// The primitives of the area lights (those of nonzero power), when
