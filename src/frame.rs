@@ -48,15 +48,24 @@ impl<F: Real> Frame<F> {
     /// (`n_x² + n_y² ≤ 10⁻¹²`).
     #[inline]
     pub fn azimuthal(n: V3<F>) -> Self {
+        Self::around(n, true)
+    }
+
+    /// [`Frame::azimuthal`] of `n` where `azimuthal` holds, else
+    /// [`Frame::from_normal`]: both computed and one selected, without a
+    /// branch, for kernels over many normals at SIMD width.
+    #[inline(always)]
+    pub fn around(n: V3<F>, azimuthal: bool) -> Self {
+        let normal = Self::from_normal(n);
         let r2 = n[0] * n[0] + n[1] * n[1];
-        if r2.partial_cmp(&F::c(1e-12)) != Some(std::cmp::Ordering::Greater) {
-            return Self::from_normal(n);
-        }
         let inv = F::one() / r2.sqrt();
         let s = [-n[1] * inv, n[0] * inv, F::zero()];
+        let t = cross(n, s);
+        // (A NaN `r2` is not above the bound either.)
+        let turns = azimuthal & (r2 > F::c(1e-12));
         Frame {
-            s,
-            t: cross(n, s),
+            s: if turns { s } else { normal.s },
+            t: if turns { t } else { normal.t },
             n,
         }
     }

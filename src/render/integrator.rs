@@ -241,16 +241,31 @@ pub(super) fn shading_frame(
     from: Vec3A,
     sampler: Sampler,
 ) -> Frame<f32> {
-    let ns = if scene.material(shape).two_sided && ns.dot(from) < 0.0 {
+    let n = facing_normal(scene, shape, ns, from).to_array();
+    if turns_with_azimuth(scene, shape, sampler) {
+        Frame::azimuthal(n)
+    } else {
+        Frame::from_normal(n)
+    }
+}
+
+/// The normal of [`shading_frame`]: `ns` of a point of `shape`, turned
+/// toward `from` when its material is two-sided.
+#[inline]
+pub(super) fn facing_normal(scene: &Scene, shape: u32, ns: Vec3A, from: Vec3A) -> Vec3A {
+    if scene.material(shape).two_sided && ns.dot(from) < 0.0 {
         -ns
     } else {
         ns
-    };
-    if sampler != Sampler::Independent && scene.is_sphere(shape) {
-        Frame::azimuthal(ns.to_array())
-    } else {
-        Frame::from_normal(ns.to_array())
     }
+}
+
+/// Whether [`shading_frame`] at a point of `shape` under `sampler` is
+/// [`Frame::azimuthal`] (a sphere's, under the samplers other than the
+/// independent one) rather than [`Frame::from_normal`].
+#[inline]
+pub(super) fn turns_with_azimuth(scene: &Scene, shape: u32, sampler: Sampler) -> bool {
+    sampler != Sampler::Independent && scene.is_sphere(shape)
 }
 
 /// Whether nothing blocks the segment from `o` to `end` at time `tau`

@@ -1,23 +1,27 @@
 //! The shading of a bounce's paths, in three steps over the whole bounce:
 //!
 //! ```text
-//! begin   each path at its hit: its emission, its shading frame, and
-//!         its row of the BSDF kernel (the view's wi, the light sample's
-//!         direction, the BSDF sample's numbers, the BRDF's terms)
-//! kernel  every row at SIMD width (bsdf_kernel): the BRDF and its
-//!         density toward the light sample, and the BSDF sample
+//! begin   each path at its hit: its emission, and its row of the BSDF
+//!         kernel (the shading normal, the view's direction, the light
+//!         sample's direction, density and radiance, the BSDF sample's
+//!         numbers, the BRDF's terms)
+//! kernel  every row at SIMD width (bsdf_kernel): the shading frame, the
+//!         BRDF and its density toward the light sample and the light
+//!         that sample carries (MIS weight, cosine), and the BSDF sample
+//!         with its direction in world space
 //! finish  each path: its light sample's light kept with its shadow ray,
 //!         its next ray, roulette
 //! ```
 //!
-//! The kernel holds what costs most per vertex (three powers, two sines
-//! and cosines, the mirror's frame), which one path at a time would
-//! compute in scalar code. It computes both parts' directions and selects,
-//! where one path at a time draws only the chosen part's direction: the
-//! same bits (`PhongView::eval_pdf_one`, `PhongView::sample_one`). The
-//! rows of BRDFs without a glossy part (diffuse surfaces) go to a kernel
-//! of their own, without the lobe and the glossy direction (one sine and
-//! cosine, no power): the same bits again
+//! The kernel holds what costs most per vertex (the frame's division, three
+//! powers, two sines and cosines, the mirror's frame, the MIS weight's
+//! divisions, the next direction's square root), which one path at a time
+//! would compute in scalar code. It computes both parts' directions and
+//! selects, where one path at a time draws only the chosen part's
+//! direction: the same bits (`PhongView::eval_pdf_one`,
+//! `PhongView::sample_one`). The rows of BRDFs without a glossy part
+//! (diffuse surfaces) go to a kernel of their own, without the lobe and the
+//! glossy direction (one sine and cosine, no power): the same bits again
 //! (`PhongView::eval_pdf_diffuse`, `PhongView::sample_diffuse`).
 
 use glam::Vec3A;
@@ -26,26 +30,30 @@ use super::{Path, Unshadowed};
 use crate::error::Result;
 use crate::frame::Frame;
 use crate::math::V3;
+use crate::mis::Heuristic;
 use crate::phong::{PhongView, VIEW_TERMS};
 use crate::render::integrator::{
-    Integrator, Settings, Strategy, add_scaled, dims, emission_weight, ends_after_light, mul,
-    offset, shading_frame, shadow_ray,
+    Integrator, Settings, Strategy, add_scaled, dims, emission_weight, ends_after_light,
+    facing_normal, mul, offset, shadow_ray, turns_with_azimuth,
 };
 use crate::render::numbers::Numbers;
 use crate::render::scene::{LightSample, Scene};
 use crate::render::shape::{Ray, SurfacePoint};
 use crate::simd;
 
-/// Numbers per row into [`bsdf_kernel`]: `wi` in the shading frame (3),
-/// the light sample's direction there (3, zeros without one), the BSDF
-/// sample's numbers `u0, u1, part` (3) and the BRDF's
+/// Numbers per row into [`bsdf_kernel`], all in world space: the shading
+/// normal (3) and whether the frame turns with the azimuth (1: 1 or 0,
+/// [`Frame::around`]), the view's direction `wi` (3), the light sample's
+/// direction (3), density and radiance (1 + 3; zeros without one), the
+/// BSDF sample's numbers `u0, u1, part` (3) and the BRDF's
 /// [`crate::phong::Phong::view_terms`].
-pub(super) const BSDF_IN: usize = 9 + VIEW_TERMS;
+pub(super) const BSDF_IN: usize = 17 + VIEW_TERMS;
 
-/// Numbers per row out of [`bsdf_kernel`]: `f_r` toward the light sample
-/// (3) and the BSDF's density there, then the BSDF sample's direction (3),
-/// density and weight (3).
-pub(super) const BSDF_OUT: usize = 11;
+/// Numbers per row out of [`bsdf_kernel`]: the light sample's light
+/// `f_r · L` (3) and its scale `w |cos θ_l| / p_l` (1), whether `f_r > 0`
+/// in some channel (1: 1 or 0), then the BSDF sample's direction in world
+/// space (3), density and weight (3).
+pub(super) const BSDF_OUT: usize = 12;
 
 /// What [`Bounce::finish`] needs of a path's [`Bounce::begin`].
 #[derive(Clone, Copy, Debug)]
@@ -53,11 +61,6 @@ pub(super) struct Begun {
     /// The path's index at the bounce's start (of its surface, light
     /// sample and numbers drawn beforehand).
     pub k: u32,
-    /// Its shading frame.
-    pub frame: Frame<f32>,
-    /// The cosine of its light sample's direction with the shading
-    /// normal (0 without one).
-    pub wl_z: f32,
     /// Whether it ends after its light sample (emitter sampling, whose
     /// next vertex's emission would not count).
     pub ends: bool,
@@ -66,44 +69,86 @@ pub(super) struct Begun {
     pub diffuse: bool,
 }
 
-/// The row of [`BSDF_IN`] numbers of [`bsdf_kernel`] for the view from
-/// `wi` of the BRDF of `terms`, the light sample's direction `wl` and the
-/// BSDF sample's numbers `u` and `part` (all in the shading frame).
+/// The row of [`BSDF_IN`] numbers of [`bsdf_kernel`] at a vertex whose
+/// shading normal is `n` (its frame [`Frame::around`] `n` and
+/// `azimuthal`), seen along `wi`, with the light sample's direction,
+/// density and radiance `light` (if any), the BSDF sample's numbers `u`
+/// and `part`, and the BRDF of `terms`.
 #[inline]
 pub(super) fn bsdf_row(
-    (wi, wl): (V3<f32>, V3<f32>),
+    ((n, azimuthal), wi): ((V3<f32>, bool), V3<f32>),
+    light: Option<(V3<f32>, f32, [f32; 3])>,
     (u, part): ([f32; 2], f32),
     terms: &[f32; VIEW_TERMS],
 ) -> [f32; BSDF_IN] {
+    let (wl, pdf, radiance) = light.unwrap_or(([0.0; 3], 0.0, [0.0; 3]));
     let mut row = [0.0; BSDF_IN];
-    row[..3].copy_from_slice(&wi);
-    row[3..6].copy_from_slice(&wl);
-    row[6..9].copy_from_slice(&[u[0], u[1], part]);
-    row[9..].copy_from_slice(terms);
+    row[..3].copy_from_slice(&n);
+    row[3] = if azimuthal { 1.0 } else { 0.0 };
+    row[4..7].copy_from_slice(&wi);
+    row[7..10].copy_from_slice(&wl);
+    row[10] = pdf;
+    row[11..14].copy_from_slice(&radiance);
+    row[14..17].copy_from_slice(&[u[0], u[1], part]);
+    row[17..].copy_from_slice(terms);
     row
 }
 
 /// The BSDF's part of a vertex's shading, for one row of [`BSDF_IN`]
-/// numbers ([`bsdf_row`]): with `LIGHT`, `(f_r(wi, wl), p(wl))` toward
-/// the light sample's direction `wl` ([`PhongView::eval_pdf`]); with
-/// `SAMPLE`, the sample [`PhongView::sample`] of `[u0, u1, part]`; as
-/// [`BSDF_OUT`] numbers (zeros for the part not asked for: under BSDF
-/// sampling the light's power is skipped, and where every path ends
-/// after its light sample, the sample's two). `GLOSSY` is the general
-/// kernel, right for every row; without it, for rows of BRDFs without a
-/// glossy part only, by their diffuse forms (no lobe: the same bits,
-/// [`PhongView::eval_pdf_diffuse`], [`PhongView::sample_diffuse`]).
-/// Branch-free, for [`crate::simd::map_rows`].
+/// numbers ([`bsdf_row`]), in the shading frame [`Frame::around`] the
+/// row's normal: with `LIGHT`, toward the light sample's direction `wl`
+/// (density `p_l`, radiance `L`), `f_r(wi, wl) · L` and
+/// `w |cos θ_l| / p_l`, where `(f_r, p)` is [`PhongView::eval_pdf`] and the
+/// MIS weight `w` is `mis`'s `w(p_l, p)` (1 without MIS); with `SAMPLE`,
+/// the sample [`PhongView::sample`] of `[u0, u1, part]`, its direction
+/// taken to world space and normalised; as [`BSDF_OUT`] numbers (zeros for
+/// the part not asked for: under BSDF sampling the light's power is
+/// skipped, and where every path ends after its light sample, the
+/// sample's two). `GLOSSY` is the general kernel, right for every row;
+/// without it, for rows of BRDFs without a glossy part only, by their
+/// diffuse forms (no lobe: the same bits, [`PhongView::eval_pdf_diffuse`],
+/// [`PhongView::sample_diffuse`]). Branch-free, for
+/// [`crate::simd::map_rows`].
 #[inline(always)]
 pub(super) fn bsdf_kernel<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: bool>(
     row: [f32; BSDF_IN],
+    mis: Option<Heuristic>,
 ) -> [f32; BSDF_OUT] {
-    let [w0, w1, w2, l0, l1, l2, u0, u1, part, terms @ ..] = row;
-    let view = PhongView::from_terms([w0, w1, w2], terms);
-    let ([f0, f1, f2], pdf_l) = match (LIGHT, GLOSSY) {
-        (false, _) => ([0.0; 3], 0.0),
-        (true, true) => view.eval_pdf([l0, l1, l2]),
-        (true, false) => view.eval_pdf_diffuse([l0, l1, l2]),
+    let [
+        n0,
+        n1,
+        n2,
+        azimuthal,
+        w0,
+        w1,
+        w2,
+        l0,
+        l1,
+        l2,
+        pdf_l,
+        e0,
+        e1,
+        e2,
+        u0,
+        u1,
+        part,
+        terms @ ..,
+    ] = row;
+    let frame = Frame::around([n0, n1, n2], azimuthal > 0.0);
+    let view = PhongView::from_terms(frame.to_local([w0, w1, w2]), terms);
+    let ([c0, c1, c2], scale, lit) = if LIGHT {
+        let wl = frame.to_local([l0, l1, l2]);
+        let (f, pdf) = if GLOSSY {
+            view.eval_pdf(wl)
+        } else {
+            view.eval_pdf_diffuse(wl)
+        };
+        let w = mis.map_or(1.0, |h| h.weight(pdf_l, pdf));
+        let lit = (f[0] > 0.0) | (f[1] > 0.0) | (f[2] > 0.0);
+        let lit = if lit { 1.0 } else { 0.0 };
+        (mul(f, [e0, e1, e2]), w * wl[2].abs() / pdf_l, lit)
+    } else {
+        ([0.0; 3], 0.0, 0.0)
     };
     let ([x, y, z], pdf, [r, g, b]) = if SAMPLE {
         let s = if GLOSSY {
@@ -111,11 +156,14 @@ pub(super) fn bsdf_kernel<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: b
         } else {
             view.sample_diffuse([u0, u1])
         };
-        (s.wo, s.pdf, s.weight)
+        // Normalised as glam's `Vec3A::normalize`: the same bits.
+        let [x, y, z] = frame.to_world(s.wo);
+        let length = (x * x + y * y + z * z).sqrt();
+        ([x / length, y / length, z / length], s.pdf, s.weight)
     } else {
         ([0.0; 3], 0.0, [0.0; 3])
     };
-    [f0, f1, f2, pdf_l, x, y, z, pdf, r, g, b]
+    [c0, c1, c2, scale, lit, x, y, z, pdf, r, g, b]
 }
 
 /// A bounce's rows of [`bsdf_kernel`] and its rows out, in two groups of
@@ -171,32 +219,37 @@ impl KernelRows {
     /// `depth`: the light's part where the strategy draws light samples,
     /// the BSDF sample's where the paths go on after them.
     pub fn run(&mut self, settings: &Settings, depth: u32) {
-        fn map<const LIGHT: bool, const SAMPLE: bool>(d: &mut Rows, g: &mut Rows) {
-            fn one<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: bool>(group: &mut Rows) {
+        type Mis = Option<Heuristic>;
+        fn map<const LIGHT: bool, const SAMPLE: bool>(d: &mut Rows, g: &mut Rows, mis: Mis) {
+            fn one<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: bool>(
+                group: &mut Rows,
+                mis: Mis,
+            ) {
                 // Through a closure marked inline: given the function
                 // itself, the kernel ran 50 % slower (demo BSDF sampling
                 // 20.4 -> 30.6 ms).
                 let kernel = {
                     #[inline(always)]
-                    |row| bsdf_kernel::<LIGHT, SAMPLE, GLOSSY>(row)
+                    |row| bsdf_kernel::<LIGHT, SAMPLE, GLOSSY>(row, mis)
                 };
                 group.out.clear();
                 group.out.resize(group.rows.len(), [0.0; BSDF_OUT]);
                 simd::map_rows(&mut group.out, &group.rows, &kernel, |_| true, false);
             }
-            one::<LIGHT, SAMPLE, false>(d);
-            one::<LIGHT, SAMPLE, true>(g);
+            one::<LIGHT, SAMPLE, false>(d, mis);
+            one::<LIGHT, SAMPLE, true>(g, mis);
         }
+        let mis = (settings.strategy == Strategy::Mis).then_some(settings.heuristic);
         let light = settings.strategy != Strategy::Bsdf;
         let sample = !ends_after_light(settings, depth);
         let (d, g) = (&mut self.diffuse, &mut self.glossy);
         match (light, sample) {
-            (true, true) => map::<true, true>(d, g),
-            (true, false) => map::<true, false>(d, g),
+            (true, true) => map::<true, true>(d, g, mis),
+            (true, false) => map::<true, false>(d, g, mis),
             (false, _) => {
                 // Under BSDF sampling no path ends after a light sample.
                 debug_assert!(sample);
-                map::<false, true>(d, g);
+                map::<false, true>(d, g, mis);
             }
         }
     }
@@ -272,10 +325,16 @@ impl Bounce<'_> {
         if depth + 1 >= max_depth {
             return None;
         }
-        let frame = shading_frame(scene, shape, sp.ns, wi, numbers.stream.sampler());
-        let wl = match ls {
-            Some(ls) if settings.strategy != Strategy::Bsdf => frame.to_local(ls.d.to_array()),
-            _ => [0.0; 3],
+        let sampler = numbers.stream.sampler();
+        let normal = (
+            facing_normal(scene, shape, sp.ns, wi).to_array(),
+            turns_with_azimuth(scene, shape, sampler),
+        );
+        let light = match ls {
+            Some(ls) if settings.strategy != Strategy::Bsdf => {
+                Some((ls.d.to_array(), ls.pdf, ls.radiance))
+            }
+            _ => None,
         };
         let ends = ends_after_light(settings, depth);
         // The direction from the 2D request, the part from the 1D one
@@ -287,73 +346,53 @@ impl Bounce<'_> {
             let u = numbers.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
             (u, numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT)))
         };
-        let wi_local = frame.to_local(wi.to_array());
         let bsdf = &scene.material(shape).bsdf;
-        let row = bsdf_row((wi_local, wl), bsdf_numbers, &bsdf.view_terms());
+        let row = bsdf_row(
+            (normal, wi.to_array()),
+            light,
+            bsdf_numbers,
+            &bsdf.view_terms(),
+        );
         let begun = Begun {
             k: k as u32,
-            frame,
-            wl_z: wl[2],
             ends,
             diffuse: !bsdf.is_glossy(),
         };
         Some((begun, row))
     }
 
-    /// The light sample `ls` seen from the shading point `sp` of `path`,
-    /// where the cosine of its direction is `wl_z`, the BRDF toward it `f`
-    /// and its density `pdf_wl` (the kernel's): its light (BSDF, cosine,
-    /// MIS weight) kept in `shadows` with its shadow ray when it carries
-    /// any.
-    #[inline]
-    fn connect(
-        &self,
-        path: &Path,
-        sp: &SurfacePoint,
-        (wl_z, f, pdf_wl): (f32, [f32; 3], f32),
-        ls: &LightSample,
-        (shadows, shadow_rays): (&mut Vec<Unshadowed>, &mut Vec<Ray>),
-    ) {
-        if f.iter().any(|&v| v > 0.0) {
-            let w = if self.settings.strategy == Strategy::Mis {
-                self.settings.weight(ls.pdf, pdf_wl)
-            } else {
-                1.0
-            };
-            shadows.push(Unshadowed {
-                slot: path.slot,
-                time: path.time,
-                beta: path.beta,
-                fc: mul(f, ls.radiance),
-                s: w * wl_z.abs() / ls.pdf,
-            });
-            shadow_rays.push(shadow_ray(sp.p, sp.ng, ls));
-        }
-    }
-
     /// The last step of shading a path's vertex (at `sp`, begun as
     /// `begun`, with the kernel's numbers `out`): its light sample `ls`
-    /// connected, and the path moved on along its BSDF sample, after
-    /// roulette (whose number `roulette` draws for the path and a
-    /// dimension). The path's next ray when it goes on (also its
-    /// `ray`: handed back by value, as the caller stores it too,
-    /// because reading it back from the path would wait on the stores
-    /// that just wrote it).
+    /// connected (its light kept in `shadows` with its shadow ray, when the
+    /// BRDF toward it is not zero), and the path moved on along its BSDF
+    /// sample, after roulette (whose number `roulette` draws for the path
+    /// and a dimension). The path's next ray when it goes on (also its
+    /// `ray`: handed back by value, as the caller stores it too, because
+    /// reading it back from the path would wait on the stores that just
+    /// wrote it).
     #[inline]
     pub fn finish(
         &self,
         path: &mut Path,
         (begun, sp, out): (&Begun, &SurfacePoint, &[f32; BSDF_OUT]),
         ls: Option<&LightSample>,
-        shadows: (&mut Vec<Unshadowed>, &mut Vec<Ray>),
+        (shadows, shadow_rays): (&mut Vec<Unshadowed>, &mut Vec<Ray>),
         roulette: impl FnOnce(&mut Path, u32) -> f32,
     ) -> Option<Ray> {
         let settings = self.settings;
-        let [f0, f1, f2, pdf_wl, x, y, z, pdf, r, g, b] = *out;
+        let [c0, c1, c2, scale, lit, x, y, z, pdf, r, g, b] = *out;
         if settings.strategy != Strategy::Bsdf
+            && lit > 0.0
             && let Some(ls) = ls
         {
-            self.connect(path, sp, (begun.wl_z, [f0, f1, f2], pdf_wl), ls, shadows);
+            shadows.push(Unshadowed {
+                slot: path.slot,
+                time: path.time,
+                beta: path.beta,
+                fc: [c0, c1, c2],
+                s: scale,
+            });
+            shadow_rays.push(shadow_ray(sp.p, sp.ng, ls));
         }
         if begun.ends || [r, g, b].iter().all(|&v| v <= 0.0) {
             return None;
@@ -361,7 +400,7 @@ impl Bounce<'_> {
         let depth = path.depth;
         path.beta = mul(path.beta, [r, g, b]);
         path.bsdf_pdf = pdf;
-        let d = Vec3A::from(begun.frame.to_world([x, y, z])).normalize();
+        let d = Vec3A::new(x, y, z);
         path.from = sp.p;
         let ray = Ray {
             o: offset(sp.p, sp.ng, d),

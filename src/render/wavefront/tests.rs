@@ -142,14 +142,14 @@ fn a_path_in_a_batch_is_the_path_alone() {
 /// the two groups mixed, and the kernel without the lobe gives the
 /// general kernel's bits for every BRDF without a glossy part (exponents
 /// 0 and the largest, both selections, `ρs = −0`, a black one; directions
-/// above and below the surface; the largest `part` below 1), in each of
-/// the three forms a bounce runs.
+/// above and below the surface; the largest `part` below 1; frames of the
+/// normal and of the azimuth, about normals at and near the poles; rows
+/// without a light sample), in each of the three forms a bounce runs.
 #[test]
 fn kernel_rows_give_each_path_the_general_kernel_s_bits() {
-    use crate::frame::Frame;
     use crate::phong::MAX_EXPONENT;
     use crate::warp::square_to_uniform_sphere;
-    use shade::{BSDF_IN, BSDF_OUT, bsdf_kernel, bsdf_row};
+    use shade::{BSDF_IN, bsdf_row};
     let phong = |d, s, n, selection| Phong::new(d, s, n, selection).unwrap();
     let brdfs = [
         phong([0.6; 3], [0.0; 3], 0.0, Selection::Max),
@@ -167,11 +167,18 @@ fn kernel_rows_give_each_path_the_general_kernel_s_bits() {
     ];
     let mut rng = Rng::new(5, 9);
     let mut direction = || square_to_uniform_sphere::<f32>([rng.next_float(), rng.next_float()]);
+    let poles = [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1e-7, 0.0, 1.0]];
     // Rows for 300 paths, of the BRDFs in turn (diffuse and glossy
-    // interleaved), every 7th with the largest part below 1.
+    // interleaved), every 7th with the largest part below 1, every 11th
+    // without a light sample, every 13th about a pole.
     let paths: Vec<(Begun, [f32; BSDF_IN])> = (0..300)
         .map(|k| {
             let bsdf = &brdfs[k % brdfs.len()];
+            let n = if k % 13 == 5 {
+                poles[k % 3]
+            } else {
+                direction()
+            };
             let (wi, wl) = (direction(), direction());
             let [u0, u1, part] = direction().map(|v| 0.5 * (v + 1.0));
             let part = if k % 7 == 3 {
@@ -179,11 +186,15 @@ fn kernel_rows_give_each_path_the_general_kernel_s_bits() {
             } else {
                 part.min(0.99)
             };
-            let row = bsdf_row((wi, wl), ([u0, u1], part), &bsdf.view_terms());
+            let light = (k % 11 != 4).then_some((wl, 0.1 + u0, [u1, 2.0 * u0, 0.5]));
+            let row = bsdf_row(
+                ((n, k % 2 == 0), wi),
+                light,
+                ([u0, u1], part),
+                &bsdf.view_terms(),
+            );
             let begun = Begun {
                 k: k as u32,
-                frame: Frame::from_normal([0.0, 0.0, 1.0]),
-                wl_z: wl[2],
                 ends: false,
                 diffuse: !bsdf.is_glossy(),
             };
@@ -192,24 +203,16 @@ fn kernel_rows_give_each_path_the_general_kernel_s_bits() {
         .collect();
     let (begun, rows): (Vec<Begun>, Vec<_>) = paths.iter().copied().unzip();
     assert!(begun.iter().any(|b| b.diffuse) && begun.iter().any(|b| !b.diffuse));
-    // The general kernel over every row, in the paths' order.
-    fn general<const LIGHT: bool, const SAMPLE: bool>(
-        rows: &[[f32; BSDF_IN]],
-    ) -> Vec<[f32; BSDF_OUT]> {
-        let kernel = {
-            #[inline(always)]
-            |row| bsdf_kernel::<LIGHT, SAMPLE, true>(row)
-        };
-        let mut out = vec![[0.0; BSDF_OUT]; rows.len()];
-        crate::simd::map_rows(&mut out, rows, &kernel, |_| true, false);
-        out
-    }
     // (light, sample): MIS with a next bounce, emitter sampling at the
     // last (no BSDF sample), BSDF sampling (no light sample).
+    let power = Some(crate::mis::Heuristic::Power);
     let forms = [
-        (Strategy::Mis, general::<true, true>(&rows)),
-        (Strategy::Emitter, general::<true, false>(&rows)),
-        (Strategy::Bsdf, general::<false, true>(&rows)),
+        (Strategy::Mis, general_kernel::<true, true>(&rows, power)),
+        (
+            Strategy::Emitter,
+            general_kernel::<true, false>(&rows, None),
+        ),
+        (Strategy::Bsdf, general_kernel::<false, true>(&rows, None)),
     ];
     for (strategy, expected) in forms {
         let s = settings(Integrator::Direct, strategy);
@@ -230,6 +233,87 @@ fn kernel_rows_give_each_path_the_general_kernel_s_bits() {
             );
         }
         // Not all zeros: the light's part and the sample's are there.
-        assert!(expected.iter().filter(|o| o[3] > 0.0 || o[7] > 0.0).count() > 100);
+        assert!(expected.iter().filter(|o| o[3] > 0.0 || o[8] > 0.0).count() > 100);
     }
+}
+
+/// [`shade::bsdf_kernel`] of every row (the general kernel), in order,
+/// with the MIS heuristic `mis`.
+fn general_kernel<const LIGHT: bool, const SAMPLE: bool>(
+    rows: &[[f32; shade::BSDF_IN]],
+    mis: Option<crate::mis::Heuristic>,
+) -> Vec<[f32; shade::BSDF_OUT]> {
+    let kernel = {
+        #[inline(always)]
+        |row| shade::bsdf_kernel::<LIGHT, SAMPLE, true>(row, mis)
+    };
+    let mut out = vec![[0.0; shade::BSDF_OUT]; rows.len()];
+    crate::simd::map_rows(&mut out, rows, &kernel, |_| true, false);
+    out
+}
+
+/// The kernel, at SIMD width, gives the bits one path at a time gets from
+/// its shading frame (of the normal, or of the azimuth, also at and near
+/// the poles), the BRDF's view, evaluation and sample in that frame, the
+/// power heuristic's weight and the direction taken back to world space
+/// and normalised by glam.
+#[test]
+fn the_kernel_gives_each_path_s_frame_light_and_direction() {
+    use crate::frame::Frame;
+    use crate::mis::Heuristic;
+    use crate::warp::square_to_uniform_sphere;
+    use shade::bsdf_row;
+    let bsdf = Phong::new([0.5, 0.4, 0.3], [0.3, 0.2, 0.1], 20.0, Selection::Max).unwrap();
+    let mut rng = Rng::new(8, 3);
+    let mut next = || rng.next_float();
+    let poles = [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.0, 1e-7, -1.0]];
+    let mut checked = [0; 2];
+    for k in 0..200 {
+        let mut direction = || square_to_uniform_sphere::<f32>([next(), next()]);
+        let n = if k % 10 == 0 {
+            poles[k % 3]
+        } else {
+            direction()
+        };
+        let (wi, wl) = (direction(), direction());
+        let azimuthal = k % 2 == 1;
+        let u = [next(), next(), next()];
+        let (pdf_l, radiance) = (0.2 + u[0], [1.0, u[1], 3.0]);
+        let row = bsdf_row(
+            ((n, azimuthal), wi),
+            Some((wl, pdf_l, radiance)),
+            ([u[0], u[1]], u[2]),
+            &bsdf.view_terms(),
+        );
+        let out = general_kernel::<true, true>(&[row], Some(Heuristic::Power))[0];
+        let frame = if azimuthal {
+            Frame::azimuthal(n)
+        } else {
+            Frame::from_normal(n)
+        };
+        let view = bsdf.view(frame.to_local(wi));
+        let local = frame.to_local(wl);
+        let (f, pdf) = view.eval_pdf(local);
+        let w = Heuristic::Power.weight(pdf_l, pdf);
+        let s = view.sample(u);
+        let d = Vec3A::from(frame.to_world(s.wo)).normalize();
+        let lit = if f.iter().any(|&v| v > 0.0) { 1.0 } else { 0.0 };
+        let want = [
+            f[0] * radiance[0],
+            f[1] * radiance[1],
+            f[2] * radiance[2],
+            w * local[2].abs() / pdf_l,
+            lit,
+            d.x,
+            d.y,
+            d.z,
+            s.pdf,
+            s.weight[0],
+            s.weight[1],
+            s.weight[2],
+        ];
+        assert_eq!(out.map(f32::to_bits), want.map(f32::to_bits), "{k}");
+        checked[usize::from(lit > 0.0)] += 1;
+    }
+    assert!(checked.iter().all(|&c| c > 30), "{checked:?}");
 }
