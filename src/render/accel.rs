@@ -120,6 +120,17 @@ impl Primitive {
     }
 }
 
+/// The steps of [`Accel::prefetch_point`], in the order they run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ahead {
+    /// The primitive's entry and its shape.
+    Entry,
+    /// A triangle's face (its vertex indices).
+    Face,
+    /// The face's vertices and vertex normals.
+    Vertices,
+}
+
 /// The closest hit of a ray.
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
@@ -303,6 +314,23 @@ impl Accel {
     #[inline]
     pub fn shape_of(&self, primitive: u32) -> u32 {
         self.shape_of[primitive as usize]
+    }
+
+    /// Asks the caches for what [`Primitive::point`] of a hit on
+    /// `primitive` and [`Accel::shape_of`] it will read, in the `step` of
+    /// three some hits apart, each reading what the one before brought
+    /// ([`crate::simd::prefetch`], a hint; nothing past a table's end).
+    #[inline(always)]
+    pub fn prefetch_point(&self, primitive: u32, step: Ahead) {
+        let i = primitive as usize;
+        if step == Ahead::Entry {
+            crate::simd::prefetch(&self.primitives, i);
+            crate::simd::prefetch(&self.shape_of, i);
+        } else if let Some(&Primitive::Triangle { mesh, face }) = self.primitives.get(i)
+            && let Some(mesh) = self.meshes.get(mesh as usize)
+        {
+            mesh.prefetch_point(face, step == Ahead::Vertices);
+        }
     }
 
     /// The nearest hit in `(0, ray.tmax)`. Inlined for scenes of one leaf

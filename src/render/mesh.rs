@@ -179,6 +179,24 @@ impl Mesh {
         self.triangle(face).point(bary, &self.normals)
     }
 
+    /// Asks the caches for what [`Mesh::point`] of face `face` reads, in
+    /// two steps some hits apart ([`crate::simd::prefetch`], a hint): the
+    /// face's indices, then (`vertices`) its vertices and vertex normals,
+    /// which reads the face the first step brought.
+    #[inline(always)]
+    pub fn prefetch_point(&self, face: u32, vertices: bool) {
+        if !vertices {
+            crate::simd::prefetch(&self.faces, face as usize);
+            return;
+        }
+        for &i in self.faces.get(face as usize).into_iter().flatten() {
+            crate::simd::prefetch(&self.points, i as usize);
+            if !self.normals.is_empty() {
+                crate::simd::prefetch(&self.normals, i as usize);
+            }
+        }
+    }
+
     /// A point of face `face` drawn uniformly by area (density `1 / area`;
     /// [`Triangle::sample`]).
     #[inline]

@@ -36,7 +36,7 @@
 
 use glam::Vec3A;
 
-use super::accel::{Hit, Subset};
+use super::accel::{Ahead, Hit, Subset};
 use super::embree;
 use super::integrator::{Escaped, Settings, Strategy, add_scaled, dims, ray_to};
 use super::numbers::{Numbers, bounce_dims, draws_light_choice};
@@ -49,6 +49,14 @@ use crate::rng::Rng;
 use crate::sampler::batch::{Dim, Drawn};
 use crate::sampler::{Sampler, Stream};
 use shade::{Begun, Bounce, KernelRows};
+
+/// The fewest primitives for which the surface points' reads are asked
+/// for ahead ([`super::accel::Accel::prefetch_point`]): smaller tables stay in the
+/// caches.
+const PREFETCH_MIN: usize = 1 << 14;
+
+/// How many hits ahead each step of [`super::accel::Accel::prefetch_point`] runs.
+const AHEAD: [(usize, Ahead); 3] = [(30, Ahead::Entry), (20, Ahead::Face), (10, Ahead::Vertices)];
 
 /// A path between two bounces.
 #[derive(Clone, Debug)]
@@ -232,28 +240,13 @@ impl Wavefront {
             self.rays.clear();
             self.shadows.clear();
             self.shadow_rays.clear();
-            // The surfaces first, in a loop of their own: the reads of
-            // the hit primitives overlap.
-            self.surfaces.clear();
-            let hits = self.paths.iter().zip(&self.hits);
-            if scene.has_movers() {
-                let surface = |(path, hit): (&Path, _)| scene.surface(&path.ray, hit, path.time);
-                self.surfaces.extend(hits.map(surface));
-            } else {
-                // Without the moving shapes' call in the loop: its result,
-                // returned through memory, was merged with the still
-                // shapes' through the stack, where a 4-byte store read
-                // back by a 16-byte load stalled every path (1.8 % of the
-                // plane's direct render).
-                let surface = |(path, hit): (&Path, _)| scene.still_surface(&path.ray, hit);
-                self.surfaces.extend(hits.map(surface));
-            }
-            // The numbers the shading will ask for, drawn together: the
-            // paths in flight have all made as many bounces.
-            self.dims.clear();
-            self.drawn.values.clear();
+            // The paths in flight have all made as many bounces.
             let depth = self.paths.first().map_or(0, |p| p.depth);
             debug_assert!(self.paths.iter().all(|p| p.depth == depth));
+            self.find_surfaces(scene, depth);
+            // The numbers the shading will ask for, drawn together.
+            self.dims.clear();
+            self.drawn.values.clear();
             if streams
                 .first()
                 .is_some_and(|s| s.sampler() != Sampler::Independent)
@@ -324,6 +317,40 @@ impl Wavefront {
             });
         }
         Ok(())
+    }
+
+    /// The shape and surface point of each path's hit (`depth`: the
+    /// paths' bounces), into `self.surfaces`, in a loop of their own: the
+    /// reads of the hit primitives overlap.
+    fn find_surfaces(&mut self, scene: &Scene, depth: u32) {
+        self.surfaces.clear();
+        let hits = self.paths.iter().zip(&self.hits);
+        if scene.has_movers() {
+            let surface = |(path, hit): (&Path, _)| scene.surface(&path.ray, hit, path.time);
+            self.surfaces.extend(hits.map(surface));
+            return;
+        }
+        // Without the moving shapes' call in the loop: its result,
+        // returned through memory, was merged with the still shapes'
+        // through the stack, where a 4-byte store read back by a 16-byte
+        // load stalled every path (1.8 % of the plane's direct render).
+        let surface = |(path, hit): (&Path, _)| scene.still_surface(&path.ray, hit);
+        let accel = scene.accel();
+        if depth == 0 || accel.primitives().len() < PREFETCH_MIN {
+            self.surfaces.extend(hits.map(surface));
+            return;
+        }
+        // Tables beyond the caches, and hits scattered over them (the
+        // camera rays' lie close together): each hit's primitive, face and
+        // vertices asked for ahead, in three steps.
+        for (k, vertex) in hits.enumerate() {
+            for (distance, step) in AHEAD {
+                if let Some(h) = self.hits.get(k + distance) {
+                    accel.prefetch_point(h.primitive, step);
+                }
+            }
+            self.surfaces.push(surface(vertex));
+        }
     }
 
     /// The light sample of each path's vertex at `depth`, into

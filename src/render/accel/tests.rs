@@ -475,3 +475,21 @@ fn faces_out_of_their_order_are_refused() {
     }
     assert!(Accel::new(listed(&[0, 1, 2, 3]), vec![0, 0, 1, 1], meshes).is_ok());
 }
+
+/// The reads a hit's surface point asks for ahead stay a hint: each step
+/// for a primitive past the table (a moving shape's) or past any index
+/// reads nothing and does not panic.
+#[test]
+fn surface_prefetches_stay_within_the_tables() {
+    let mut meshes = Vec::new();
+    let prims: Vec<Primitive> = Geometry::Mesh(strip(0.0, 3, |_| [0.0, 0.0, 1.0]))
+        .into_primitives(&mut meshes)
+        .collect();
+    let n = prims.len() as u32;
+    let accel = Accel::new(prims, vec![0; n as usize], meshes).unwrap();
+    for primitive in [0, n - 1, n, u32::MAX] {
+        for step in [Ahead::Entry, Ahead::Face, Ahead::Vertices] {
+            accel.prefetch_point(primitive, step);
+        }
+    }
+}
