@@ -38,6 +38,7 @@ use glam::Vec3A;
 
 use super::accel::{Ahead, Hit, Subset};
 use super::embree;
+use super::integrator::ends_after_light;
 use super::integrator::{Escaped, Settings, Strategy, add_scaled, dims, ray_to};
 use super::numbers::{Numbers, bounce_dims, draws_light_choice};
 use super::scene::{InvertedSamples, LightSample, Scene};
@@ -141,6 +142,10 @@ pub struct Wavefront {
     /// The light sample of each path's vertex at this bounce (none under
     /// BSDF sampling, and at the last vertex).
     light_samples: Vec<Option<LightSample>>,
+    /// The numbers of each path's BSDF sample at this bounce (`u`, then
+    /// the part's; zeros where the path ends after its light sample),
+    /// drawn with its light sample's.
+    bsdf_numbers: Vec<([f32; 2], f32)>,
     /// What each path that goes on past [`Bounce::begin`] at this bounce
     /// keeps for [`Bounce::finish`].
     begun: Vec<Begun>,
@@ -185,6 +190,7 @@ impl Wavefront {
             self.by_inversion.draws,
             self.env_samples,
             self.light_samples,
+            self.bsdf_numbers,
             self.begun
         )?;
         self.kernel_rows.reserve(n, WHAT)?;
@@ -256,7 +262,7 @@ impl Wavefront {
                 let samples = self.paths.iter().map(|p| (p.pixel, p.index));
                 self.drawn.draw(streams, samples, &self.dims)?;
             }
-            self.sample_lights(scene, settings, streams, depth);
+            self.draw_samples(scene, settings, streams, depth);
             self.shade(scene, settings, (streams, depth), l);
             self.blocked.clear();
             scene
@@ -354,13 +360,15 @@ impl Wavefront {
     }
 
     /// The light sample of each path's vertex at `depth`, into
-    /// `self.light_samples` (one per path; none under BSDF sampling or at
-    /// the last vertex), drawn before the shading: the light's choice and
-    /// position numbers (then, for an environment map's cell sampler, 64
-    /// random bits) are the first the vertex asks for. The environment
-    /// map's samples are drawn together: their table reads overlap, and
-    /// their directions are computed at SIMD width.
-    fn sample_lights(
+    /// `self.light_samples` (one per path; none under BSDF sampling), and
+    /// the numbers of its BSDF sample, into `self.bsdf_numbers`: nothing at
+    /// the last vertex, whose shading ends after its emission. The light's
+    /// choice and position numbers (then, for an environment map's cell
+    /// sampler, 64 random bits) are the first the vertex asks for, the
+    /// BSDF sample's next. The environment map's samples are drawn
+    /// together: their table reads overlap, and their directions are
+    /// computed at SIMD width.
+    fn draw_samples(
         &mut self,
         scene: &Scene,
         settings: &Settings,
@@ -377,47 +385,65 @@ impl Wavefront {
             env_samples,
             inverted,
             light_samples,
+            bsdf_numbers,
             ..
         } = self;
         light_samples.clear();
+        bsdf_numbers.clear();
         by_cells.clear();
         by_inversion.clear();
-        if depth + 1 >= settings.max_depth() || settings.strategy == Strategy::Bsdf {
+        if depth + 1 >= settings.max_depth() {
             return;
         }
-        light_samples.resize(paths.len(), None);
+        let lights = settings.strategy != Strategy::Bsdf;
+        if lights {
+            light_samples.resize(paths.len(), None);
+        }
+        let ends = ends_after_light(settings, depth);
         let many = scene.chooses_among_lights();
         let density = settings.env_density();
         let drawn = (&wanted[..], &drawn.values[..]);
         for (k, (path, (_, sp))) in paths.iter_mut().zip(&*surfaces).enumerate() {
-            with_numbers(streams, drawn, (k, path), |numbers, _| {
-                let choice = if draws_light_choice(many, numbers.stream.sampler()) {
-                    numbers.get1(dims::bounce(depth, dims::LIGHT_CHOICE))
-                } else {
-                    0.0
-                };
-                let u = numbers.get2(dims::bounce(depth, dims::LIGHT_POSITION));
-                // The independent sampler picks environment cells from extra
-                // random bits (an alias table); the others by inversion, which
-                // keeps their stratification.
-                let Some(light) = scene.choose_light(choice, density) else {
-                    return;
-                };
-                let bits = light
-                    .cells()
-                    .and(numbers.independent())
-                    .map(|r| r.next_u64());
-                match bits {
-                    // A map's cell: drawn with the bounce's others.
-                    Some(bits) => by_cells.push(k, (bits, u)),
-                    // A map by inversion (the other samplers, or a map
-                    // without cells): likewise.
-                    None if light.is_environment() && scene.environment_map().is_some() => {
-                        by_inversion.push(k, u.map(f64::from));
+            let bsdf = with_numbers(streams, drawn, (k, path), |numbers, _| {
+                if lights {
+                    let choice = if draws_light_choice(many, numbers.stream.sampler()) {
+                        numbers.get1(dims::bounce(depth, dims::LIGHT_CHOICE))
+                    } else {
+                        0.0
+                    };
+                    let u = numbers.get2(dims::bounce(depth, dims::LIGHT_POSITION));
+                    // The independent sampler picks environment cells from
+                    // extra random bits (an alias table); the others by
+                    // inversion, which keeps their stratification.
+                    if let Some(light) = scene.choose_light(choice, density) {
+                        let bits = light
+                            .cells()
+                            .and(numbers.independent())
+                            .map(|r| r.next_u64());
+                        match bits {
+                            // A map's cell: drawn with the bounce's others.
+                            Some(bits) => by_cells.push(k, (bits, u)),
+                            // A map by inversion (the other samplers, or a
+                            // map without cells): likewise.
+                            None if light.is_environment() && scene.environment_map().is_some() => {
+                                by_inversion.push(k, u.map(f64::from));
+                            }
+                            None => light_samples[k] = scene.sample_chosen(light, sp.p, u, None),
+                        }
                     }
-                    None => light_samples[k] = scene.sample_chosen(light, sp.p, u, None),
+                }
+                // The direction from the 2D request, the part from the 1D
+                // one (drawn in this order, the independent sampler's
+                // numbers are those of `PhongView::sample`'s `[u0, u1,
+                // part]`).
+                if ends {
+                    ([0.0; 2], 0.0)
+                } else {
+                    let u = numbers.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
+                    (u, numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT)))
                 }
             });
+            bsdf_numbers.push(bsdf);
         }
         scene.sample_environment_cells(&by_cells.draws, env_samples, density, |i, ls| {
             light_samples[by_cells.at[i] as usize] = ls;
@@ -445,6 +471,7 @@ impl Wavefront {
             hits,
             surfaces,
             light_samples,
+            bsdf_numbers,
             dims: wanted,
             drawn,
             begun,
@@ -456,7 +483,14 @@ impl Wavefront {
         } = self;
         debug_assert_eq!(hits.len(), paths.len());
         debug_assert_eq!(surfaces.len(), paths.len());
-        let bounce = Bounce { scene, settings };
+        let sampler = streams
+            .first()
+            .map_or(Sampler::Independent, Stream::sampler);
+        let bounce = Bounce {
+            scene,
+            settings,
+            sampler,
+        };
         let drawn = (&wanted[..], &drawn.values[..]);
         let light = |k: usize| light_samples.get(k).and_then(Option::as_ref);
         begun.clear();
@@ -469,10 +503,8 @@ impl Wavefront {
             };
             let l = &mut l[path.slot as usize];
             let vertex = (hit.t, (*shape, sp));
-            let started = with_numbers(streams, drawn, (k, path), |numbers, path| {
-                bounce.begin((k, path), vertex, light(k), numbers, l)
-            });
-            let Some((b, row)) = started else {
+            let numbers = bsdf_numbers.get(k).copied().unwrap_or_default();
+            let Some((b, row)) = bounce.begin((k, path), vertex, (light(k), numbers), l) else {
                 return false;
             };
             kernel_rows.push(b.diffuse, row);

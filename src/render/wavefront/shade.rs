@@ -36,9 +36,9 @@ use crate::render::integrator::{
     Integrator, Settings, Strategy, add_scaled, dims, emission_weight, ends_after_light,
     facing_normal, mul, offset, shadow_ray, turns_with_azimuth,
 };
-use crate::render::numbers::Numbers;
 use crate::render::scene::{LightSample, Scene};
 use crate::render::shape::{Ray, SurfacePoint};
+use crate::sampler::Sampler;
 use crate::simd;
 
 /// Numbers per row into [`bsdf_kernel`], all in world space: the shading
@@ -293,23 +293,23 @@ impl<'a> Iterator for RowsOut<'a> {
 pub(super) struct Bounce<'a> {
     pub scene: &'a Scene,
     pub settings: &'a Settings,
+    /// The sampler of the paths' numbers.
+    pub sampler: Sampler,
 }
 
 impl Bounce<'_> {
     /// The first step of shading the vertex where `path.ray` meets the
     /// scene (at distance `t`, on `shape` at `sp`), whose light sample is
-    /// `ls`: its emission added to `l`; `None` if the path ends there,
-    /// else what [`Bounce::finish`] needs of it (`k`: the path's index at
-    /// the bounce's start) and its row of [`bsdf_kernel`] (the BSDF
-    /// sample's numbers drawn from `numbers`, unless the path ends after
-    /// its light sample).
+    /// `ls` and whose BSDF sample's numbers are `bsdf_numbers` (`u`, then
+    /// the part's): its emission added to `l`; `None` if the path ends
+    /// there, else what [`Bounce::finish`] needs of it (`k`: the path's
+    /// index at the bounce's start) and its row of [`bsdf_kernel`].
     #[inline]
     pub fn begin(
         &self,
         (k, path): (usize, &Path),
         (t, (shape, sp)): (f32, (u32, &SurfacePoint)),
-        ls: Option<&LightSample>,
-        numbers: &mut Numbers,
+        (ls, bsdf_numbers): (Option<&LightSample>, ([f32; 2], f32)),
         l: &mut [f32; 3],
     ) -> Option<(Begun, [f32; BSDF_IN])> {
         let (scene, settings) = (self.scene, self.settings);
@@ -325,10 +325,9 @@ impl Bounce<'_> {
         if depth + 1 >= max_depth {
             return None;
         }
-        let sampler = numbers.stream.sampler();
         let normal = (
             facing_normal(scene, shape, sp.ns, wi).to_array(),
-            turns_with_azimuth(scene, shape, sampler),
+            turns_with_azimuth(scene, shape, self.sampler),
         );
         let light = match ls {
             Some(ls) if settings.strategy != Strategy::Bsdf => {
@@ -337,15 +336,6 @@ impl Bounce<'_> {
             _ => None,
         };
         let ends = ends_after_light(settings, depth);
-        // The direction from the 2D request, the part from the 1D one
-        // (drawn in this order, the independent sampler's numbers are
-        // those of `PhongView::sample`'s `[u0, u1, part]`).
-        let bsdf_numbers = if ends {
-            ([0.0; 2], 0.0)
-        } else {
-            let u = numbers.get2(dims::bounce(depth, dims::BSDF_DIRECTION));
-            (u, numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT)))
-        };
         let bsdf = &scene.material(shape).bsdf;
         let row = bsdf_row(
             (normal, wi.to_array()),
