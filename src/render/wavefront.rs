@@ -3,16 +3,21 @@
 //!
 //! ```text
 //! loop while paths remain:
+//!   surface each path's shape and surface point at its hit (on large
+//!           tables, the reads of the hits ahead prefetched)
 //!   numbers the numbers the shading below will ask for, drawn together
 //!           (samplers other than the independent one: `sampler::batch`)
-//!   light   each path's light sample, drawn before its shading: the
-//!           environment map's together (`CellSampler::sample_many`, or
-//!           by inversion `EnvMap::sample_into` for the other samplers)
-//!   shade   each path at its hit: emission, its light sample's light
-//!           (the shadow ray kept for later), a BSDF sample (the next
-//!           ray), roulette; the BSDF's evaluation and sample of every
-//!           path by kernels at SIMD width, one for the BRDFs without a
-//!           glossy part and one for the others (`shade`)
+//!   begin   each path at its hit, in one pass: its emission; its light
+//!           sample (an area light's drawn there, the environment map's
+//!           queued) and its BSDF sample's numbers; its row of the BSDF
+//!           kernel. Then the queued environment samples together
+//!           (`CellSampler::sample_many`, or by inversion
+//!           `EnvMap::sample_into` for the other samplers), written into
+//!           their rows
+//!   shade   the BSDF kernel over every row at SIMD width (`shade`: the
+//!           frame, the BRDF toward the light sample and its MIS weight,
+//!           the BSDF sample), then each path's light sample's light kept
+//!           with its shadow ray, its next ray, roulette
 //!   occlude every shadow ray of the batch, one stream; add the light of
 //!           those that reach it
 //!   trace   every next ray, one stream; rays that leave the scene go to
@@ -36,7 +41,7 @@
 
 use glam::Vec3A;
 
-use super::accel::{Ahead, Hit, Subset};
+use super::accel::{Hit, Subset};
 use super::embree;
 use super::integrator::ends_after_light;
 use super::integrator::{Escaped, Settings, Strategy, add_scaled, dims, ray_to};
@@ -50,14 +55,6 @@ use crate::rng::Rng;
 use crate::sampler::batch::{Dim, Drawn};
 use crate::sampler::{Sampler, Stream};
 use shade::{Begun, Bounce, KernelRows};
-
-/// The fewest primitives for which the surface points' reads are asked
-/// for ahead ([`super::accel::Accel::prefetch_point`]): smaller tables stay in the
-/// caches.
-const PREFETCH_MIN: usize = 1 << 14;
-
-/// How many hits ahead each step of [`super::accel::Accel::prefetch_point`] runs.
-const AHEAD: [(usize, Ahead); 3] = [(30, Ahead::Entry), (20, Ahead::Face), (10, Ahead::Vertices)];
 
 /// A path between two bounces.
 #[derive(Clone, Debug)]
@@ -142,10 +139,6 @@ pub struct Wavefront {
     /// The light sample of each path's vertex at this bounce (none under
     /// BSDF sampling, and at the last vertex).
     light_samples: Vec<Option<LightSample>>,
-    /// The numbers of each path's BSDF sample at this bounce (`u`, then
-    /// the part's; zeros where the path ends after its light sample),
-    /// drawn with its light sample's.
-    bsdf_numbers: Vec<([f32; 2], f32)>,
     /// What each path that goes on past [`Bounce::begin`] at this bounce
     /// keeps for [`Bounce::finish`].
     begun: Vec<Begun>,
@@ -190,7 +183,6 @@ impl Wavefront {
             self.by_inversion.draws,
             self.env_samples,
             self.light_samples,
-            self.bsdf_numbers,
             self.begun
         )?;
         self.kernel_rows.reserve(n, WHAT)?;
@@ -262,8 +254,8 @@ impl Wavefront {
                 let samples = self.paths.iter().map(|p| (p.pixel, p.index));
                 self.drawn.draw(streams, samples, &self.dims)?;
             }
-            self.draw_samples(scene, settings, streams, depth);
-            self.shade(scene, settings, (streams, depth), l);
+            self.begin_vertices(scene, settings, (streams, depth), l);
+            self.shade(scene, settings, (streams, depth));
             self.blocked.clear();
             scene
                 .accel()
@@ -325,58 +317,27 @@ impl Wavefront {
         Ok(())
     }
 
-    /// The shape and surface point of each path's hit (`depth`: the
-    /// paths' bounces), into `self.surfaces`, in a loop of their own: the
-    /// reads of the hit primitives overlap.
-    fn find_surfaces(&mut self, scene: &Scene, depth: u32) {
-        self.surfaces.clear();
-        let hits = self.paths.iter().zip(&self.hits);
-        if scene.has_movers() {
-            let surface = |(path, hit): (&Path, _)| scene.surface(&path.ray, hit, path.time);
-            self.surfaces.extend(hits.map(surface));
-            return;
-        }
-        // Without the moving shapes' call in the loop: its result,
-        // returned through memory, was merged with the still shapes'
-        // through the stack, where a 4-byte store read back by a 16-byte
-        // load stalled every path (1.8 % of the plane's direct render).
-        let surface = |(path, hit): (&Path, _)| scene.still_surface(&path.ray, hit);
-        let accel = scene.accel();
-        if depth == 0 || accel.primitives().len() < PREFETCH_MIN {
-            self.surfaces.extend(hits.map(surface));
-            return;
-        }
-        // Tables beyond the caches, and hits scattered over them (the
-        // camera rays' lie close together): each hit's primitive, face and
-        // vertices asked for ahead, in three steps.
-        for (k, vertex) in hits.enumerate() {
-            for (distance, step) in AHEAD {
-                if let Some(h) = self.hits.get(k + distance) {
-                    accel.prefetch_point(h.primitive, step);
-                }
-            }
-            self.surfaces.push(surface(vertex));
-        }
-    }
-
-    /// The light sample of each path's vertex at `depth`, into
-    /// `self.light_samples` (one per path; none under BSDF sampling), and
-    /// the numbers of its BSDF sample, into `self.bsdf_numbers`: nothing at
-    /// the last vertex, whose shading ends after its emission. The light's
-    /// choice and position numbers (then, for an environment map's cell
-    /// sampler, 64 random bits) are the first the vertex asks for, the
-    /// BSDF sample's next. The environment map's samples are drawn
-    /// together: their table reads overlap, and their directions are
-    /// computed at SIMD width.
-    fn draw_samples(
+    /// The first step of shading every path in flight at its hit (at
+    /// bounce `depth`), in one pass: its emission added to `l[slot]`; then,
+    /// unless the vertex is the last (whose shading ends there: every path
+    /// is removed), its light sample into `self.light_samples` (none under
+    /// BSDF sampling), the numbers of its BSDF sample, and its row of the
+    /// BSDF kernel ([`Bounce::begin`]). The light's choice and position
+    /// numbers (then, for an environment map's cell sampler, 64 random
+    /// bits) are the first the vertex asks for, the BSDF sample's next.
+    /// The environment map's samples are drawn together after the pass
+    /// (their table reads overlap, and their directions are computed at
+    /// SIMD width), and written into their rows then.
+    fn begin_vertices(
         &mut self,
         scene: &Scene,
         settings: &Settings,
-        streams: &mut [Stream],
-        depth: u32,
+        (streams, depth): (&mut [Stream], u32),
+        l: &mut [[f32; 3]],
     ) {
         let Wavefront {
             paths,
+            hits,
             surfaces,
             dims: wanted,
             drawn,
@@ -385,26 +346,37 @@ impl Wavefront {
             env_samples,
             inverted,
             light_samples,
-            bsdf_numbers,
+            begun,
+            kernel_rows,
             ..
         } = self;
+        debug_assert_eq!(hits.len(), paths.len());
+        debug_assert_eq!(surfaces.len(), paths.len());
         light_samples.clear();
-        bsdf_numbers.clear();
         by_cells.clear();
         by_inversion.clear();
-        if depth + 1 >= settings.max_depth() {
-            return;
-        }
+        begun.clear();
+        kernel_rows.clear();
+        let sampler = streams
+            .first()
+            .map_or(Sampler::Independent, Stream::sampler);
+        let bounce = Bounce { scene, settings };
+        let last = depth + 1 >= settings.max_depth();
         let lights = settings.strategy != Strategy::Bsdf;
-        if lights {
+        if lights && !last {
             light_samples.resize(paths.len(), None);
         }
         let ends = ends_after_light(settings, depth);
         let many = scene.chooses_among_lights();
         let density = settings.env_density();
         let drawn = (&wanted[..], &drawn.values[..]);
-        for (k, (path, (_, sp))) in paths.iter_mut().zip(&*surfaces).enumerate() {
-            let bsdf = with_numbers(streams, drawn, (k, path), |numbers, _| {
+        let vertices = paths.iter_mut().zip(hits.iter().zip(&*surfaces));
+        for (k, (path, (hit, (shape, sp)))) in vertices.enumerate() {
+            bounce.emit(path, (hit.t, (*shape, sp)), &mut l[path.slot as usize]);
+            if last {
+                continue;
+            }
+            let bsdf_numbers = with_numbers(streams, drawn, (k, path), |numbers, _| {
                 if lights {
                     let choice = if draws_light_choice(many, numbers.stream.sampler()) {
                         numbers.get1(dims::bounce(depth, dims::LIGHT_CHOICE))
@@ -443,35 +415,47 @@ impl Wavefront {
                     (u, numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT)))
                 }
             });
-            bsdf_numbers.push(bsdf);
+            let ls = light_samples.get(k).and_then(Option::as_ref);
+            let (b, row) = bounce.begin((k, path), (*shape, sp), (ls, bsdf_numbers), sampler);
+            begun.push(Begun {
+                row: kernel_rows.push(b.diffuse, row),
+                ..b
+            });
         }
+        if last {
+            paths.clear();
+            return;
+        }
+        let mut light = |k: u32, ls: Option<LightSample>| {
+            if let (Some(ls), Some(b)) = (&ls, begun.get(k as usize)) {
+                kernel_rows.set_light(b, ls);
+            }
+            light_samples[k as usize] = ls;
+        };
         scene.sample_environment_cells(&by_cells.draws, env_samples, density, |i, ls| {
-            light_samples[by_cells.at[i] as usize] = ls;
+            light(by_cells.at[i], ls);
         });
         scene.sample_environment_inverted(&by_inversion.draws, inverted, density, |i, ls| {
-            light_samples[by_inversion.at[i] as usize] = ls;
+            light(by_inversion.at[i], ls);
         });
     }
 
-    /// Shades every path in flight (at bounce `depth`) at its hit, in the
-    /// three steps of [`shade`]: its emission added to `l[slot]`, its
-    /// light sample's light kept with its shadow ray (`self.shadows`,
-    /// `self.shadow_rays`), its next ray (`self.rays`). The paths that end
-    /// are removed; the others keep their order, so that they line up
-    /// with their rays.
+    /// The last two steps of shading every path in flight (at bounce
+    /// `depth`, begun by [`Wavefront::begin_vertices`]): the BSDF kernel
+    /// over every row, then each path's light sample's light kept with its
+    /// shadow ray (`self.shadows`, `self.shadow_rays`) and its next ray
+    /// (`self.rays`). The paths that end are removed; the others keep their
+    /// order, so that they line up with their rays.
     fn shade(
         &mut self,
         scene: &Scene,
         settings: &Settings,
         (streams, depth): (&mut [Stream], u32),
-        l: &mut [[f32; 3]],
     ) {
         let Wavefront {
             paths,
-            hits,
             surfaces,
             light_samples,
-            bsdf_numbers,
             dims: wanted,
             drawn,
             begun,
@@ -481,36 +465,10 @@ impl Wavefront {
             rays,
             ..
         } = self;
-        debug_assert_eq!(hits.len(), paths.len());
-        debug_assert_eq!(surfaces.len(), paths.len());
-        let sampler = streams
-            .first()
-            .map_or(Sampler::Independent, Stream::sampler);
-        let bounce = Bounce {
-            scene,
-            settings,
-            sampler,
-        };
+        debug_assert_eq!(begun.len(), paths.len());
+        let bounce = Bounce { scene, settings };
         let drawn = (&wanted[..], &drawn.values[..]);
         let light = |k: usize| light_samples.get(k).and_then(Option::as_ref);
-        begun.clear();
-        kernel_rows.clear();
-        let mut vertices = hits.iter().zip(&*surfaces).enumerate();
-        paths.retain_mut(|path| {
-            let Some((k, (hit, (shape, sp)))) = vertices.next() else {
-                debug_assert!(false, "a path without its hit");
-                return false;
-            };
-            let l = &mut l[path.slot as usize];
-            let vertex = (hit.t, (*shape, sp));
-            let numbers = bsdf_numbers.get(k).copied().unwrap_or_default();
-            let Some((b, row)) = bounce.begin((k, path), vertex, (light(k), numbers), l) else {
-                return false;
-            };
-            kernel_rows.push(b.diffuse, row);
-            begun.push(b);
-            true
-        });
         kernel_rows.run(settings, depth);
         let mut rows_out = kernel_rows.out(begun);
         paths.retain_mut(|path| {
@@ -647,5 +605,6 @@ impl<D> Waiting<D> {
 }
 
 mod shade;
+mod surfaces;
 #[cfg(test)]
 mod tests;

@@ -1,10 +1,12 @@
 //! The shading of a bounce's paths, in three steps over the whole bounce:
 //!
 //! ```text
-//! begin   each path at its hit: its emission, and its row of the BSDF
-//!         kernel (the shading normal, the view's direction, the light
-//!         sample's direction, density and radiance, the BSDF sample's
-//!         numbers, the BRDF's terms)
+//! begin   each path at its hit: its emission (Bounce::emit), and its
+//!         row of the BSDF kernel (Bounce::begin: the shading normal, the
+//!         view's direction, the light sample's direction, density and
+//!         radiance, the BSDF sample's numbers, the BRDF's terms; an
+//!         environment map's light sample written later, when the
+//!         bounce's are drawn together: KernelRows::set_light)
 //! kernel  every row at SIMD width (bsdf_kernel): the shading frame, the
 //!         BRDF and its density toward the light sample and the light
 //!         that sample carries (MIS weight, cosine), and the BSDF sample
@@ -61,6 +63,8 @@ pub(super) struct Begun {
     /// The path's index at the bounce's start (of its surface, light
     /// sample and numbers drawn beforehand).
     pub k: u32,
+    /// Its row's index in its group of [`KernelRows`] ([`KernelRows::push`]).
+    pub row: u32,
     /// Whether it ends after its light sample (emitter sampling, whose
     /// next vertex's emission would not count).
     pub ends: bool,
@@ -81,17 +85,30 @@ pub(super) fn bsdf_row(
     (u, part): ([f32; 2], f32),
     terms: &[f32; VIEW_TERMS],
 ) -> [f32; BSDF_IN] {
-    let (wl, pdf, radiance) = light.unwrap_or(([0.0; 3], 0.0, [0.0; 3]));
     let mut row = [0.0; BSDF_IN];
     row[..3].copy_from_slice(&n);
     row[3] = if azimuthal { 1.0 } else { 0.0 };
     row[4..7].copy_from_slice(&wi);
-    row[7..10].copy_from_slice(&wl);
-    row[10] = pdf;
-    row[11..14].copy_from_slice(&radiance);
+    set_row_light(&mut row, light.unwrap_or(([0.0; 3], 0.0, [0.0; 3])));
     row[14..17].copy_from_slice(&[u[0], u[1], part]);
     row[17..].copy_from_slice(terms);
     row
+}
+
+/// The light sample's direction, density and radiance written into `row`
+/// ([`bsdf_row`]).
+#[inline]
+fn set_row_light(row: &mut [f32; BSDF_IN], (wl, pdf, radiance): (V3<f32>, f32, [f32; 3])) {
+    row[7..10].copy_from_slice(&wl);
+    row[10] = pdf;
+    row[11..14].copy_from_slice(&radiance);
+}
+
+/// The light sample `ls` as [`bsdf_row`] takes it: its direction, density
+/// and radiance.
+#[inline]
+fn light_of(ls: &LightSample) -> (V3<f32>, f32, [f32; 3]) {
+    (ls.d.to_array(), ls.pdf, ls.radiance)
 }
 
 /// The BSDF's part of a vertex's shading, for one row of [`BSDF_IN`]
@@ -204,15 +221,30 @@ impl KernelRows {
         self.glossy.rows.clear();
     }
 
-    /// The row of the next path, in the diffuse group or not.
+    /// The row of the next path, in the diffuse group or not; its index in
+    /// its group.
     #[inline]
-    pub fn push(&mut self, diffuse: bool, row: [f32; BSDF_IN]) {
-        let group = if diffuse {
+    pub fn push(&mut self, diffuse: bool, row: [f32; BSDF_IN]) -> u32 {
+        let group = self.group(diffuse);
+        group.rows.push(row);
+        (group.rows.len() - 1) as u32
+    }
+
+    /// The light sample `ls` written into the row of the path `begun`.
+    #[inline]
+    pub fn set_light(&mut self, begun: &Begun, ls: &LightSample) {
+        if let Some(row) = self.group(begun.diffuse).rows.get_mut(begun.row as usize) {
+            set_row_light(row, light_of(ls));
+        }
+    }
+
+    #[inline]
+    fn group(&mut self, diffuse: bool) -> &mut Rows {
+        if diffuse {
             &mut self.diffuse
         } else {
             &mut self.glossy
-        };
-        group.rows.push(row);
+        }
     }
 
     /// [`bsdf_kernel`] of every row, for a bounce of `settings` at
@@ -293,49 +325,53 @@ impl<'a> Iterator for RowsOut<'a> {
 pub(super) struct Bounce<'a> {
     pub scene: &'a Scene,
     pub settings: &'a Settings,
-    /// The sampler of the paths' numbers.
-    pub sampler: Sampler,
 }
 
 impl Bounce<'_> {
-    /// The first step of shading the vertex where `path.ray` meets the
-    /// scene (at distance `t`, on `shape` at `sp`), whose light sample is
-    /// `ls` and whose BSDF sample's numbers are `bsdf_numbers` (`u`, then
-    /// the part's): its emission added to `l`; `None` if the path ends
-    /// there, else what [`Bounce::finish`] needs of it (`k`: the path's
-    /// index at the bounce's start) and its row of [`bsdf_kernel`].
+    /// The emission of the vertex where `path.ray` meets the scene (at
+    /// distance `t`, on `shape` at `sp`), added to `l` (with its MIS
+    /// weight).
     #[inline]
-    pub fn begin(
+    pub fn emit(
         &self,
-        (k, path): (usize, &Path),
+        path: &Path,
         (t, (shape, sp)): (f32, (u32, &SurfacePoint)),
-        (ls, bsdf_numbers): (Option<&LightSample>, ([f32; 2], f32)),
         l: &mut [f32; 3],
-    ) -> Option<(Begun, [f32; BSDF_IN])> {
+    ) {
         let (scene, settings) = (self.scene, self.settings);
-        let (ray, depth) = (path.ray, path.depth);
-        let wi = -ray.d;
-        if let Some(le) = scene.emitted(shape, sp.ng, wi) {
-            let w = emission_weight(settings, depth, path.bsdf_pdf, || {
+        let ray = path.ray;
+        if let Some(le) = scene.emitted(shape, sp.ng, -ray.d) {
+            let w = emission_weight(settings, path.depth, path.bsdf_pdf, || {
                 scene.light_pdf(shape, path.from, sp.ng, ray.d, t)
             });
             add_scaled(l, path.beta, le, w);
         }
-        let max_depth = settings.max_depth();
-        if depth + 1 >= max_depth {
-            return None;
-        }
+    }
+
+    /// The first step of shading the vertex where `path.ray` meets `shape`
+    /// at `sp`, past its emission ([`Bounce::emit`]), where the path goes
+    /// on: what [`Bounce::finish`] needs of it (`k`: the path's index at
+    /// the bounce's start) and its row of [`bsdf_kernel`], with its light
+    /// sample `ls` (which [`KernelRows::set_light`] may also write later)
+    /// and its BSDF sample's numbers `bsdf_numbers` (`u`, then the part's;
+    /// its frame as `sampler` wants it: [`turns_with_azimuth`]).
+    #[inline]
+    pub fn begin(
+        &self,
+        (k, path): (usize, &Path),
+        (shape, sp): (u32, &SurfacePoint),
+        (ls, bsdf_numbers): (Option<&LightSample>, ([f32; 2], f32)),
+        sampler: Sampler,
+    ) -> (Begun, [f32; BSDF_IN]) {
+        let (scene, settings) = (self.scene, self.settings);
+        let wi = -path.ray.d;
         let normal = (
             facing_normal(scene, shape, sp.ns, wi).to_array(),
-            turns_with_azimuth(scene, shape, self.sampler),
+            turns_with_azimuth(scene, shape, sampler),
         );
-        let light = match ls {
-            Some(ls) if settings.strategy != Strategy::Bsdf => {
-                Some((ls.d.to_array(), ls.pdf, ls.radiance))
-            }
-            _ => None,
-        };
-        let ends = ends_after_light(settings, depth);
+        let light = ls
+            .filter(|_| settings.strategy != Strategy::Bsdf)
+            .map(light_of);
         let bsdf = &scene.material(shape).bsdf;
         let row = bsdf_row(
             (normal, wi.to_array()),
@@ -345,10 +381,11 @@ impl Bounce<'_> {
         );
         let begun = Begun {
             k: k as u32,
-            ends,
+            row: 0,
+            ends: ends_after_light(settings, path.depth),
             diffuse: !bsdf.is_glossy(),
         };
-        Some((begun, row))
+        (begun, row)
     }
 
     /// The last step of shading a path's vertex (at `sp`, begun as

@@ -195,6 +195,7 @@ fn kernel_rows_give_each_path_the_general_kernel_s_bits() {
             );
             let begun = Begun {
                 k: k as u32,
+                row: 0,
                 ends: false,
                 diffuse: !bsdf.is_glossy(),
             };
@@ -316,4 +317,57 @@ fn the_kernel_gives_each_path_s_frame_light_and_direction() {
         checked[usize::from(lit > 0.0)] += 1;
     }
     assert!(checked.iter().all(|&c| c > 30), "{checked:?}");
+}
+
+/// A light sample written into a row after the row was pushed (as the
+/// environment map's samples, drawn after the pass that builds the rows)
+/// gives the kernel the numbers of a row built with it, in either group.
+#[test]
+fn a_light_sample_written_later_is_the_row_s_own() {
+    use crate::render::scene::LightSample;
+    use shade::bsdf_row;
+    let ls = LightSample {
+        d: Vec3A::new(0.6, 0.0, 0.8),
+        dist: f32::INFINITY,
+        pdf: 0.7,
+        radiance: [1.0, 2.0, 3.0],
+        point: None,
+    };
+    let brdfs = [
+        Phong::new([0.6; 3], [0.0; 3], 0.0, Selection::Max).unwrap(),
+        Phong::new([0.3; 3], [0.5; 3], 30.0, Selection::Max).unwrap(),
+    ];
+    let settings = settings(Integrator::Direct, Strategy::Mis);
+    for bsdf in &brdfs {
+        let row = |light| {
+            let normal = ([0.0, 0.6, 0.8], false);
+            bsdf_row(
+                (normal, [0.0, 0.0, 1.0]),
+                light,
+                ([0.3, 0.6], 0.4),
+                &bsdf.view_terms(),
+            )
+        };
+        let diffuse = !bsdf.is_glossy();
+        let (mut later, mut first) = (KernelRows::default(), KernelRows::default());
+        later.reserve(1, "rows").unwrap();
+        first.reserve(1, "rows").unwrap();
+        let begun = Begun {
+            k: 0,
+            row: later.push(diffuse, row(None)),
+            ends: false,
+            diffuse,
+        };
+        later.set_light(&begun, &ls);
+        first.push(diffuse, row(Some((ls.d.to_array(), ls.pdf, ls.radiance))));
+        later.run(&settings, 0);
+        first.run(&settings, 0);
+        let begun = [begun];
+        let (Some((_, a)), Some((_, b))) = (later.out(&begun).next(), first.out(&begun).next())
+        else {
+            panic!("no row out");
+        };
+        assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits));
+        assert!(a[3] > 0.0, "{a:?}");
+    }
 }
