@@ -202,6 +202,12 @@ impl Wavefront {
             }
             return;
         };
+        // Paths that end at the camera ray's hit (`max_depth` 1) count only
+        // an area light's emission there, as at any last vertex: the
+        // others need no surface point.
+        if settings.max_depth() == 1 && !scene.hits_emitter(&hit) {
+            return;
+        }
         self.paths.push(Path {
             slot: c.slot,
             pixel: c.pixel,
