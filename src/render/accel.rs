@@ -319,7 +319,8 @@ impl Accel {
     /// Asks the caches for what [`Primitive::point`] of a hit on
     /// `primitive` and [`Accel::shape_of`] it will read, in the `step` of
     /// three some hits apart, each reading what the one before brought
-    /// ([`crate::simd::prefetch`], a hint; nothing past a table's end).
+    /// ([`crate::simd::prefetch`]: hints only, which never fault; no
+    /// table is read past its end).
     #[inline(always)]
     pub fn prefetch_point(&self, primitive: u32, step: Ahead) {
         let i = primitive as usize;

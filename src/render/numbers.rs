@@ -122,8 +122,8 @@ pub fn draws_light_choice(many_lights: bool, sampler: Sampler) -> bool {
 }
 
 /// The dimensions the shading of each path's vertex at `depth` asks for
-/// (its light sample's in `Wavefront::sample_lights`, then its BSDF
-/// sample's in `Bounce::begin` and its roulette's in `Bounce::finish`, in
+/// (its light sample's, then its BSDF sample's, both in
+/// `Wavefront::begin_vertices`, then its roulette's in `Bounce::finish`, in
 /// this order: [`super::wavefront`]) under a sampler
 /// other than the independent one, into `out`: none at the last vertex;
 /// the light's choice (when `many_lights`, [`draws_light_choice`]) and

@@ -190,7 +190,10 @@ impl Wavefront {
         self.escaped.reserve(n)
     }
 
-    /// Starts the path of camera sample `c`.
+    /// Starts the path of camera sample `c`: none when it leaves the scene
+    /// (its ray goes to the escaped rays, unless emitters are hidden), nor
+    /// when the paths end at its hit (`max_depth` 1) and that hit is not on
+    /// an area light.
     #[inline]
     pub fn push(&mut self, scene: &Scene, settings: &Settings, c: CameraSample) {
         if settings.max_depth() == 0 {
@@ -363,6 +366,7 @@ impl Wavefront {
         by_inversion.clear();
         begun.clear();
         kernel_rows.clear();
+        // (Every pixel's stream is of the render's sampler.)
         let sampler = streams
             .first()
             .map_or(Sampler::Independent, Stream::sampler);
@@ -433,6 +437,8 @@ impl Wavefront {
             return;
         }
         let mut light = |k: u32, ls: Option<LightSample>| {
+            // (Every path has its row here: `begun[k]` is path `k`'s.)
+            debug_assert!(begun.get(k as usize).is_some_and(|b| b.k == k));
             if let (Some(ls), Some(b)) = (&ls, begun.get(k as usize)) {
                 kernel_rows.set_light(b, ls);
             }

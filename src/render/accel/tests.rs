@@ -476,9 +476,9 @@ fn faces_out_of_their_order_are_refused() {
     assert!(Accel::new(listed(&[0, 1, 2, 3]), vec![0, 0, 1, 1], meshes).is_ok());
 }
 
-/// The reads a hit's surface point asks for ahead stay a hint: each step
+/// The reads a hit's surface point asks for ahead stay hints: each step
 /// for a primitive past the table (a moving shape's) or past any index
-/// reads nothing and does not panic.
+/// loads nothing from the tables and does not panic.
 #[test]
 fn surface_prefetches_stay_within_the_tables() {
     let mut meshes = Vec::new();

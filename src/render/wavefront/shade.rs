@@ -54,7 +54,9 @@ pub(super) const BSDF_IN: usize = 17 + VIEW_TERMS;
 /// Numbers per row out of [`bsdf_kernel`]: the light sample's light
 /// `f_r · L` (3) and its scale `w |cos θ_l| / p_l` (1), whether `f_r > 0`
 /// in some channel (1: 1 or 0), then the BSDF sample's direction in world
-/// space (3), density and weight (3).
+/// space (3), density and weight (3). The light's four are meaningless
+/// (the scale NaN: `p_l = 0`) in a row without a light sample, whose path
+/// has none to connect.
 pub(super) const BSDF_OUT: usize = 12;
 
 /// What [`Bounce::finish`] needs of a path's [`Bounce::begin`].
@@ -173,7 +175,8 @@ pub(super) fn bsdf_kernel<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: b
         } else {
             view.sample_diffuse([u0, u1])
         };
-        // Normalised as glam's `Vec3A::normalize`: the same bits.
+        // `v / √((x² + y²) + z²)`: the bits of glam's `Vec3A::normalize`
+        // on x86-64 (its SSE2 form divides by the length).
         let [x, y, z] = frame.to_world(s.wo);
         let length = (x * x + y * y + z * z).sqrt();
         ([x / length, y / length, z / length], s.pdf, s.weight)
@@ -329,8 +332,8 @@ pub(super) struct Bounce<'a> {
 
 impl Bounce<'_> {
     /// The emission of the vertex where `path.ray` meets the scene (at
-    /// distance `t`, on `shape` at `sp`), added to `l` (with its MIS
-    /// weight).
+    /// distance `t`, on `shape` at `sp`), added to `l`: `β L_e w`, with the
+    /// MIS weight `w` against emitter sampling ([`emission_weight`]).
     #[inline]
     pub fn emit(
         &self,
@@ -354,7 +357,9 @@ impl Bounce<'_> {
     /// the bounce's start) and its row of [`bsdf_kernel`], with its light
     /// sample `ls` (which [`KernelRows::set_light`] may also write later)
     /// and its BSDF sample's numbers `bsdf_numbers` (`u`, then the part's;
-    /// its frame as `sampler` wants it: [`turns_with_azimuth`]).
+    /// its frame as `sampler` wants it: [`turns_with_azimuth`]). The
+    /// returned [`Begun::row`] is 0, for the caller to set from
+    /// [`KernelRows::push`].
     #[inline]
     pub fn begin(
         &self,

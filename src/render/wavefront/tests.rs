@@ -257,7 +257,7 @@ fn general_kernel<const LIGHT: bool, const SAMPLE: bool>(
 /// its shading frame (of the normal, or of the azimuth, also at and near
 /// the poles), the BRDF's view, evaluation and sample in that frame, the
 /// power heuristic's weight and the direction taken back to world space
-/// and normalised by glam.
+/// and normalised, `v / √((x² + y²) + z²)`.
 #[test]
 fn the_kernel_gives_each_path_s_frame_light_and_direction() {
     use crate::frame::Frame;
@@ -297,7 +297,10 @@ fn the_kernel_gives_each_path_s_frame_light_and_direction() {
         let (f, pdf) = view.eval_pdf(local);
         let w = Heuristic::Power.weight(pdf_l, pdf);
         let s = view.sample(u);
-        let d = Vec3A::from(frame.to_world(s.wo)).normalize();
+        // (`Vec3A::normalize`'s bits on x86-64.)
+        let [x, y, z] = frame.to_world(s.wo);
+        let length = (x * x + y * y + z * z).sqrt();
+        let d = Vec3A::new(x / length, y / length, z / length);
         let lit = if f.iter().any(|&v| v > 0.0) { 1.0 } else { 0.0 };
         let want = [
             f[0] * radiance[0],
