@@ -43,8 +43,7 @@ use glam::Vec3A;
 
 use super::accel::{Hit, Subset};
 use super::embree;
-use super::integrator::ends_after_light;
-use super::integrator::{Escaped, Settings, Strategy, add_scaled, dims, ray_to};
+use super::integrator::{Escaped, Settings, Strategy, add_scaled, dims, ends_after_light, ray_to};
 use super::numbers::{Numbers, bounce_dims, draws_light_choice};
 use super::scene::{InvertedSamples, LightSample, Scene};
 use super::shape::{Ray, SurfacePoint};

@@ -1,15 +1,17 @@
 //! The surface points of a bounce's hits ([`Wavefront::find_surfaces`]).
 
 use super::{Path, Wavefront};
+#[cfg(doc)]
+use crate::render::accel::Accel;
 use crate::render::accel::Ahead;
 use crate::render::scene::Scene;
 
 /// The fewest primitives for which the surface points' reads are asked
-/// for ahead ([`crate::render::accel::Accel::prefetch_point`]): smaller tables stay in the
+/// for ahead ([`Accel::prefetch_point`]): smaller tables stay in the
 /// caches.
 const PREFETCH_MIN: usize = 1 << 14;
 
-/// How many hits ahead each step of [`crate::render::accel::Accel::prefetch_point`] runs.
+/// How many hits ahead each step of [`Accel::prefetch_point`] runs.
 const AHEAD: [(usize, Ahead); 3] = [(30, Ahead::Entry), (20, Ahead::Face), (10, Ahead::Vertices)];
 
 impl Wavefront {
