@@ -24,7 +24,7 @@
 use glam::Vec3A;
 
 use super::accel::Hit;
-use super::scene::{EnvDensity, LightSample, Scene};
+use super::scene::{EnvDensity, Scene};
 use super::shape::{Ray, SurfacePoint};
 use crate::alloc;
 use crate::frame::Frame;
@@ -166,22 +166,23 @@ pub(super) fn offset(p: Vec3A, n: Vec3A, toward: Vec3A) -> Vec3A {
 }
 
 /// The shadow ray from a surface point `p` (geometric normal `n`) toward
-/// the light sample `ls`. Toward an area light it runs between the two
-/// points, each moved off its own surface toward the other by [`offset`],
-/// so that neither the receiver nor the light itself can block it (a ray
-/// kept along `ls.d` from the moved origin would cross the light's surface
-/// before its end at grazing angles); toward the environment it is
-/// unbounded.
+/// a light sample along the unit `d`, whose light is at `point` on an area
+/// light, or the environment (`None`). Toward an area light it runs
+/// between the two points, each moved off its own surface toward the other
+/// by [`offset`], so that neither the receiver nor the light itself can
+/// block it (a ray kept along `d` from the moved origin would cross the
+/// light's surface before its end at grazing angles); toward the
+/// environment it is unbounded.
 #[inline]
-pub(crate) fn shadow_ray(p: Vec3A, n: Vec3A, ls: &LightSample) -> Ray {
-    let o = offset(p, n, ls.d);
-    match ls.point {
+pub(crate) fn shadow_ray(p: Vec3A, n: Vec3A, d: Vec3A, point: Option<&SurfacePoint>) -> Ray {
+    let o = offset(p, n, d);
+    match point {
         None => Ray {
             o,
-            d: ls.d,
+            d,
             tmax: f32::INFINITY,
         },
-        Some((y, _)) => ray_to(o, &y, ls.d),
+        Some(y) => ray_to(o, y, d),
     }
 }
 
@@ -356,9 +357,15 @@ pub fn add_escaped(scene: &Scene, settings: &Settings, escaped: &mut Escaped, l:
     let n = escaped.dir.len();
     escaped.radiance.resize(n, [0.0; 3]);
     env.eval_into(&escaped.dir, &mut escaped.radiance);
-    if escaped.bsdf_pdf.iter().any(Option::is_some) {
+    // The densities from the first ray whose MIS weight remains to apply:
+    // the camera's rays, which come first, need none.
+    if let Some(first) = escaped.bsdf_pdf.iter().position(Option::is_some) {
         escaped.light_pdf.resize(n, 0.0);
-        scene.environment_pdf_into(&escaped.dir, &mut escaped.light_pdf, settings.env_density());
+        scene.environment_pdf_into(
+            &escaped.dir[first..],
+            &mut escaped.light_pdf[first..],
+            settings.env_density(),
+        );
     }
     for i in 0..n {
         let w = escaped.bsdf_pdf[i].map_or(1.0, |p| settings.weight(p, escaped.light_pdf[i]));

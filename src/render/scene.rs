@@ -16,7 +16,7 @@ use crate::alloc;
 use crate::distr::Discrete1D;
 use crate::error::{Error, Result};
 use crate::math::luminance;
-use crate::phong::Phong;
+use crate::phong::{Phong, VIEW_TERMS};
 
 mod lights;
 use lights::{AreaLight, EnvLight, Light, LightChoice};
@@ -70,6 +70,9 @@ fn bounding_sphere(accel: &Accel, movers: &[Mover]) -> (Vec3A, f32) {
 pub struct Scene {
     accel: Accel,
     materials: Vec<Material>,
+    /// Each shape's BRDF's [`crate::phong::Phong::view_terms`], computed
+    /// once.
+    view_terms: Vec<[f32; VIEW_TERMS]>,
     /// Whether each shape is a sphere (its shading frame:
     /// [`super::integrator::shading`]).
     spheres: Vec<bool>,
@@ -188,6 +191,10 @@ impl Scene {
                 light_of_shape.push(None);
             }
         }
+        let view_terms = alloc::collect(
+            materials.iter().map(|m| m.bsdf.view_terms()),
+            "the scene's shapes",
+        )?;
         let accel = Accel::new(primitives, shape_of, meshes)?;
         // At most MAX_PRIMITIVES in all (check_primitives above).
         let mut first = accel.primitives().len() as u32;
@@ -216,6 +223,7 @@ impl Scene {
         Ok(Scene {
             accel,
             materials,
+            view_terms,
             spheres,
             emitters,
             emission,
@@ -379,6 +387,13 @@ impl Scene {
     #[inline]
     pub fn material(&self, shape: u32) -> &Material {
         &self.materials[shape as usize]
+    }
+
+    /// The view terms of shape `shape`'s BRDF
+    /// ([`crate::phong::Phong::view_terms`]).
+    #[inline]
+    pub(crate) fn view_terms(&self, shape: u32) -> &[f32; VIEW_TERMS] {
+        &self.view_terms[shape as usize]
     }
 
     /// Whether shape `shape` is a sphere.

@@ -433,7 +433,8 @@ fn shadow_rays_reach_the_light_samples() {
                     continue;
                 }
                 drawn += 1;
-                let ray = integrator::shadow_ray(p, Vec3A::Z, &ls);
+                let ray =
+                    integrator::shadow_ray(p, Vec3A::Z, ls.d, ls.point.as_ref().map(|(y, _)| y));
                 reached += usize::from(!scene.accel().occluded(&ray));
             }
             assert!(drawn > 500, "{shape} {place}: {drawn} samples");

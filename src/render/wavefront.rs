@@ -135,9 +135,10 @@ pub struct Wavefront {
     by_inversion: Waiting<[f64; 2]>,
     env_samples: Vec<EnvSample<f32>>,
     inverted: InvertedSamples,
-    /// The light sample of each path's vertex at this bounce (none under
-    /// BSDF sampling, and at the last vertex).
-    light_samples: Vec<Option<LightSample>>,
+    /// The points on area lights of the bounce's light samples (those of
+    /// the paths whose [`Begun::to_point`] holds, in the paths' order):
+    /// where their shadow rays end.
+    light_points: Vec<SurfacePoint>,
     /// What each path that goes on past [`Bounce::begin`] at this bounce
     /// keeps for [`Bounce::finish`].
     begun: Vec<Begun>,
@@ -181,7 +182,7 @@ impl Wavefront {
             self.by_inversion.at,
             self.by_inversion.draws,
             self.env_samples,
-            self.light_samples,
+            self.light_points,
             self.begun
         )?;
         self.kernel_rows.reserve(n, WHAT)?;
@@ -328,9 +329,9 @@ impl Wavefront {
     /// The first step of shading every path in flight at its hit (at
     /// bounce `depth`), in one pass: its emission added to `l[slot]`; then,
     /// unless the vertex is the last (whose shading ends there: every path
-    /// is removed), its light sample into `self.light_samples` (none under
-    /// BSDF sampling), the numbers of its BSDF sample, and its row of the
-    /// BSDF kernel ([`Bounce::begin`]). The light's choice and position
+    /// is removed), its light sample (none under BSDF sampling; the point
+    /// of an area light's into `self.light_points`), the numbers of its
+    /// BSDF sample, and its row of the BSDF kernel ([`Bounce::begin`]). The light's choice and position
     /// numbers (then, for an environment map's cell sampler, 64 random
     /// bits) are the first the vertex asks for, the BSDF sample's next.
     /// The environment map's samples are drawn together after the pass
@@ -353,14 +354,14 @@ impl Wavefront {
             by_inversion,
             env_samples,
             inverted,
-            light_samples,
+            light_points,
             begun,
             kernel_rows,
             ..
         } = self;
         debug_assert_eq!(hits.len(), paths.len());
         debug_assert_eq!(surfaces.len(), paths.len());
-        light_samples.clear();
+        light_points.clear();
         by_cells.clear();
         by_inversion.clear();
         begun.clear();
@@ -372,9 +373,6 @@ impl Wavefront {
         let bounce = Bounce { scene, settings };
         let last = depth + 1 >= settings.max_depth();
         let lights = settings.strategy != Strategy::Bsdf;
-        if lights && !last {
-            light_samples.resize(paths.len(), None);
-        }
         let ends = ends_after_light(settings, depth);
         let many = scene.chooses_among_lights();
         let density = settings.env_density();
@@ -385,7 +383,10 @@ impl Wavefront {
             if last {
                 continue;
             }
-            let bsdf_numbers = with_numbers(streams, drawn, (k, path), |numbers, _| {
+            // An area light's sample (drawn here; the environment map's are
+            // drawn together below).
+            let mut ls = None;
+            let bsdf_numbers = with_numbers(streams, drawn, (k, path), |numbers| {
                 if lights {
                     let choice = if draws_light_choice(many, numbers.stream.sampler()) {
                         numbers.get1(dims::bounce(depth, dims::LIGHT_CHOICE))
@@ -409,7 +410,7 @@ impl Wavefront {
                             None if light.is_environment() && scene.environment_map().is_some() => {
                                 by_inversion.push(k, u.map(f64::from));
                             }
-                            None => light_samples[k] = scene.sample_chosen(light, sp.p, u, None),
+                            None => ls = scene.sample_chosen(light, sp.p, u, None),
                         }
                     }
                 }
@@ -424,10 +425,17 @@ impl Wavefront {
                     (u, numbers.get1(dims::bounce(depth, dims::BSDF_COMPONENT)))
                 }
             });
-            let ls = light_samples.get(k).and_then(Option::as_ref);
-            let (b, row) = bounce.begin((k, path), (*shape, sp), (ls, bsdf_numbers), sampler);
+            let (b, row) = bounce.begin(
+                (k, path),
+                (*shape, sp),
+                (ls.as_ref(), bsdf_numbers),
+                sampler,
+            );
+            let point = ls.and_then(|ls| ls.point).map(|(y, _)| y);
+            light_points.extend(point);
             begun.push(Begun {
                 row: kernel_rows.push(b.diffuse, row),
+                to_point: point.is_some(),
                 ..b
             });
         }
@@ -441,7 +449,6 @@ impl Wavefront {
             if let (Some(ls), Some(b)) = (&ls, begun.get(k as usize)) {
                 kernel_rows.set_light(b, ls);
             }
-            light_samples[k as usize] = ls;
         };
         scene.sample_environment_cells(&by_cells.draws, env_samples, density, |i, ls| {
             light(by_cells.at[i], ls);
@@ -454,7 +461,8 @@ impl Wavefront {
     /// The last two steps of shading every path in flight (at bounce
     /// `depth`, begun by [`Wavefront::begin_vertices`]): the BSDF kernel
     /// over every row, then each path's light sample's light kept with its
-    /// shadow ray (`self.shadows`, `self.shadow_rays`) and its next ray
+    /// shadow ray (up to its point in `self.light_points`, if on an area
+    /// light) (`self.shadows`, `self.shadow_rays`) and its next ray
     /// (`self.rays`). The paths that end are removed; the others keep their
     /// order, so that they line up with their rays.
     fn shade(
@@ -466,7 +474,7 @@ impl Wavefront {
         let Wavefront {
             paths,
             surfaces,
-            light_samples,
+            light_points,
             dims: wanted,
             drawn,
             begun,
@@ -479,26 +487,28 @@ impl Wavefront {
         debug_assert_eq!(begun.len(), paths.len());
         let bounce = Bounce { scene, settings };
         let drawn = (&wanted[..], &drawn.values[..]);
-        let light = |k: usize| light_samples.get(k).and_then(Option::as_ref);
+        let mut points = light_points.iter();
         kernel_rows.run(settings, depth);
         let mut rows_out = kernel_rows.out(begun);
         paths.retain_mut(|path| {
-            let Some((b, out)) = rows_out.next() else {
+            let Some((b, rows)) = rows_out.next() else {
                 debug_assert!(false, "a path without its BSDF sample");
                 return false;
             };
             let k = b.k as usize;
             let roulette = |path: &mut Path, dim| {
-                with_numbers(streams, drawn, (k, path), |numbers, _| numbers.get1(dim))
+                with_numbers(streams, drawn, (k, path), |numbers| numbers.get1(dim))
             };
-            let vertex = (b, &surfaces[k].1, out);
-            let next = bounce.finish(path, vertex, light(k), (shadows, shadow_rays), roulette);
+            let vertex = (b, &surfaces[k].1, rows);
+            let point = if b.to_point { points.next() } else { None };
+            let next = bounce.finish(path, vertex, point, (shadows, shadow_rays), roulette);
             let Some(ray) = next else {
                 return false;
             };
             rays.push(ray);
             true
         });
+        debug_assert!(points.next().is_none(), "a light's point without its path");
     }
 
     /// The last vertex of every path in flight, where only an area
@@ -561,7 +571,7 @@ fn escape(scene: &Scene, settings: &Settings, escaped: &mut Escaped, path: &Path
     }
 }
 
-/// `f` of `path` and the numbers of its vertex (`k`: its index among the
+/// `f` of the numbers of `path`'s vertex (`k`: its index among the
 /// bounce's paths, whose numbers `drawn` were drawn beforehand), its
 /// pixel's stream set to its sample. The independent sampler draws from a
 /// copy of the generator the path carries, in the stream, and the path
@@ -571,7 +581,7 @@ fn with_numbers<T>(
     streams: &mut [Stream],
     drawn: (&[Dim], &[[f32; 2]]),
     (k, path): (usize, &mut Path),
-    f: impl FnOnce(&mut Numbers, &mut Path) -> T,
+    f: impl FnOnce(&mut Numbers) -> T,
 ) -> T {
     let stream = &mut streams[path.pixel as usize];
     stream.start(path.index);
@@ -579,7 +589,7 @@ fn with_numbers<T>(
         rng.clone_from(own);
     }
     let mut numbers = Numbers::new(stream, drawn, k);
-    let out = f(&mut numbers, path);
+    let out = f(&mut numbers);
     if let (Some(rng), Some(own)) = (numbers.stream.independent(), path.rng.as_mut()) {
         own.resume(rng);
     }

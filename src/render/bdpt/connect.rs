@@ -120,7 +120,10 @@ pub(super) fn connect(
         };
         y.pdf_fwd = pdf_light_origin(ctx, &y);
         let f = scatter(ctx, pt, &cam[t - 2], &y, false);
-        if f.iter().all(|&v| v == 0.0) || scene.occluded(&shadow_ray(pt.p, pt.ng, &ls), ctx.tau) {
+        let end = ls.point.as_ref().map(|(y, _)| y);
+        if f.iter().all(|&v| v == 0.0)
+            || scene.occluded(&shadow_ray(pt.p, pt.ng, ls.d, end), ctx.tau)
+        {
             return None;
         }
         sampled = Some(y);

@@ -52,11 +52,11 @@ use crate::simd;
 pub(super) const BSDF_IN: usize = 17 + VIEW_TERMS;
 
 /// Numbers per row out of [`bsdf_kernel`]: the light sample's light
-/// `f_r · L` (3) and its scale `w |cos θ_l| / p_l` (1), whether `f_r > 0`
-/// in some channel (1: 1 or 0), then the BSDF sample's direction in world
-/// space (3), density and weight (3). The light's four are meaningless
-/// (the scale NaN: `p_l = 0`) in a row without a light sample, whose path
-/// has none to connect.
+/// `f_r · L` (3) and its scale `w |cos θ_l| / p_l` (1), whether the sample
+/// is to be connected (1: 1 or 0; `p_l > 0` and `f_r > 0` in some
+/// channel), then the BSDF sample's direction in world space (3), density
+/// and weight (3). The light's four are meaningless (the scale NaN:
+/// `p_l = 0`) in a row without a light sample, which is never connected.
 pub(super) const BSDF_OUT: usize = 12;
 
 /// What [`Bounce::finish`] needs of a path's [`Bounce::begin`].
@@ -73,6 +73,10 @@ pub(super) struct Begun {
     /// Whether its BRDF has no glossy part (`ρs = 0`: its row goes to
     /// the kernel without the lobe, [`KernelRows`]).
     pub diffuse: bool,
+    /// Whether its light sample is a point on an area light (its shadow
+    /// ray ends there): the next of the bounce's points, which are kept
+    /// in the paths' order.
+    pub to_point: bool,
 }
 
 /// The row of [`BSDF_IN`] numbers of [`bsdf_kernel`] at a vertex whose
@@ -106,6 +110,12 @@ fn set_row_light(row: &mut [f32; BSDF_IN], (wl, pdf, radiance): (V3<f32>, f32, [
     row[11..14].copy_from_slice(&radiance);
 }
 
+/// The light sample's direction in `row` ([`bsdf_row`]).
+#[inline]
+fn light_direction(row: &[f32; BSDF_IN]) -> Vec3A {
+    Vec3A::new(row[7], row[8], row[9])
+}
+
 /// The light sample `ls` as [`bsdf_row`] takes it: its direction, density
 /// and radiance.
 #[inline]
@@ -116,8 +126,9 @@ fn light_of(ls: &LightSample) -> (V3<f32>, f32, [f32; 3]) {
 /// The BSDF's part of a vertex's shading, for one row of [`BSDF_IN`]
 /// numbers ([`bsdf_row`]), in the shading frame [`Frame::around`] the
 /// row's normal: with `LIGHT`, toward the light sample's direction `wl`
-/// (density `p_l`, radiance `L`), `f_r(wi, wl) · L` and
-/// `w |cos θ_l| / p_l`, where `(f_r, p)` is [`PhongView::eval_pdf`] and the
+/// (density `p_l`, radiance `L`), `f_r(wi, wl) · L`,
+/// `w |cos θ_l| / p_l` and whether to connect it (`p_l > 0`, none
+/// without a light sample, and `f_r > 0`), where `(f_r, p)` is [`PhongView::eval_pdf`] and the
 /// MIS weight `w` is `mis`'s `w(p_l, p)` (1 without MIS); with `SAMPLE`,
 /// the sample [`PhongView::sample`] of `[u0, u1, part]`, its direction
 /// taken to world space and normalised; as [`BSDF_OUT`] numbers (zeros for
@@ -163,7 +174,7 @@ pub(super) fn bsdf_kernel<const LIGHT: bool, const SAMPLE: bool, const GLOSSY: b
             view.eval_pdf_diffuse(wl)
         };
         let w = mis.map_or(1.0, |h| h.weight(pdf_l, pdf));
-        let lit = (f[0] > 0.0) | (f[1] > 0.0) | (f[2] > 0.0);
+        let lit = ((f[0] > 0.0) | (f[1] > 0.0) | (f[2] > 0.0)) & (pdf_l > 0.0);
         let lit = if lit { 1.0 } else { 0.0 };
         (mul(f, [e0, e1, e2]), w * wl[2].abs() / pdf_l, lit)
     } else {
@@ -290,27 +301,31 @@ impl KernelRows {
     }
 
     /// The paths `begun` (in the order their rows went in) with their
-    /// rows out.
+    /// rows in and out.
     pub fn out<'a>(&'a self, begun: &'a [Begun]) -> RowsOut<'a> {
         debug_assert_eq!(begun.len(), self.diffuse.out.len() + self.glossy.out.len());
         RowsOut {
             begun: begun.iter(),
-            diffuse: self.diffuse.out.iter(),
-            glossy: self.glossy.out.iter(),
+            diffuse: self.diffuse.rows.iter().zip(&self.diffuse.out),
+            glossy: self.glossy.rows.iter().zip(&self.glossy.out),
         }
     }
 }
 
-/// The paths of a bounce with their rows out of [`KernelRows`], path
-/// after path.
+/// A group's rows in with their rows out.
+type Group<'a> =
+    std::iter::Zip<std::slice::Iter<'a, [f32; BSDF_IN]>, std::slice::Iter<'a, [f32; BSDF_OUT]>>;
+
+/// The paths of a bounce with their rows in and out of [`KernelRows`],
+/// path after path.
 pub(super) struct RowsOut<'a> {
     begun: std::slice::Iter<'a, Begun>,
-    diffuse: std::slice::Iter<'a, [f32; BSDF_OUT]>,
-    glossy: std::slice::Iter<'a, [f32; BSDF_OUT]>,
+    diffuse: Group<'a>,
+    glossy: Group<'a>,
 }
 
 impl<'a> Iterator for RowsOut<'a> {
-    type Item = (&'a Begun, &'a [f32; BSDF_OUT]);
+    type Item = (&'a Begun, (&'a [f32; BSDF_IN], &'a [f32; BSDF_OUT]));
 
     #[inline]
     fn next(&mut self) -> Option<Self::Item> {
@@ -359,7 +374,8 @@ impl Bounce<'_> {
     /// and its BSDF sample's numbers `bsdf_numbers` (`u`, then the part's;
     /// its frame as `sampler` wants it: [`turns_with_azimuth`]). The
     /// returned [`Begun::row`] is 0, for the caller to set from
-    /// [`KernelRows::push`].
+    /// [`KernelRows::push`], and its [`Begun::to_point`] false, for the
+    /// caller to set where it keeps the light sample's point.
     #[inline]
     pub fn begin(
         &self,
@@ -377,26 +393,27 @@ impl Bounce<'_> {
         let light = ls
             .filter(|_| settings.strategy != Strategy::Bsdf)
             .map(light_of);
-        let bsdf = &scene.material(shape).bsdf;
         let row = bsdf_row(
             (normal, wi.to_array()),
             light,
             bsdf_numbers,
-            &bsdf.view_terms(),
+            scene.view_terms(shape),
         );
         let begun = Begun {
             k: k as u32,
             row: 0,
             ends: ends_after_light(settings, path.depth),
-            diffuse: !bsdf.is_glossy(),
+            diffuse: !scene.material(shape).bsdf.is_glossy(),
+            to_point: false,
         };
         (begun, row)
     }
 
     /// The last step of shading a path's vertex (at `sp`, begun as
-    /// `begun`, with the kernel's numbers `out`): its light sample `ls`
-    /// connected (its light kept in `shadows` with its shadow ray, when the
-    /// BRDF toward it is not zero), and the path moved on along its BSDF
+    /// `begun`, with its kernel's rows in and out): its light sample
+    /// connected (its light kept in `shadows` with its shadow ray, toward
+    /// the row's direction and up to `point` on an area light, when the
+    /// kernel says to connect it), and the path moved on along its BSDF
     /// sample, after roulette (whose number `roulette` draws for the path
     /// and a dimension). The path's next ray when it goes on (also its
     /// `ray`: handed back by value, as the caller stores it too, because
@@ -406,17 +423,14 @@ impl Bounce<'_> {
     pub fn finish(
         &self,
         path: &mut Path,
-        (begun, sp, out): (&Begun, &SurfacePoint, &[f32; BSDF_OUT]),
-        ls: Option<&LightSample>,
+        (begun, sp, (row, out)): (&Begun, &SurfacePoint, (&[f32; BSDF_IN], &[f32; BSDF_OUT])),
+        point: Option<&SurfacePoint>,
         (shadows, shadow_rays): (&mut Vec<Unshadowed>, &mut Vec<Ray>),
         roulette: impl FnOnce(&mut Path, u32) -> f32,
     ) -> Option<Ray> {
         let settings = self.settings;
         let [c0, c1, c2, scale, lit, x, y, z, pdf, r, g, b] = *out;
-        if settings.strategy != Strategy::Bsdf
-            && lit > 0.0
-            && let Some(ls) = ls
-        {
+        if lit > 0.0 {
             shadows.push(Unshadowed {
                 slot: path.slot,
                 time: path.time,
@@ -424,7 +438,7 @@ impl Bounce<'_> {
                 fc: [c0, c1, c2],
                 s: scale,
             });
-            shadow_rays.push(shadow_ray(sp.p, sp.ng, ls));
+            shadow_rays.push(shadow_ray(sp.p, sp.ng, light_direction(row), point));
         }
         if begun.ends || [r, g, b].iter().all(|&v| v <= 0.0) {
             return None;

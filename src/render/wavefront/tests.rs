@@ -198,6 +198,7 @@ fn kernel_rows_give_each_path_the_general_kernel_s_bits() {
                 row: 0,
                 ends: false,
                 diffuse: !bsdf.is_glossy(),
+                to_point: false,
             };
             (begun, row)
         })
@@ -225,8 +226,13 @@ fn kernel_rows_give_each_path_the_general_kernel_s_bits() {
         kernel_rows.run(&s, 0);
         let out: Vec<_> = kernel_rows.out(&begun).collect();
         assert_eq!(out.len(), rows.len(), "{strategy:?}");
-        for (k, ((b, row), want)) in out.iter().zip(&expected).enumerate() {
+        for (k, ((b, (row_in, row)), want)) in out.iter().zip(&expected).enumerate() {
             assert_eq!(b.k, k as u32, "{strategy:?}");
+            assert_eq!(row_in.map(f32::to_bits), rows[k].map(f32::to_bits));
+            // A row without a light sample is never connected.
+            if rows[k][10] == 0.0 {
+                assert_eq!(row[4], 0.0, "{strategy:?} {k}");
+            }
             assert_eq!(
                 row.map(f32::to_bits),
                 want.map(f32::to_bits),
@@ -320,6 +326,19 @@ fn the_kernel_gives_each_path_s_frame_light_and_direction() {
         checked[usize::from(lit > 0.0)] += 1;
     }
     assert!(checked.iter().all(|&c| c > 30), "{checked:?}");
+    // A light direction of density 0 (no light sample) is never connected,
+    // though the BRDF toward it is not zero.
+    let up = [0.0, 0.0, 1.0];
+    for pdf_l in [0.0, 1.0] {
+        let row = bsdf_row(
+            ((up, false), up),
+            Some((up, pdf_l, [1.0; 3])),
+            ([0.5, 0.5], 0.5),
+            &bsdf.view_terms(),
+        );
+        let out = general_kernel::<true, true>(&[row], Some(Heuristic::Power))[0];
+        assert_eq!(out[4], pdf_l, "{out:?}");
+    }
 }
 
 /// A light sample written into a row after the row was pushed (as the
@@ -360,13 +379,15 @@ fn a_light_sample_written_later_is_the_row_s_own() {
             row: later.push(diffuse, row(None)),
             ends: false,
             diffuse,
+            to_point: false,
         };
         later.set_light(&begun, &ls);
         first.push(diffuse, row(Some((ls.d.to_array(), ls.pdf, ls.radiance))));
         later.run(&settings, 0);
         first.run(&settings, 0);
         let begun = [begun];
-        let (Some((_, a)), Some((_, b))) = (later.out(&begun).next(), first.out(&begun).next())
+        let (Some((_, (_, a))), Some((_, (_, b)))) =
+            (later.out(&begun).next(), first.out(&begun).next())
         else {
             panic!("no row out");
         };
