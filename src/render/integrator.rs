@@ -303,18 +303,25 @@ pub(super) fn add_scaled(acc: &mut [f32; 3], a: [f32; 3], b: [f32; 3], s: f32) {
 /// loops whose texel and table reads overlap.
 #[derive(Debug, Default)]
 pub struct Escaped {
-    /// The sample (index in the batch) each ray belongs to.
-    slot: Vec<u32>,
-    /// World directions.
+    /// World directions (apart: the lookups read them as one array).
     dir: Vec<[f32; 3]>,
-    /// The path throughput `β`.
-    beta: Vec<[f32; 3]>,
-    /// The BSDF density that drew the ray, where the MIS weight against
-    /// environment sampling remains to be applied.
-    bsdf_pdf: Vec<Option<f32>>,
+    /// What the light each ray finds is added to.
+    to: Vec<EscapedTo>,
     /// Scratch for the batch: radiance and environment densities.
     radiance: Vec<[f32; 3]>,
     light_pdf: Vec<f32>,
+}
+
+/// Where the light an escaped ray finds goes, and its weights.
+#[derive(Clone, Copy, Debug)]
+struct EscapedTo {
+    /// The sample (index in the batch) the ray belongs to.
+    slot: u32,
+    /// The path throughput `β`.
+    beta: [f32; 3],
+    /// The BSDF density that drew the ray, where the MIS weight against
+    /// environment sampling remains to be applied.
+    bsdf_pdf: Option<f32>,
 }
 
 impl Escaped {
@@ -324,15 +331,13 @@ impl Escaped {
     /// [`crate::Error::Memory`] when the memory cannot be had.
     pub fn reserve(&mut self, n: usize) -> crate::Result<()> {
         alloc::reserve_each!(n, "the batch's escaped rays";
-            self.slot, self.dir, self.beta, self.bsdf_pdf, self.radiance, self.light_pdf)
+            self.dir, self.to, self.radiance, self.light_pdf)
     }
 
     /// Forgets every ray (keeping the memory).
     pub fn clear(&mut self) {
-        self.slot.clear();
         self.dir.clear();
-        self.beta.clear();
-        self.bsdf_pdf.clear();
+        self.to.clear();
         self.radiance.clear();
         self.light_pdf.clear();
     }
@@ -341,10 +346,12 @@ impl Escaped {
     /// when its MIS weight against environment sampling remains to apply.
     #[inline]
     pub(super) fn push(&mut self, slot: u32, d: Vec3A, beta: [f32; 3], bsdf_pdf: Option<f32>) {
-        self.slot.push(slot);
         self.dir.push(d.to_array());
-        self.beta.push(beta);
-        self.bsdf_pdf.push(bsdf_pdf);
+        self.to.push(EscapedTo {
+            slot,
+            beta,
+            bsdf_pdf,
+        });
     }
 }
 
@@ -359,7 +366,7 @@ pub fn add_escaped(scene: &Scene, settings: &Settings, escaped: &mut Escaped, l:
     env.eval_into(&escaped.dir, &mut escaped.radiance);
     // The densities from the first ray whose MIS weight remains to apply:
     // the camera's rays, which come first, need none.
-    if let Some(first) = escaped.bsdf_pdf.iter().position(Option::is_some) {
+    if let Some(first) = escaped.to.iter().position(|to| to.bsdf_pdf.is_some()) {
         escaped.light_pdf.resize(n, 0.0);
         scene.environment_pdf_into(
             &escaped.dir[first..],
@@ -367,14 +374,12 @@ pub fn add_escaped(scene: &Scene, settings: &Settings, escaped: &mut Escaped, l:
             settings.env_density(),
         );
     }
-    for i in 0..n {
-        let w = escaped.bsdf_pdf[i].map_or(1.0, |p| settings.weight(p, escaped.light_pdf[i]));
-        add_scaled(
-            &mut l[escaped.slot[i] as usize],
-            escaped.beta[i],
-            escaped.radiance[i],
-            w,
-        );
+    let light_pdf = &escaped.light_pdf;
+    for (i, (to, &radiance)) in escaped.to.iter().zip(&escaped.radiance).enumerate() {
+        let w = to
+            .bsdf_pdf
+            .map_or(1.0, |p| settings.weight(p, light_pdf[i]));
+        add_scaled(&mut l[to.slot as usize], to.beta, radiance, w);
     }
 }
 
