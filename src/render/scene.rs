@@ -70,8 +70,7 @@ fn bounding_sphere(accel: &Accel, movers: &[Mover]) -> (Vec3A, f32) {
 pub struct Scene {
     accel: Accel,
     materials: Vec<Material>,
-    /// Each shape's BRDF's [`crate::phong::Phong::view_terms`], computed
-    /// once.
+    /// Each shape's BRDF's [`Phong::view_terms`], computed once.
     view_terms: Vec<[f32; VIEW_TERMS]>,
     /// Whether each shape is a sphere (its shading frame:
     /// [`super::integrator::shading`]).
@@ -389,8 +388,7 @@ impl Scene {
         &self.materials[shape as usize]
     }
 
-    /// The view terms of shape `shape`'s BRDF
-    /// ([`crate::phong::Phong::view_terms`]).
+    /// The view terms of shape `shape`'s BRDF ([`Phong::view_terms`]).
     #[inline]
     pub(crate) fn view_terms(&self, shape: u32) -> &[f32; VIEW_TERMS] {
         &self.view_terms[shape as usize]

@@ -433,8 +433,7 @@ fn shadow_rays_reach_the_light_samples() {
                     continue;
                 }
                 drawn += 1;
-                let ray =
-                    integrator::shadow_ray(p, Vec3A::Z, ls.d, ls.point.as_ref().map(|(y, _)| y));
+                let ray = integrator::shadow_ray(p, Vec3A::Z, ls.d, ls.end());
                 reached += usize::from(!scene.accel().occluded(&ray));
             }
             assert!(drawn > 500, "{shape} {place}: {drawn} samples");

@@ -331,9 +331,10 @@ impl Wavefront {
     /// unless the vertex is the last (whose shading ends there: every path
     /// is removed), its light sample (none under BSDF sampling; the point
     /// of an area light's into `self.light_points`), the numbers of its
-    /// BSDF sample, and its row of the BSDF kernel ([`Bounce::begin`]). The light's choice and position
-    /// numbers (then, for an environment map's cell sampler, 64 random
-    /// bits) are the first the vertex asks for, the BSDF sample's next.
+    /// BSDF sample, and its row of the BSDF kernel ([`Bounce::begin`]).
+    /// The light's choice and position numbers (then, for an environment
+    /// map's cell sampler, 64 random bits) are the first the vertex asks
+    /// for, the BSDF sample's next.
     /// The environment map's samples are drawn together after the pass
     /// (their table reads overlap, and their directions are computed at
     /// SIMD width), and written into their rows then.
@@ -431,11 +432,9 @@ impl Wavefront {
                 (ls.as_ref(), bsdf_numbers),
                 sampler,
             );
-            let point = ls.and_then(|ls| ls.point).map(|(y, _)| y);
-            light_points.extend(point);
+            light_points.extend(ls.as_ref().and_then(LightSample::end));
             begun.push(Begun {
                 row: kernel_rows.push(b.diffuse, row),
-                to_point: point.is_some(),
                 ..b
             });
         }
@@ -461,8 +460,8 @@ impl Wavefront {
     /// The last two steps of shading every path in flight (at bounce
     /// `depth`, begun by [`Wavefront::begin_vertices`]): the BSDF kernel
     /// over every row, then each path's light sample's light kept with its
-    /// shadow ray (up to its point in `self.light_points`, if on an area
-    /// light) (`self.shadows`, `self.shadow_rays`) and its next ray
+    /// shadow ray (`self.shadows`, `self.shadow_rays`; up to its point in
+    /// `self.light_points` if on an area light) and its next ray
     /// (`self.rays`). The paths that end are removed; the others keep their
     /// order, so that they line up with their rays.
     fn shade(
@@ -501,6 +500,10 @@ impl Wavefront {
             };
             let vertex = (b, &surfaces[k].1, rows);
             let point = if b.to_point { points.next() } else { None };
+            debug_assert!(
+                !b.to_point || point.is_some(),
+                "a path without its light's point"
+            );
             let next = bounce.finish(path, vertex, point, (shadows, shadow_rays), roulette);
             let Some(ray) = next else {
                 return false;

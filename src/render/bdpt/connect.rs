@@ -120,9 +120,8 @@ pub(super) fn connect(
         };
         y.pdf_fwd = pdf_light_origin(ctx, &y);
         let f = scatter(ctx, pt, &cam[t - 2], &y, false);
-        let end = ls.point.as_ref().map(|(y, _)| y);
         if f.iter().all(|&v| v == 0.0)
-            || scene.occluded(&shadow_ray(pt.p, pt.ng, ls.d, end), ctx.tau)
+            || scene.occluded(&shadow_ray(pt.p, pt.ng, ls.d, ls.end()), ctx.tau)
         {
             return None;
         }

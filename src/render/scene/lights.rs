@@ -184,6 +184,15 @@ pub struct LightSample {
     pub point: Option<(SurfacePoint, u32)>,
 }
 
+impl LightSample {
+    /// The point on an area light where the shadow ray ends (`None` for
+    /// the environment).
+    #[inline]
+    pub fn end(&self) -> Option<&SurfacePoint> {
+        self.point.as_ref().map(|(y, _)| y)
+    }
+}
+
 /// Where light starts ([`Scene::sample_emission`]).
 #[derive(Clone, Copy, Debug)]
 pub enum Emission {

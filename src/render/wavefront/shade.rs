@@ -62,8 +62,9 @@ pub(super) const BSDF_OUT: usize = 12;
 /// What [`Bounce::finish`] needs of a path's [`Bounce::begin`].
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Begun {
-    /// The path's index at the bounce's start (of its surface, light
-    /// sample and numbers drawn beforehand).
+    /// The path's index at the bounce's start (of its surface and of its
+    /// numbers drawn beforehand; the environment map's samples drawn
+    /// together are handed back by it).
     pub k: u32,
     /// Its row's index in its group of [`KernelRows`] ([`KernelRows::push`]).
     pub row: u32,
@@ -128,8 +129,8 @@ fn light_of(ls: &LightSample) -> (V3<f32>, f32, [f32; 3]) {
 /// row's normal: with `LIGHT`, toward the light sample's direction `wl`
 /// (density `p_l`, radiance `L`), `f_r(wi, wl) · L`,
 /// `w |cos θ_l| / p_l` and whether to connect it (`p_l > 0`, none
-/// without a light sample, and `f_r > 0`), where `(f_r, p)` is [`PhongView::eval_pdf`] and the
-/// MIS weight `w` is `mis`'s `w(p_l, p)` (1 without MIS); with `SAMPLE`,
+/// without a light sample, and `f_r > 0`), where `(f_r, p)` is
+/// [`PhongView::eval_pdf`] and the MIS weight `w` is `mis`'s `w(p_l, p)` (1 without MIS); with `SAMPLE`,
 /// the sample [`PhongView::sample`] of `[u0, u1, part]`, its direction
 /// taken to world space and normalised; as [`BSDF_OUT`] numbers (zeros for
 /// the part not asked for: under BSDF sampling the light's power is
@@ -244,9 +245,12 @@ impl KernelRows {
         (group.rows.len() - 1) as u32
     }
 
-    /// The light sample `ls` written into the row of the path `begun`.
+    /// The light sample `ls`, the environment's (an area light's point
+    /// would have no place: [`Begun::to_point`]), written into the row of
+    /// the path `begun`.
     #[inline]
     pub fn set_light(&mut self, begun: &Begun, ls: &LightSample) {
+        debug_assert!(ls.point.is_none(), "an area light's sample written later");
         if let Some(row) = self.group(begun.diffuse).rows.get_mut(begun.row as usize) {
             set_row_light(row, light_of(ls));
         }
@@ -374,8 +378,8 @@ impl Bounce<'_> {
     /// and its BSDF sample's numbers `bsdf_numbers` (`u`, then the part's;
     /// its frame as `sampler` wants it: [`turns_with_azimuth`]). The
     /// returned [`Begun::row`] is 0, for the caller to set from
-    /// [`KernelRows::push`], and its [`Begun::to_point`] false, for the
-    /// caller to set where it keeps the light sample's point.
+    /// [`KernelRows::push`]; the caller keeps the point of an area light's
+    /// sample ([`Begun::to_point`]).
     #[inline]
     pub fn begin(
         &self,
@@ -404,7 +408,7 @@ impl Bounce<'_> {
             row: 0,
             ends: ends_after_light(settings, path.depth),
             diffuse: !scene.material(shape).bsdf.is_glossy(),
-            to_point: false,
+            to_point: ls.and_then(LightSample::end).is_some(),
         };
         (begun, row)
     }
